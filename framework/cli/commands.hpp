@@ -1,0 +1,21 @@
+#pragma once
+// Subcommands of the `redres` CLI. Each registers its options on the CLI11 app and returns the action to run.
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace redres::cli {
+
+/// Exit codes (DESIGN section 6).
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailedSteps = 1;
+inline constexpr int kExitBadInput = 2;
+
+/// An action run after parsing; returns the exit code.
+using Action = std::function<int()>;
+
+/// `redres robot FILE [--theta v1,v2,...] [--json]`.
+void add_robot_command(CLI::App& app, Action& action);
+
+}  // namespace redres::cli

@@ -1,0 +1,140 @@
+// `redres robot FILE`: the model's summary and its kinematics at theta (by default the home configuration).
+
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "redres/formula.hpp"
+#include "redres/kinematics.hpp"
+
+namespace redres::cli {
+
+namespace {
+
+struct RobotOptions {
+  std::string file;
+  std::string theta;
+  bool json = false;
+};
+
+Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      values.push_back(evaluate_constant(item));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--theta: ") + e.what());
+    }
+  }
+  if (static_cast<int>(values.size()) != model.dof()) {
+    throw std::invalid_argument("--theta: expected " + std::to_string(model.dof()) + " comma-separated values (one "
+                                "per joint), got " + std::to_string(values.size()));
+  }
+  Eigen::VectorXd theta = Eigen::Map<Eigen::VectorXd>(values.data(), model.dof());
+  require(theta.allFinite(), "--theta", "every value is finite");
+  return theta;
+}
+
+std::vector<double> to_vector(const Eigen::Ref<const Eigen::VectorXd>& v) { return {v.data(), v.data() + v.size()}; }
+
+nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const Eigen::VectorXd& lo,
+                       const Eigen::VectorXd& hi) {
+  nlohmann::json joints = nlohmann::json::array();
+  for (int j = 0; j < model.dof(); ++j) {
+    const JointSpec& jt = model.joint(j);
+    joints.push_back({{"name", jt.name},
+                      {"type", to_string(jt.type)},
+                      {"limits", {jt.lower, jt.upper}},
+                      {"velocity_law", jt.velocity_limit->describe()},
+                      {"velocity_limits", {lo(j), hi(j)}}});
+  }
+  nlohmann::json J = nlohmann::json::array();
+  for (Eigen::Index r = 0; r < k.J.rows(); ++r) J.push_back(to_vector(k.J.row(r).transpose()));
+  return {{"name", model.name()},
+          {"kind", to_string(model.kind())},
+          {"dof", model.dof()},
+          {"task", model.task_names()},
+          {"source", model.source()},
+          {"joints", joints},
+          {"theta", to_vector(k.theta)},
+          {"f", to_vector(k.f)},
+          {"J", J},
+          {"manipulability", k.w},
+          {"grad_manipulability", to_vector(k.grad_w)},
+          {"yoshikawa", k.mu},
+          {"grad_yoshikawa", to_vector(k.grad_mu)}};
+}
+
+std::string row(const Eigen::Ref<const Eigen::VectorXd>& v) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(9) << "[";
+  for (Eigen::Index i = 0; i < v.size(); ++i) s << (i ? ", " : "") << v(i);
+  s << "]";
+  return s.str();
+}
+
+void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::VectorXd& lo,
+                const Eigen::VectorXd& hi, bool at_home) {
+  std::ostream& o = std::cout;
+  std::string rows;
+  for (const auto& n : model.task_names()) rows += (rows.empty() ? "" : ", ") + n;
+  o << "robot   " << model.name() << " (" << to_string(model.kind()) << ", " << model.dof() << " joints, task rows "
+    << rows << ")\n";
+  if (!model.source().empty()) o << "source  " << model.source() << "\n";
+  o << "\njoint  name          type        theta^-      theta^+      velocity-limit law\n";
+  for (int j = 0; j < model.dof(); ++j) {
+    const JointSpec& jt = model.joint(j);
+    o << std::setw(5) << j + 1 << "  " << std::left << std::setw(12) << jt.name << "  " << std::setw(10)
+      << to_string(jt.type) << std::right << std::fixed << std::setprecision(6) << std::setw(11) << jt.lower << "  "
+      << std::setw(11) << jt.upper << "  " << jt.velocity_limit->describe() << "\n";
+  }
+  o << "\nat theta " << row(k.theta) << (at_home ? "  (home)" : "") << "\n";
+  o << "f        " << row(k.f) << "\n";
+  o << "J\n";
+  for (Eigen::Index r = 0; r < k.J.rows(); ++r) o << "  " << row(k.J.row(r).transpose()) << "\n";
+  o << std::setprecision(9) << "w = det(JJ')      " << k.w << "\n";
+  o << "grad w            " << row(k.grad_w) << "\n";
+  o << "sqrt(det(JJ'))    " << k.mu << "\n";
+  o << "grad sqrt         " << row(k.grad_mu) << "\n";
+  o << "\njoint  velocity limits at theta (lower, upper)\n";
+  for (int j = 0; j < model.dof(); ++j) {
+    o << std::setw(5) << j + 1 << "  " << std::setprecision(9) << std::setw(14) << lo(j) << "  " << std::setw(14)
+      << hi(j) << "\n";
+  }
+}
+
+}  // namespace
+
+void add_robot_command(CLI::App& app, Action& action) {
+  auto opts = std::make_shared<RobotOptions>();
+  CLI::App* cmd = app.add_subcommand("robot", "Print a robot model's summary and its kinematics at theta");
+  cmd->add_option("FILE", opts->file, "robot TOML file")->required();
+  cmd->add_option("--theta", opts->theta,
+                  "joint positions, comma-separated (formulas allowed, e.g. pi/4,pi/12); default: the home "
+                  "configuration");
+  cmd->add_flag("--json", opts->json, "print JSON instead of text");
+  cmd->callback([opts, &action] {
+    action = [opts] {
+      const RobotModel model = load_robot(opts->file);
+      const bool at_home = opts->theta.empty();
+      const Eigen::VectorXd theta = at_home ? model.home() : parse_theta(opts->theta, model);
+      KinematicsData k(model);
+      compute_kinematics(model, theta, k, KinematicsLevel::kAll);
+      Eigen::VectorXd lo(model.dof()), hi(model.dof());
+      model.velocity_limits(theta, lo, hi);
+      if (opts->json) {
+        std::cout << to_json(model, k, lo, hi).dump(2) << "\n";
+      } else {
+        print_text(model, k, lo, hi, at_home);
+      }
+      return kExitOk;
+    };
+  });
+}
+
+}  // namespace redres::cli

@@ -1,0 +1,42 @@
+#pragma once
+/// @file
+/// Error types. Bad configuration throws ConfigError; API misuse (wrong size, NaN input) throws
+/// std::invalid_argument with the violated condition in the message. Numerical outcomes (not converged,
+/// infeasible) are statuses in results, never exceptions.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace redres {
+
+/// Where in a configuration file something was found. `line` and `column` are 1-based; 0 means unknown.
+struct SourceLocation {
+  std::string file;        //!< path of the file as it was opened
+  std::uint32_t line = 0;  //!< 1-based line, 0 if unknown
+  std::uint32_t column = 0;  //!< 1-based column, 0 if unknown
+
+  /// "file:line:col" (or just "file" when the position is unknown).
+  [[nodiscard]] std::string str() const;
+};
+
+/// A configuration error. what() starts with "file:line:col: " when the location is known, then says what was
+/// expected.
+class ConfigError : public std::runtime_error {
+ public:
+  ConfigError(SourceLocation where, const std::string& message);
+
+  /// The location the error points at.
+  [[nodiscard]] const SourceLocation& where() const noexcept { return where_; }
+  /// The message without the location prefix.
+  [[nodiscard]] const std::string& detail() const noexcept { return detail_; }
+
+ private:
+  SourceLocation where_;
+  std::string detail_;
+};
+
+/// Throws std::invalid_argument("<function>: <condition>") when `ok` is false. Used for API misuse checks.
+void require(bool ok, const char* function, const std::string& condition);
+
+}  // namespace redres

@@ -1,0 +1,78 @@
+#pragma once
+/// @file
+/// Exact kinematics of a RobotModel: f(theta), J, the kinematic Hessian dJ/dtheta_i, the manipulability
+/// w = det(J J') with its gradient q (eq. 5, DESIGN section 4), and Yoshikawa's mu = sqrt(det(J J')) with its
+/// gradient. All results live in a KinematicsData workspace sized once for the model; compute() allocates
+/// nothing.
+///
+/// Gradients that stay valid at singular configurations:
+/// - q_i = d det(A)/d theta_i = trace(adj(A) dA/dtheta_i) with A = J J' (Jacobi's formula; the paper's
+///   w trace(A^-1 dA/dtheta_i) wherever A is invertible) = 2 <adj(A) J, dJ/dtheta_i>_F. The adjugate is formed
+///   from cofactors (m <= 3) or from A's eigen-decomposition (adj = V diag(prod_{j != k} lambda_j) V'), never
+///   from an inverse.
+/// - mu = prod_k s_k (singular values of J), d mu/d theta_i = sum_k (prod_{j != k} s_j) u_k' dJ/dtheta_i v_k,
+///   which is finite at every configuration and exact wherever the singular values are distinct.
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+
+#include "redres/robot.hpp"
+
+namespace redres {
+
+/// How much compute() evaluates; each level includes the previous ones.
+enum class KinematicsLevel {
+  kPosition,        //!< f, end-effector pose, joint frames
+  kJacobian,        //!< + J
+  kManipulability,  //!< + dJ/dtheta_i, w, q = grad w
+  kAll,             //!< + Yoshikawa's mu and grad mu
+};
+
+/// Per-call buffers and results for one model. Reentrant: use one per thread.
+class KinematicsData {
+ public:
+  /// Sizes every buffer for `model`.
+  explicit KinematicsData(const RobotModel& model);
+
+  Eigen::VectorXd theta;               //!< configuration the results belong to (n)
+  Eigen::VectorXd f;                   //!< task coordinates f(theta) (m): m, rad (planar phi), rotation vector
+  Eigen::Isometry3d ee_pose;           //!< end-effector pose in the base frame
+  Eigen::Matrix3Xd axes;               //!< z_j, joint axes in the base frame (3 x n)
+  Eigen::Matrix3Xd origins;            //!< p_j, points on the joint axes (3 x n), m
+  Eigen::MatrixXd J;                   //!< task Jacobian (m x n)
+  Eigen::MatrixXd dJ;                  //!< [dJ/dtheta_1, ..., dJ/dtheta_n] (m x n*n); see dJ_block()
+  double w = 0.0;                      //!< det(J J')
+  Eigen::VectorXd grad_w;              //!< q = d w / d theta (n)
+  double mu = 0.0;                     //!< Yoshikawa's sqrt(det(J J'))
+  Eigen::VectorXd grad_mu;             //!< d mu / d theta (n)
+  KinematicsLevel level = KinematicsLevel::kPosition;  //!< what the last compute() filled in
+
+  /// dJ/dtheta_i (m x n).
+  [[nodiscard]] auto dJ_block(int i) { return dJ.middleCols(static_cast<Eigen::Index>(i) * J.cols(), J.cols()); }
+  [[nodiscard]] auto dJ_block(int i) const {
+    return dJ.middleCols(static_cast<Eigen::Index>(i) * J.cols(), J.cols());
+  }
+
+ private:
+  friend void compute_kinematics(const RobotModel&, const Eigen::Ref<const Eigen::VectorXd>&, KinematicsData&,
+                                 KinematicsLevel);
+  Eigen::MatrixXd jjt_;                                   // A = J J' (m x m)
+  Eigen::MatrixXd adj_;                                   // adj(A) (m x m)
+  Eigen::MatrixXd weighted_;                              // adj(A) J or U diag(c) V' (m x n)
+  Eigen::VectorXd products_;                              // prod_{j != k} s_j (m)
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig_;    // for adj(A) when m > 3
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd_;                 // for mu
+};
+
+/// Evaluates the kinematics of `model` at `theta` into `data`. Throws std::invalid_argument when theta has the
+/// wrong size or is not finite. Allocation-free.
+void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
+                        KinematicsData& data, KinematicsLevel level = KinematicsLevel::kManipulability);
+
+/// det(A) and adj(A) of a symmetric m x m matrix without inverting it (cofactors for m <= 3, eigen-decomposition
+/// otherwise, using `eig` as scratch). Allocation-free when `adj` and `eig` are sized.
+double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> adj,
+                              Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>& eig);
+
+}  // namespace redres

@@ -1,0 +1,134 @@
+#pragma once
+/// @file
+/// The robot model: an immutable serial chain with per-joint position limits and velocity-limit laws.
+///
+/// Notation (as in the paper): n joints, theta in R^n joint positions (rad for revolute, m for prismatic),
+/// m task rows, f(theta) in R^m the end-effector task coordinates, J = df/dtheta in R^{m x n}.
+///
+/// Geometry. Every joint j is a fixed transform A_j, then the joint motion (Rz(theta_j) for revolute, Tz(theta_j)
+/// for prismatic), then a fixed transform B_j; the end effector is a fixed transform E after the last joint:
+///   T(theta) = A_1 M_1(theta_1) B_1 ... A_n M_n(theta_n) B_n E.
+/// - planar chains (relative joint angles, eq. in DESIGN section 5): A_j = I, B_j = Tx(l_j);
+///   so x = sum_i l_i cos(theta_1 + ... + theta_i) and y likewise with sin.
+/// - spatial, standard DH (`convention = "dh"`): A_j = Rz(theta_offset_j) [Tz(d_j) if prismatic],
+///   B_j = [Tz(d_j) if revolute] Tx(a_j) Rx(alpha_j). Joint j moves about/along the z axis of frame j-1.
+/// - spatial, modified DH (`convention = "modified_dh"`, Craig): A_j = Rx(alpha_j) Tx(a_j) Rz(theta_offset_j)
+///   [Tz(d_j) if prismatic], B_j = [Tz(d_j) if revolute]; alpha_j and a_j are those of the link before joint j
+///   (Craig's alpha_{j-1}, a_{j-1}). Joint j moves about/along the z axis of frame j.
+///
+/// Task rows (`task`): planar "position" = (x, y), planar "pose" = (x, y, phi) with phi the end-effector angle;
+/// spatial "position" = (x, y, z), spatial "pose" = (x, y, z, wx, wy, wz) where the last three rows of J are the
+/// geometric angular velocity in the base frame (so they are not the derivative of f's rotation-vector entries).
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "redres/toml_reader.hpp"
+#include "redres/velocity_limit.hpp"
+
+namespace redres {
+
+/// Planar chains move in the x-y plane; spatial chains in 3-D.
+enum class ChainKind { kPlanar, kSpatial };
+/// Joint type.
+enum class JointType { kRevolute, kPrismatic };
+/// Denavit-Hartenberg convention of a spatial chain.
+enum class DhConvention { kStandard, kModified };
+/// Which task-space rows the chain exposes.
+enum class TaskRows { kPosition, kPose };
+
+/// One joint as described in the robot file.
+struct JointSpec {
+  std::string name;                             //!< unique joint name
+  JointType type = JointType::kRevolute;        //!< revolute (rad) or prismatic (m; spatial chains only)
+  double length = 0.0;                          //!< planar link length l_j after the joint (m, > 0)
+  double a = 0.0;                               //!< DH link length (m)
+  double alpha = 0.0;                           //!< DH link twist (rad)
+  double d = 0.0;                               //!< DH link offset (m)
+  double theta_offset = 0.0;                    //!< DH joint-angle offset (rad)
+  double lower = 0.0;                           //!< position limit theta^- (rad or m)
+  double upper = 0.0;                           //!< position limit theta^+ (rad or m)
+  std::shared_ptr<const VelocityLimitLaw> velocity_limit;  //!< theta_dot^-(theta), theta_dot^+(theta)
+};
+
+/// Everything needed to build a RobotModel; filled by the TOML loader or by code (tests, generators).
+struct RobotSpec {
+  std::string name;                                 //!< robot name
+  ChainKind kind = ChainKind::kPlanar;              //!< planar or spatial
+  DhConvention convention = DhConvention::kStandard;  //!< spatial only
+  TaskRows task = TaskRows::kPosition;              //!< task rows
+  std::vector<JointSpec> joints;                    //!< the chain, base to tip
+  Eigen::Isometry3d end_effector = Eigen::Isometry3d::Identity();  //!< E, in the last joint's frame
+  Eigen::VectorXd home;                             //!< home configuration (size n; empty = zeros)
+  std::string source;                               //!< file the spec came from (may be empty)
+};
+
+/// An immutable robot model. Construction validates the spec and throws std::invalid_argument on misuse.
+class RobotModel {
+ public:
+  /// Validates and precomputes the fixed transforms.
+  explicit RobotModel(RobotSpec spec);
+
+  /// Robot name.
+  [[nodiscard]] const std::string& name() const noexcept { return spec_.name; }
+  /// Planar or spatial.
+  [[nodiscard]] ChainKind kind() const noexcept { return spec_.kind; }
+  /// DH convention (spatial chains).
+  [[nodiscard]] DhConvention convention() const noexcept { return spec_.convention; }
+  /// Task rows.
+  [[nodiscard]] TaskRows task() const noexcept { return spec_.task; }
+  /// Number of joints n.
+  [[nodiscard]] int dof() const noexcept { return static_cast<int>(spec_.joints.size()); }
+  /// Number of task rows m (2 or 3 planar, 3 or 6 spatial).
+  [[nodiscard]] int task_dim() const noexcept { return task_dim_; }
+  /// Names of the task rows, e.g. {"x", "y"}.
+  [[nodiscard]] const std::vector<std::string>& task_names() const noexcept { return task_names_; }
+  /// Joint j (0-based).
+  [[nodiscard]] const JointSpec& joint(int j) const { return spec_.joints.at(static_cast<std::size_t>(j)); }
+  /// All joints.
+  [[nodiscard]] const std::vector<JointSpec>& joints() const noexcept { return spec_.joints; }
+  /// Home configuration.
+  [[nodiscard]] const Eigen::VectorXd& home() const noexcept { return spec_.home; }
+  /// Position limits theta^- and theta^+.
+  [[nodiscard]] const Eigen::VectorXd& lower_limits() const noexcept { return lower_; }
+  [[nodiscard]] const Eigen::VectorXd& upper_limits() const noexcept { return upper_; }
+  /// End-effector transform E in the last joint's frame.
+  [[nodiscard]] const Eigen::Isometry3d& end_effector() const noexcept { return spec_.end_effector; }
+  /// Fixed transforms before and after joint j's motion.
+  [[nodiscard]] const Eigen::Isometry3d& before(int j) const { return before_[static_cast<std::size_t>(j)]; }
+  [[nodiscard]] const Eigen::Isometry3d& after(int j) const { return after_[static_cast<std::size_t>(j)]; }
+  /// File the model was loaded from (empty when built in code).
+  [[nodiscard]] const std::string& source() const noexcept { return spec_.source; }
+  /// The spec the model was built from.
+  [[nodiscard]] const RobotSpec& spec() const noexcept { return spec_; }
+
+  /// Velocity limits of every joint at theta; writes into lower/upper (size n). Allocation-free.
+  void velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
+                       Eigen::Ref<Eigen::VectorXd> upper) const;
+
+ private:
+  RobotSpec spec_;
+  int task_dim_ = 0;
+  std::vector<std::string> task_names_;
+  Eigen::VectorXd lower_, upper_;
+  std::vector<Eigen::Isometry3d> before_, after_;
+};
+
+/// Loads a robot TOML file. Every problem is a ConfigError starting "file:line:col:".
+[[nodiscard]] RobotModel load_robot(const std::filesystem::path& file);
+
+/// Loads a robot from a table (the root of a robot file, or a table embedded in another file).
+[[nodiscard]] RobotModel load_robot(const TableReader& table);
+
+/// Text name of an enum value ("planar", "revolute", "dh", "position", ...).
+[[nodiscard]] const char* to_string(ChainKind kind);
+[[nodiscard]] const char* to_string(JointType type);
+[[nodiscard]] const char* to_string(DhConvention convention);
+[[nodiscard]] const char* to_string(TaskRows rows);
+
+}  // namespace redres

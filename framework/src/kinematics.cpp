@@ -1,0 +1,208 @@
+#include "redres/kinematics.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace redres {
+
+namespace {
+
+using Eigen::Vector3d;
+
+// Velocity of a point p (or a free vector when `point` is false) induced by a unit rate of joint i.
+Vector3d joint_motion(bool revolute, const Vector3d& z_i, const Vector3d& p_i, const Vector3d& p) {
+  return revolute ? Vector3d(z_i.cross(p - p_i)) : z_i;
+}
+
+// Writes the selected task rows of a spatial 6-vector (linear; angular) into column `col` of `out`.
+void put_rows(const RobotModel& model, const Vector3d& lin, const Vector3d& ang, Eigen::Ref<Eigen::MatrixXd> out,
+              Eigen::Index col) {
+  if (model.kind() == ChainKind::kPlanar) {
+    out(0, col) = lin.x();
+    out(1, col) = lin.y();
+    if (model.task() == TaskRows::kPose) out(2, col) = ang.z();
+  } else {
+    out.block<3, 1>(0, col) = lin;
+    if (model.task() == TaskRows::kPose) out.block<3, 1>(3, col) = ang;
+  }
+}
+
+}  // namespace
+
+KinematicsData::KinematicsData(const RobotModel& model)
+    : theta(Eigen::VectorXd::Zero(model.dof())),
+      f(Eigen::VectorXd::Zero(model.task_dim())),
+      ee_pose(Eigen::Isometry3d::Identity()),
+      axes(Eigen::Matrix3Xd::Zero(3, model.dof())),
+      origins(Eigen::Matrix3Xd::Zero(3, model.dof())),
+      J(Eigen::MatrixXd::Zero(model.task_dim(), model.dof())),
+      dJ(Eigen::MatrixXd::Zero(model.task_dim(), static_cast<Eigen::Index>(model.dof()) * model.dof())),
+      grad_w(Eigen::VectorXd::Zero(model.dof())),
+      grad_mu(Eigen::VectorXd::Zero(model.dof())),
+      jjt_(Eigen::MatrixXd::Zero(model.task_dim(), model.task_dim())),
+      adj_(Eigen::MatrixXd::Zero(model.task_dim(), model.task_dim())),
+      weighted_(Eigen::MatrixXd::Zero(model.task_dim(), model.dof())),
+      products_(Eigen::VectorXd::Zero(model.task_dim())),
+      eig_(model.task_dim()),
+      svd_(model.task_dim(), model.dof(), Eigen::ComputeThinU | Eigen::ComputeThinV) {}
+
+double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> adj,
+                              Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>& eig) {
+  const Eigen::Index m = A.rows();
+  switch (m) {
+    case 1:
+      adj(0, 0) = 1.0;
+      return A(0, 0);
+    case 2:
+      adj(0, 0) = A(1, 1);
+      adj(1, 1) = A(0, 0);
+      adj(0, 1) = -A(0, 1);
+      adj(1, 0) = -A(1, 0);
+      return A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+    case 3: {
+      // adj(A)_{ij} = cofactor C_{ji}; A symmetric so adj is too.
+      adj(0, 0) = A(1, 1) * A(2, 2) - A(1, 2) * A(2, 1);
+      adj(0, 1) = A(0, 2) * A(2, 1) - A(0, 1) * A(2, 2);
+      adj(0, 2) = A(0, 1) * A(1, 2) - A(0, 2) * A(1, 1);
+      adj(1, 0) = A(1, 2) * A(2, 0) - A(1, 0) * A(2, 2);
+      adj(1, 1) = A(0, 0) * A(2, 2) - A(0, 2) * A(2, 0);
+      adj(1, 2) = A(0, 2) * A(1, 0) - A(0, 0) * A(1, 2);
+      adj(2, 0) = A(1, 0) * A(2, 1) - A(1, 1) * A(2, 0);
+      adj(2, 1) = A(0, 1) * A(2, 0) - A(0, 0) * A(2, 1);
+      adj(2, 2) = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+      return A(0, 0) * adj(0, 0) + A(0, 1) * adj(1, 0) + A(0, 2) * adj(2, 0);
+    }
+    default: {
+      eig.compute(A);
+      const auto& lambda = eig.eigenvalues();
+      const auto& V = eig.eigenvectors();
+      adj.setZero();
+      double det = 1.0;
+      for (Eigen::Index k = 0; k < m; ++k) {
+        det *= lambda(k);
+        double others = 1.0;
+        for (Eigen::Index j = 0; j < m; ++j) {
+          if (j != k) others *= lambda(j);
+        }
+        adj.noalias() += others * V.col(k) * V.col(k).transpose();
+      }
+      return det;
+    }
+  }
+}
+
+void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
+                        KinematicsData& data, KinematicsLevel level) {
+  const int n = model.dof();
+  require(theta.size() == n, "compute_kinematics",
+          "theta.size() == dof() (got " + std::to_string(theta.size()) + ", expected " + std::to_string(n) + ")");
+  require(theta.allFinite(), "compute_kinematics", "theta is finite (it contains NaN or Inf)");
+  require(data.J.cols() == n && data.J.rows() == model.task_dim(), "compute_kinematics",
+          "data was sized for this model (KinematicsData(model))");
+
+  data.theta = theta;
+
+  // Forward pass: joint frames and end-effector pose.
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  double phi = 0.0;  // planar end-effector angle, kept unwrapped
+  for (int j = 0; j < n; ++j) {
+    const JointSpec& joint = model.joint(j);
+    T = T * model.before(j);
+    data.axes.col(j) = T.linear().col(2);
+    data.origins.col(j) = T.translation();
+    if (joint.type == JointType::kRevolute) {
+      T.rotate(Eigen::AngleAxisd(theta(j), Eigen::Vector3d::UnitZ()));
+      phi += theta(j);
+    } else {
+      T.translate(Eigen::Vector3d(0.0, 0.0, theta(j)));
+    }
+    T = T * model.after(j);
+  }
+  T = T * model.end_effector();
+  data.ee_pose = T;
+  const Vector3d p_e = T.translation();
+
+  if (model.kind() == ChainKind::kPlanar) {
+    data.f(0) = p_e.x();
+    data.f(1) = p_e.y();
+    if (model.task() == TaskRows::kPose) {
+      const Eigen::Matrix3d& E = model.end_effector().linear();
+      data.f(2) = phi + std::atan2(E(1, 0), E(0, 0));
+    }
+  } else {
+    data.f.head<3>() = p_e;
+    if (model.task() == TaskRows::kPose) {
+      const Eigen::AngleAxisd aa(T.linear());
+      data.f.tail<3>() = aa.angle() * aa.axis();
+    }
+  }
+  data.level = KinematicsLevel::kPosition;
+  if (level == KinematicsLevel::kPosition) return;
+
+  // Geometric Jacobian, task rows only.
+  for (int j = 0; j < n; ++j) {
+    const Vector3d z = data.axes.col(j);
+    if (model.joint(j).type == JointType::kRevolute) {
+      put_rows(model, z.cross(p_e - data.origins.col(j)), z, data.J, j);
+    } else {
+      put_rows(model, z, Vector3d::Zero(), data.J, j);
+    }
+  }
+  data.level = KinematicsLevel::kJacobian;
+  if (level == KinematicsLevel::kJacobian) return;
+
+  // Kinematic Hessian. A unit rate of joint i moves every axis z_j and point p_j with j > i, and p_e.
+  for (int i = 0; i < n; ++i) {
+    const bool rev_i = model.joint(i).type == JointType::kRevolute;
+    const Vector3d z_i = data.axes.col(i);
+    const Vector3d p_i = data.origins.col(i);
+    const Vector3d dp_e = joint_motion(rev_i, z_i, p_i, p_e);
+    auto block = data.dJ_block(i);
+    for (int j = 0; j < n; ++j) {
+      const Vector3d z_j = data.axes.col(j);
+      const Vector3d p_j = data.origins.col(j);
+      const bool downstream = i < j;
+      const Vector3d dz_j = (downstream && rev_i) ? Vector3d(z_i.cross(z_j)) : Vector3d::Zero();
+      const Vector3d dp_j = downstream ? joint_motion(rev_i, z_i, p_i, p_j) : Vector3d::Zero();
+      if (model.joint(j).type == JointType::kRevolute) {
+        put_rows(model, dz_j.cross(p_e - p_j) + z_j.cross(dp_e - dp_j), dz_j, block, j);
+      } else {
+        put_rows(model, dz_j, Vector3d::Zero(), block, j);
+      }
+    }
+  }
+
+  // w = det(J J') and q_i = 2 <adj(J J') J, dJ_i>_F.
+  data.jjt_.noalias() = data.J * data.J.transpose();
+  data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
+  data.weighted_.noalias() = data.adj_ * data.J;
+  for (int i = 0; i < n; ++i) data.grad_w(i) = 2.0 * data.weighted_.cwiseProduct(data.dJ_block(i)).sum();
+  data.level = KinematicsLevel::kManipulability;
+  if (level == KinematicsLevel::kManipulability) return;
+
+  // mu = prod s_k and d mu = sum_k (prod_{j != k} s_j) u_k' dJ v_k. With fewer joints than task rows a
+  // singular value is identically zero, so mu and its gradient vanish.
+  if (n < model.task_dim()) {
+    data.mu = 0.0;
+    data.grad_mu.setZero();
+  } else {
+    data.svd_.compute(data.J, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const auto& s = data.svd_.singularValues();
+    const Eigen::Index m = s.size();
+    data.mu = 1.0;
+    for (Eigen::Index k = 0; k < m; ++k) {
+      data.mu *= s(k);
+      double others = 1.0;
+      for (Eigen::Index j = 0; j < m; ++j) {
+        if (j != k) others *= s(j);
+      }
+      data.products_(k) = others;
+    }
+    data.adj_.noalias() = data.svd_.matrixU() * data.products_.asDiagonal();
+    data.weighted_.noalias() = data.adj_ * data.svd_.matrixV().transpose();
+    for (int i = 0; i < n; ++i) data.grad_mu(i) = data.weighted_.cwiseProduct(data.dJ_block(i)).sum();
+  }
+  data.level = KinematicsLevel::kAll;
+}
+
+}  // namespace redres

@@ -1,0 +1,217 @@
+#include "redres/robot.hpp"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace redres {
+
+const char* to_string(ChainKind kind) { return kind == ChainKind::kPlanar ? "planar" : "spatial"; }
+const char* to_string(JointType type) { return type == JointType::kRevolute ? "revolute" : "prismatic"; }
+const char* to_string(DhConvention convention) {
+  return convention == DhConvention::kStandard ? "dh" : "modified_dh";
+}
+const char* to_string(TaskRows rows) { return rows == TaskRows::kPosition ? "position" : "pose"; }
+
+namespace {
+
+using Eigen::AngleAxisd;
+using Eigen::Isometry3d;
+using Eigen::Vector3d;
+
+Isometry3d rot_z(double a) { return Isometry3d(AngleAxisd(a, Vector3d::UnitZ())); }
+Isometry3d rot_x(double a) { return Isometry3d(AngleAxisd(a, Vector3d::UnitX())); }
+Isometry3d trans(double x, double y, double z) {
+  Isometry3d t = Isometry3d::Identity();
+  t.translation() = Vector3d(x, y, z);
+  return t;
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+void validate(const RobotSpec& spec) {
+  const char* fn = "RobotModel";
+  require(!spec.name.empty(), fn, "name is not empty");
+  require(!spec.joints.empty(), fn, "the chain has at least one joint");
+  require(spec.end_effector.matrix().allFinite(), fn, "end_effector is finite");
+  std::set<std::string> names;
+  for (std::size_t j = 0; j < spec.joints.size(); ++j) {
+    const JointSpec& jt = spec.joints[j];
+    const std::string who = "joint " + std::to_string(j + 1) + " ('" + jt.name + "')";
+    require(!jt.name.empty(), fn, "joint " + std::to_string(j + 1) + " has a name");
+    require(names.insert(jt.name).second, fn, who + " has a unique name");
+    require(std::isfinite(jt.lower) && std::isfinite(jt.upper), fn, who + " limits are finite");
+    require(jt.lower < jt.upper, fn, who + " lower limit < upper limit (" + num(jt.lower) + " vs " +
+                                         num(jt.upper) + ")");
+    require(jt.velocity_limit != nullptr, fn, who + " has a velocity-limit law");
+    require(std::isfinite(jt.a) && std::isfinite(jt.alpha) && std::isfinite(jt.d) && std::isfinite(jt.theta_offset),
+            fn, who + " DH parameters are finite");
+    if (spec.kind == ChainKind::kPlanar) {
+      require(jt.type == JointType::kRevolute, fn, who + " is revolute (planar chains have revolute joints only)");
+      require(std::isfinite(jt.length) && jt.length > 0.0, fn, who + " length > 0 (got " + num(jt.length) + ")");
+    }
+  }
+  if (spec.home.size() != 0) {
+    require(spec.home.size() == static_cast<Eigen::Index>(spec.joints.size()), fn,
+            "home.size() == number of joints");
+    require(spec.home.allFinite(), fn, "home is finite");
+  }
+}
+
+}  // namespace
+
+RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
+  validate(spec_);
+  const int n = dof();
+  if (spec_.home.size() == 0) spec_.home = Eigen::VectorXd::Zero(n);
+  lower_.resize(n);
+  upper_.resize(n);
+  before_.reserve(static_cast<std::size_t>(n));
+  after_.reserve(static_cast<std::size_t>(n));
+  for (int j = 0; j < n; ++j) {
+    const JointSpec& jt = joint(j);
+    lower_(j) = jt.lower;
+    upper_(j) = jt.upper;
+    const bool revolute = jt.type == JointType::kRevolute;
+    if (spec_.kind == ChainKind::kPlanar) {
+      before_.push_back(Isometry3d::Identity());
+      after_.push_back(trans(jt.length, 0.0, 0.0));
+    } else if (spec_.convention == DhConvention::kStandard) {
+      before_.push_back(revolute ? rot_z(jt.theta_offset) : rot_z(jt.theta_offset) * trans(0.0, 0.0, jt.d));
+      after_.push_back((revolute ? trans(0.0, 0.0, jt.d) : Isometry3d::Identity()) * trans(jt.a, 0.0, 0.0) *
+                       rot_x(jt.alpha));
+    } else {
+      const Isometry3d link = rot_x(jt.alpha) * trans(jt.a, 0.0, 0.0) * rot_z(jt.theta_offset);
+      before_.push_back(revolute ? link : link * trans(0.0, 0.0, jt.d));
+      after_.push_back(revolute ? trans(0.0, 0.0, jt.d) : Isometry3d::Identity());
+    }
+  }
+  if (spec_.kind == ChainKind::kPlanar) {
+    task_names_ = {"x", "y"};
+    if (spec_.task == TaskRows::kPose) task_names_.emplace_back("phi");
+  } else {
+    task_names_ = {"x", "y", "z"};
+    if (spec_.task == TaskRows::kPose) task_names_.insert(task_names_.end(), {"wx", "wy", "wz"});
+  }
+  task_dim_ = static_cast<int>(task_names_.size());
+}
+
+void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
+                                 Eigen::Ref<Eigen::VectorXd> upper) const {
+  const int n = dof();
+  require(theta.size() == n && lower.size() == n && upper.size() == n, "RobotModel::velocity_limits",
+          "theta, lower and upper have size dof() = " + std::to_string(n));
+  for (int j = 0; j < n; ++j) {
+    const VelocityBounds b = spec_.joints[static_cast<std::size_t>(j)].velocity_limit->bounds(theta(j));
+    lower(j) = b.lower;
+    upper(j) = b.upper;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// TOML loading
+
+namespace {
+
+JointSpec load_joint(const TableReader& entry, ChainKind kind, std::set<std::string>& names) {
+  JointSpec jt;
+  jt.name = entry.string("name");
+  if (jt.name.empty()) entry.fail("name", "expected a non-empty joint name");
+  const TableReader r(entry.file_ptr(), entry.raw(), "joint '" + jt.name + "'");
+  (void)r.has("name");
+  if (!names.insert(jt.name).second) r.fail("name", "duplicate joint name '" + jt.name + "'");
+
+  const std::string type = kind == ChainKind::kPlanar ? r.choice("type", {"revolute"}, "revolute")
+                                                      : r.choice("type", {"revolute", "prismatic"}, "revolute");
+  jt.type = type == "revolute" ? JointType::kRevolute : JointType::kPrismatic;
+
+  if (kind == ChainKind::kPlanar) {
+    jt.length = r.number("length");
+    if (!(jt.length > 0.0)) r.fail("length", "expected a link length > 0 m, got " + num(jt.length));
+  } else {
+    jt.a = r.number("a", 0.0);
+    jt.alpha = r.number("alpha", 0.0);
+    jt.d = r.number("d", 0.0);
+    jt.theta_offset = r.number("theta_offset", 0.0);
+  }
+
+  const std::vector<double> lim = r.numbers("limits", 2);
+  jt.lower = lim[0];
+  jt.upper = lim[1];
+  if (!(jt.lower < jt.upper)) {
+    r.fail("limits", "expected [lower, upper] with lower < upper, got lower " + num(jt.lower) + " >= upper " +
+                         num(jt.upper));
+  }
+
+  const TableReader law_table = r.table("velocity_limit");
+  const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' velocity_limit");
+  jt.velocity_limit = velocity_limit_registry().create(law_reader);
+  law_reader.finish();
+  if (auto bad = check_velocity_law(*jt.velocity_limit, jt.lower, jt.upper)) {
+    law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() + "' is invalid at theta = " +
+                    num(bad->theta) + (jt.type == JointType::kRevolute ? " rad" : " m") + " (joint range [" +
+                    num(jt.lower) + ", " + num(jt.upper) + "]): " + bad->reason);
+  }
+  r.finish();
+  return jt;
+}
+
+}  // namespace
+
+RobotModel load_robot(const std::filesystem::path& file) {
+  return load_robot(TableReader::root(parse_toml_file(file), "robot"));
+}
+
+RobotModel load_robot(const TableReader& r) {
+  RobotSpec spec;
+  spec.source = r.file().path.string();
+  spec.name = r.string("name");
+  if (spec.name.empty()) r.fail("name", "expected a non-empty robot name");
+  spec.kind = r.choice("kind", {"planar", "spatial"}) == "planar" ? ChainKind::kPlanar : ChainKind::kSpatial;
+  if (spec.kind == ChainKind::kSpatial) {
+    spec.convention =
+        r.choice("convention", {"dh", "modified_dh"}) == "dh" ? DhConvention::kStandard : DhConvention::kModified;
+  }
+  spec.task = r.choice("task", {"position", "pose"}, "position") == "position" ? TaskRows::kPosition : TaskRows::kPose;
+
+  std::set<std::string> names;
+  for (const TableReader& entry : r.tables("joints")) spec.joints.push_back(load_joint(entry, spec.kind, names));
+  const auto n = static_cast<Eigen::Index>(spec.joints.size());
+
+  if (auto ee = r.optional_table("end_effector")) {
+    const TableReader e(ee->file_ptr(), ee->raw(), "end_effector");
+    if (spec.kind == ChainKind::kPlanar) {
+      const std::vector<double> p = e.has("position") ? e.numbers("position", 2) : std::vector<double>{0.0, 0.0};
+      spec.end_effector = trans(p[0], p[1], 0.0) * rot_z(e.number("angle", 0.0));
+    } else {
+      const std::vector<double> p =
+          e.has("position") ? e.numbers("position", 3) : std::vector<double>{0.0, 0.0, 0.0};
+      const std::vector<double> rpy = e.has("rpy") ? e.numbers("rpy", 3) : std::vector<double>{0.0, 0.0, 0.0};
+      spec.end_effector = trans(p[0], p[1], p[2]) * Isometry3d(AngleAxisd(rpy[2], Vector3d::UnitZ()) *
+                                                               AngleAxisd(rpy[1], Vector3d::UnitY()) *
+                                                               AngleAxisd(rpy[0], Vector3d::UnitX()));
+    }
+    e.finish();
+  }
+
+  if (r.has("home")) {
+    const std::vector<double> h = r.numbers("home", static_cast<std::size_t>(n));
+    spec.home = Eigen::Map<const Eigen::VectorXd>(h.data(), n);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const JointSpec& jt = spec.joints[static_cast<std::size_t>(j)];
+      if (h[static_cast<std::size_t>(j)] < jt.lower || h[static_cast<std::size_t>(j)] > jt.upper) {
+        r.fail("home", "expected joint '" + jt.name + "' within its limits [" + num(jt.lower) + ", " +
+                           num(jt.upper) + "], got " + num(h[static_cast<std::size_t>(j)]));
+      }
+    }
+  }
+  r.finish();
+  return RobotModel(std::move(spec));
+}
+
+}  // namespace redres

@@ -1,0 +1,260 @@
+#include "redres/toml_reader.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace redres {
+
+namespace {
+
+std::string join(const std::set<std::string, std::less<>>& names) {
+  std::string out;
+  for (const auto& n : names) {
+    if (!out.empty()) out += ", ";
+    out += n;
+  }
+  return out.empty() ? "(none)" : out;
+}
+
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) {
+    if (!out.empty()) out += ", ";
+    out += "'" + n + "'";
+  }
+  return out;
+}
+
+std::shared_ptr<const TomlFile> parse(std::string_view text, const std::filesystem::path& path) {
+  auto file = std::make_shared<TomlFile>();
+  file->path = path;
+  try {
+    file->root = toml::parse(text, path.string());
+  } catch (const toml::parse_error& e) {
+    const auto& b = e.source().begin;
+    throw ConfigError({path.string(), b.line, b.column},
+                      std::string("TOML syntax error: ") + std::string(e.description()));
+  }
+  return file;
+}
+
+}  // namespace
+
+std::shared_ptr<const TomlFile> parse_toml_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError({path.string(), 0, 0}, "cannot open file (does it exist and is it readable?)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parse(buffer.str(), path);
+}
+
+std::shared_ptr<const TomlFile> parse_toml_string(std::string_view text, const std::string& name) {
+  return parse(text, name);
+}
+
+SourceLocation location_of(const TomlFile& file, const toml::node& node) {
+  const auto& b = node.source().begin;
+  return {file.path.string(), b.line, b.column};
+}
+
+std::string describe_type(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+    default: return "nothing";
+  }
+}
+
+TableReader::TableReader(std::shared_ptr<const TomlFile> file, const toml::table& table, std::string context)
+    : file_(std::move(file)),
+      table_(&table),
+      context_(std::move(context)),
+      asked_(std::make_shared<std::set<std::string, std::less<>>>()) {}
+
+TableReader TableReader::root(std::shared_ptr<const TomlFile> file, std::string context) {
+  const toml::table& t = file->root;
+  return TableReader(std::move(file), t, std::move(context));
+}
+
+std::string TableReader::prefix() const { return context_.empty() ? std::string() : context_ + ": "; }
+
+const toml::node* TableReader::find(std::string_view key) const {
+  asked_->emplace(key);
+  return table_->get(key);
+}
+
+const toml::node& TableReader::need(std::string_view key) const {
+  const toml::node* n = find(key);
+  if (n == nullptr) fail("missing required key '" + std::string(key) + "'");
+  return *n;
+}
+
+SourceLocation TableReader::location() const { return location_of(*file_, *table_); }
+
+SourceLocation TableReader::location(std::string_view key) const {
+  const toml::node* n = table_->get(key);
+  return n != nullptr ? location_of(*file_, *n) : location();
+}
+
+void TableReader::fail(std::string_view key, const std::string& message) const {
+  throw ConfigError(location(key), prefix() + "key '" + std::string(key) + "': " + message);
+}
+
+void TableReader::fail(const std::string& message) const { throw ConfigError(location(), prefix() + message); }
+
+bool TableReader::has(std::string_view key) const { return find(key) != nullptr; }
+
+double TableReader::to_number(std::string_view key, const toml::node& node, const std::string& what) const {
+  double v = 0.0;
+  if (const auto* i = node.as_integer()) {
+    v = static_cast<double>(i->get());
+  } else if (const auto* f = node.as_floating_point()) {
+    v = f->get();
+  } else {
+    throw ConfigError(location_of(*file_, node),
+                      prefix() + "key '" + std::string(key) + "': expected " + what + ", got " + describe_type(node));
+  }
+  if (!std::isfinite(v)) {
+    std::ostringstream s;
+    s << v;
+    throw ConfigError(location_of(*file_, node),
+                      prefix() + "key '" + std::string(key) + "': expected a finite number, got " + s.str());
+  }
+  return v;
+}
+
+double TableReader::number(std::string_view key) const { return to_number(key, need(key), "a number"); }
+
+double TableReader::number(std::string_view key, double fallback) const {
+  const toml::node* n = find(key);
+  return n == nullptr ? fallback : to_number(key, *n, "a number");
+}
+
+std::int64_t TableReader::integer(std::string_view key) const {
+  const toml::node& n = need(key);
+  if (const auto* i = n.as_integer()) return i->get();
+  fail(key, "expected an integer, got " + describe_type(n));
+}
+
+std::int64_t TableReader::integer(std::string_view key, std::int64_t fallback) const {
+  return has(key) ? integer(key) : fallback;
+}
+
+std::string TableReader::string(std::string_view key) const {
+  const toml::node& n = need(key);
+  if (const auto* s = n.as_string()) return s->get();
+  fail(key, "expected a string, got " + describe_type(n));
+}
+
+std::string TableReader::string(std::string_view key, std::string_view fallback) const {
+  return has(key) ? string(key) : std::string(fallback);
+}
+
+bool TableReader::boolean(std::string_view key, bool fallback) const {
+  const toml::node* n = find(key);
+  if (n == nullptr) return fallback;
+  if (const auto* b = n->as_boolean()) return b->get();
+  fail(key, "expected a boolean (true or false), got " + describe_type(*n));
+}
+
+std::vector<double> TableReader::numbers(std::string_view key, std::optional<std::size_t> size) const {
+  const toml::node& n = need(key);
+  const auto* arr = n.as_array();
+  const std::string what = size ? "an array of " + std::to_string(*size) + " numbers" : "an array of numbers";
+  if (arr == nullptr) fail(key, "expected " + what + ", got " + describe_type(n));
+  if (size && arr->size() != *size) {
+    fail(key, "expected " + what + ", got " + std::to_string(arr->size()) + " element(s)");
+  }
+  std::vector<double> out;
+  out.reserve(arr->size());
+  for (const auto& el : *arr) out.push_back(to_number(key, el, "a number in " + what));
+  return out;
+}
+
+std::vector<std::string> TableReader::strings(std::string_view key) const {
+  const toml::node& n = need(key);
+  const auto* arr = n.as_array();
+  if (arr == nullptr) fail(key, "expected an array of strings, got " + describe_type(n));
+  std::vector<std::string> out;
+  for (const auto& el : *arr) {
+    const auto* s = el.as_string();
+    if (s == nullptr) {
+      throw ConfigError(location_of(*file_, el), prefix() + "key '" + std::string(key) +
+                                                     "': expected an array of strings, got " + describe_type(el) +
+                                                     " in it");
+    }
+    out.push_back(s->get());
+  }
+  return out;
+}
+
+std::string TableReader::choice(std::string_view key, const std::vector<std::string>& choices) const {
+  std::string v = string(key);
+  for (const auto& c : choices) {
+    if (c == v) return v;
+  }
+  fail(key, "expected one of " + quoted_list(choices) + ", got '" + v + "'");
+}
+
+std::string TableReader::choice(std::string_view key, const std::vector<std::string>& choices,
+                                std::string_view fallback) const {
+  return has(key) ? choice(key, choices) : std::string(fallback);
+}
+
+TableReader TableReader::table(std::string_view key) const {
+  const toml::node& n = need(key);
+  const auto* t = n.as_table();
+  if (t == nullptr) fail(key, "expected a table, got " + describe_type(n));
+  return TableReader(file_, *t, prefix().empty() ? std::string(key) : context_ + "." + std::string(key));
+}
+
+std::optional<TableReader> TableReader::optional_table(std::string_view key) const {
+  if (!has(key)) return std::nullopt;
+  return table(key);
+}
+
+std::vector<TableReader> TableReader::tables(std::string_view key) const {
+  const toml::node& n = need(key);
+  const auto* arr = n.as_array();
+  if (arr == nullptr || !arr->is_array_of_tables()) {
+    fail(key, "expected an array of tables ([[" + std::string(key) + "]]), got " + describe_type(n));
+  }
+  if (arr->empty()) fail(key, "expected at least one [[" + std::string(key) + "]] entry, got none");
+  std::vector<TableReader> out;
+  std::size_t i = 0;
+  for (const auto& el : *arr) {
+    out.emplace_back(file_, *el.as_table(),
+                     (context_.empty() ? "" : context_ + ".") + std::string(key) + "[" + std::to_string(i++) + "]");
+  }
+  return out;
+}
+
+std::filesystem::path TableReader::path(std::string_view key) const {
+  const std::filesystem::path p = string(key);
+  if (p.empty()) fail(key, "expected a non-empty path");
+  if (p.is_absolute()) return p;
+  return file_->path.parent_path() / p;
+}
+
+void TableReader::finish() const {
+  for (const auto& [k, v] : *table_) {
+    if (asked_->count(k.str()) == 0) {
+      const auto& b = k.source().begin;
+      const SourceLocation where =
+          b.line != 0 ? SourceLocation{file_->path.string(), b.line, b.column} : location_of(*file_, v);
+      throw ConfigError(where, "unknown key '" + std::string(k.str()) + "'" +
+                                   (context_.empty() ? std::string() : " in " + context_) +
+                                   "; known keys: " + join(*asked_));
+    }
+  }
+}
+
+}  // namespace redres

@@ -1,0 +1,33 @@
+#include "redres/velocity_limit.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace redres {
+
+VelocityLimitRegistry& velocity_limit_registry() {
+  static VelocityLimitRegistry registry("velocity-limit law");
+  return registry;
+}
+
+std::optional<UndefinedAt> check_velocity_law(const VelocityLimitLaw& law, double lo, double hi) {
+  if (auto bad = law.undefined_in(lo, hi)) return bad;
+  for (int k = 0; k < kVelocityLawSamples; ++k) {
+    const double theta =
+        k == kVelocityLawSamples - 1 ? hi : lo + (hi - lo) * static_cast<double>(k) / (kVelocityLawSamples - 1);
+    const VelocityBounds b = law.bounds(theta);
+    std::ostringstream why;
+    why.precision(10);
+    if (!std::isfinite(b.lower) || !std::isfinite(b.upper)) {
+      why << "limits are not finite (lower " << b.lower << ", upper " << b.upper << ")";
+    } else if (!(b.lower < 0.0 && 0.0 < b.upper)) {
+      why << "expected lower < 0 < upper, got lower " << b.lower << ", upper " << b.upper;
+    } else {
+      continue;
+    }
+    return UndefinedAt{theta, why.str()};
+  }
+  return std::nullopt;
+}
+
+}  // namespace redres

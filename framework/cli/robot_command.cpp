@@ -36,7 +36,7 @@ Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model) {
                                 "per joint), got " + std::to_string(values.size()));
   }
   Eigen::VectorXd theta = Eigen::Map<Eigen::VectorXd>(values.data(), model.dof());
-  require(theta.allFinite(), "--theta", "every value is finite");
+  REDRES_REQUIRE(theta.allFinite(), "--theta", "every value is finite");
   return theta;
 }
 

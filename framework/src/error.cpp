@@ -17,8 +17,8 @@ std::string format(const SourceLocation& where, const std::string& message) {
 ConfigError::ConfigError(SourceLocation where, const std::string& message)
     : std::runtime_error(format(where, message)), where_(std::move(where)), detail_(message) {}
 
-void require(bool ok, const char* function, const std::string& condition) {
-  if (!ok) throw std::invalid_argument(std::string(function) + ": " + condition);
+void throw_invalid_argument(const char* function, const std::string& condition) {
+  throw std::invalid_argument(std::string(function) + ": " + condition);
 }
 
 }  // namespace redres

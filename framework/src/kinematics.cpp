@@ -94,10 +94,10 @@ double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen:
 void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
                         KinematicsData& data, KinematicsLevel level) {
   const int n = model.dof();
-  require(theta.size() == n, "compute_kinematics",
+  REDRES_REQUIRE(theta.size() == n, "compute_kinematics",
           "theta.size() == dof() (got " + std::to_string(theta.size()) + ", expected " + std::to_string(n) + ")");
-  require(theta.allFinite(), "compute_kinematics", "theta is finite (it contains NaN or Inf)");
-  require(data.J.cols() == n && data.J.rows() == model.task_dim(), "compute_kinematics",
+  REDRES_REQUIRE(theta.allFinite(), "compute_kinematics", "theta is finite (it contains NaN or Inf)");
+  REDRES_REQUIRE(data.J.cols() == n && data.J.rows() == model.task_dim(), "compute_kinematics",
           "data was sized for this model (KinematicsData(model))");
 
   data.theta = theta;

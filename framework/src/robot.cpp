@@ -36,30 +36,30 @@ std::string num(double v) {
 
 void validate(const RobotSpec& spec) {
   const char* fn = "RobotModel";
-  require(!spec.name.empty(), fn, "name is not empty");
-  require(!spec.joints.empty(), fn, "the chain has at least one joint");
-  require(spec.end_effector.matrix().allFinite(), fn, "end_effector is finite");
+  REDRES_REQUIRE(!spec.name.empty(), fn, "name is not empty");
+  REDRES_REQUIRE(!spec.joints.empty(), fn, "the chain has at least one joint");
+  REDRES_REQUIRE(spec.end_effector.matrix().allFinite(), fn, "end_effector is finite");
   std::set<std::string> names;
   for (std::size_t j = 0; j < spec.joints.size(); ++j) {
     const JointSpec& jt = spec.joints[j];
     const std::string who = "joint " + std::to_string(j + 1) + " ('" + jt.name + "')";
-    require(!jt.name.empty(), fn, "joint " + std::to_string(j + 1) + " has a name");
-    require(names.insert(jt.name).second, fn, who + " has a unique name");
-    require(std::isfinite(jt.lower) && std::isfinite(jt.upper), fn, who + " limits are finite");
-    require(jt.lower < jt.upper, fn, who + " lower limit < upper limit (" + num(jt.lower) + " vs " +
+    REDRES_REQUIRE(!jt.name.empty(), fn, "joint " + std::to_string(j + 1) + " has a name");
+    REDRES_REQUIRE(names.insert(jt.name).second, fn, who + " has a unique name");
+    REDRES_REQUIRE(std::isfinite(jt.lower) && std::isfinite(jt.upper), fn, who + " limits are finite");
+    REDRES_REQUIRE(jt.lower < jt.upper, fn, who + " lower limit < upper limit (" + num(jt.lower) + " vs " +
                                          num(jt.upper) + ")");
-    require(jt.velocity_limit != nullptr, fn, who + " has a velocity-limit law");
-    require(std::isfinite(jt.a) && std::isfinite(jt.alpha) && std::isfinite(jt.d) && std::isfinite(jt.theta_offset),
+    REDRES_REQUIRE(jt.velocity_limit != nullptr, fn, who + " has a velocity-limit law");
+    REDRES_REQUIRE(std::isfinite(jt.a) && std::isfinite(jt.alpha) && std::isfinite(jt.d) && std::isfinite(jt.theta_offset),
             fn, who + " DH parameters are finite");
     if (spec.kind == ChainKind::kPlanar) {
-      require(jt.type == JointType::kRevolute, fn, who + " is revolute (planar chains have revolute joints only)");
-      require(std::isfinite(jt.length) && jt.length > 0.0, fn, who + " length > 0 (got " + num(jt.length) + ")");
+      REDRES_REQUIRE(jt.type == JointType::kRevolute, fn, who + " is revolute (planar chains have revolute joints only)");
+      REDRES_REQUIRE(std::isfinite(jt.length) && jt.length > 0.0, fn, who + " length > 0 (got " + num(jt.length) + ")");
     }
   }
   if (spec.home.size() != 0) {
-    require(spec.home.size() == static_cast<Eigen::Index>(spec.joints.size()), fn,
+    REDRES_REQUIRE(spec.home.size() == static_cast<Eigen::Index>(spec.joints.size()), fn,
             "home.size() == number of joints");
-    require(spec.home.allFinite(), fn, "home is finite");
+    REDRES_REQUIRE(spec.home.allFinite(), fn, "home is finite");
   }
 }
 
@@ -104,7 +104,7 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
 void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
                                  Eigen::Ref<Eigen::VectorXd> upper) const {
   const int n = dof();
-  require(theta.size() == n && lower.size() == n && upper.size() == n, "RobotModel::velocity_limits",
+  REDRES_REQUIRE(theta.size() == n && lower.size() == n && upper.size() == n, "RobotModel::velocity_limits",
           "theta, lower and upper have size dof() = " + std::to_string(n));
   for (int j = 0; j < n; ++j) {
     const VelocityBounds b = spec_.joints[static_cast<std::size_t>(j)].velocity_limit->bounds(theta(j));

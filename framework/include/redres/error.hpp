@@ -36,7 +36,14 @@ class ConfigError : public std::runtime_error {
   std::string detail_;
 };
 
-/// Throws std::invalid_argument("<function>: <condition>") when `ok` is false. Used for API misuse checks.
-void require(bool ok, const char* function, const std::string& condition);
+/// Throws std::invalid_argument("<function>: <condition>"). Use through REDRES_REQUIRE.
+[[noreturn]] void throw_invalid_argument(const char* function, const std::string& condition);
 
 }  // namespace redres
+
+/// API-misuse check: throws std::invalid_argument("<function>: <condition>") when `ok` is false. The message
+/// expression is evaluated only on failure, so a passing check costs no allocation (real-time path).
+#define REDRES_REQUIRE(ok, function, condition)                          \
+  do {                                                                   \
+    if (!(ok)) ::redres::throw_invalid_argument((function), (condition)); \
+  } while (false)

@@ -1,0 +1,218 @@
+// Properties of the kinematics over random chains (planar and spatial, 2 to 9 joints, random geometry, random
+// angles inside the limits): J, dJ/dtheta_i, grad w and grad mu against central differences; q_1 = 0 and w
+// invariant under base rotation for planar arms; finite, correct gradients at and near singular configurations;
+// no allocation.
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
+
+#include "alloc_counter.hpp"
+#include "random_chain.hpp"
+#include "redres/kinematics.hpp"
+#include "test_util.hpp"
+
+namespace redres {
+namespace {
+
+using testing::random_planar;
+using testing::random_spatial;
+using testing::random_theta;
+
+constexpr double kStep = 1e-6;  // central-difference step (rad or m)
+
+RobotModel random_model() {
+  const bool planar = *rc::gen::arbitrary<bool>();
+  const int n = *rc::gen::inRange(2, 10);
+  const TaskRows task = *rc::gen::element(TaskRows::kPosition, TaskRows::kPose);
+  return RobotModel(planar ? random_planar(n, task) : random_spatial(n, task));
+}
+
+// Central difference of the task coordinates: f for position rows and the planar angle; for spatial orientation
+// rows the rotation vector of R(theta + h) R(theta - h)' (which the geometric Jacobian's angular rows match).
+Eigen::VectorXd task_difference(const RobotModel& model, const KinematicsData& plus, const KinematicsData& minus) {
+  Eigen::VectorXd d = (plus.f - minus.f) / (2 * kStep);
+  if (model.kind() == ChainKind::kSpatial && model.task() == TaskRows::kPose) {
+    const Eigen::AngleAxisd aa(plus.ee_pose.linear() * minus.ee_pose.linear().transpose());
+    d.tail<3>() = aa.angle() * aa.axis() / (2 * kStep);
+  }
+  return d;
+}
+
+// |a - b|_inf <= tol (1 + |b|_inf), with a message naming the worst entry.
+void expect_close(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::Ref<const Eigen::MatrixXd>& b, double tol,
+                  const std::string& what) {
+  const double scale = 1.0 + b.cwiseAbs().maxCoeff();
+  Eigen::Index r = 0, c = 0;
+  const double err = (a - b).cwiseAbs().maxCoeff(&r, &c);
+  RC_ASSERT(std::isfinite(err));
+  if (err > tol * scale) {
+    RC_FAIL(what + ": entry (" + std::to_string(r) + ", " + std::to_string(c) + ") analytic " +
+            std::to_string(a(r, c)) + " vs central difference " + std::to_string(b(r, c)));
+  }
+}
+
+RC_GTEST_PROP(KinematicsProperty, JacobianMatchesCentralDifferencesOfF, ()) {
+  const RobotModel model = random_model();
+  const Eigen::VectorXd theta = random_theta(model);
+  KinematicsData k(model), kp(model), km(model);
+  compute_kinematics(model, theta, k, KinematicsLevel::kJacobian);
+  Eigen::MatrixXd fd(model.task_dim(), model.dof());
+  for (int i = 0; i < model.dof(); ++i) {
+    Eigen::VectorXd t = theta;
+    t(i) += kStep;
+    compute_kinematics(model, t, kp, KinematicsLevel::kPosition);
+    t(i) -= 2 * kStep;
+    compute_kinematics(model, t, km, KinematicsLevel::kPosition);
+    fd.col(i) = task_difference(model, kp, km);
+  }
+  expect_close(k.J, fd, 1e-6, "J");
+}
+
+RC_GTEST_PROP(KinematicsProperty, HessianMatchesCentralDifferencesOfJ, ()) {
+  const RobotModel model = random_model();
+  const Eigen::VectorXd theta = random_theta(model);
+  KinematicsData k(model), kp(model), km(model);
+  compute_kinematics(model, theta, k, KinematicsLevel::kManipulability);
+  for (int i = 0; i < model.dof(); ++i) {
+    Eigen::VectorXd t = theta;
+    t(i) += kStep;
+    compute_kinematics(model, t, kp, KinematicsLevel::kJacobian);
+    t(i) -= 2 * kStep;
+    compute_kinematics(model, t, km, KinematicsLevel::kJacobian);
+    const Eigen::MatrixXd fd = (kp.J - km.J) / (2 * kStep);
+    expect_close(k.dJ_block(i), fd, 1e-6, "dJ/dtheta_" + std::to_string(i + 1));
+  }
+}
+
+RC_GTEST_PROP(KinematicsProperty, ManipulabilityGradientsMatchCentralDifferences, ()) {
+  const RobotModel model = random_model();
+  const Eigen::VectorXd theta = random_theta(model);
+  KinematicsData k(model), kp(model), km(model);
+  compute_kinematics(model, theta, k, KinematicsLevel::kAll);
+  RC_ASSERT(std::abs(k.mu * k.mu - k.w) <= 1e-9 * (1.0 + k.w));
+  Eigen::VectorXd fd_w(model.dof()), fd_mu(model.dof());
+  for (int i = 0; i < model.dof(); ++i) {
+    Eigen::VectorXd t = theta;
+    t(i) += kStep;
+    compute_kinematics(model, t, kp, KinematicsLevel::kAll);
+    t(i) -= 2 * kStep;
+    compute_kinematics(model, t, km, KinematicsLevel::kAll);
+    fd_w(i) = (kp.w - km.w) / (2 * kStep);
+    fd_mu(i) = (kp.mu - km.mu) / (2 * kStep);
+  }
+  expect_close(k.grad_w, fd_w, 1e-6, "grad w");
+  RC_ASSERT(k.grad_mu.allFinite());
+  // sqrt is smooth only away from w = 0; there the central difference of mu itself is not a derivative.
+  RC_CLASSIFY(k.mu > 1e-3, "mu > 1e-3");
+  if (k.mu > 1e-3) expect_close(k.grad_mu, fd_mu, 1e-5, "grad mu");
+}
+
+RC_GTEST_PROP(KinematicsProperty, PlanarBaseRotationLeavesManipulabilityUnchanged, ()) {
+  const int n = *rc::gen::inRange(2, 10);
+  const TaskRows task = *rc::gen::element(TaskRows::kPosition, TaskRows::kPose);
+  const RobotModel model(random_planar(n, task));
+  const Eigen::VectorXd theta = random_theta(model);
+  KinematicsData k(model), rotated(model);
+  compute_kinematics(model, theta, k, KinematicsLevel::kManipulability);
+  RC_ASSERT(std::abs(k.grad_w(0)) <= 1e-9 * (1.0 + k.grad_w.cwiseAbs().maxCoeff()));
+  Eigen::VectorXd t = theta;
+  t(0) += testing::draw(-3.0, 3.0);
+  compute_kinematics(model, t, rotated, KinematicsLevel::kManipulability);
+  RC_ASSERT(std::abs(rotated.w - k.w) <= 1e-10 * (1.0 + k.w));
+  RC_ASSERT((rotated.grad_w - k.grad_w).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + k.grad_w.cwiseAbs().maxCoeff()));
+}
+
+// The stretched planar 3R arm is singular (J has rank 1): w = 0, and its gradient must still be finite and
+// equal to the central difference; so must it be just next to the singularity, where A = JJ' is nearly singular.
+TEST(KinematicsSingular, GradientsStayFiniteAndCorrectAtAndNearSingularity) {
+  const RobotModel model = load_robot(source_path("robots/yoshikawa_3link.toml"));
+  KinematicsData k(model), kp(model), km(model);
+  for (double eps : {0.0, 1e-9, 1e-6, 1e-3}) {
+    Eigen::VectorXd theta(3);
+    theta << 0.3, eps, -0.5 * eps;
+    compute_kinematics(model, theta, k, KinematicsLevel::kAll);
+    ASSERT_TRUE(k.grad_w.allFinite()) << "eps " << eps;
+    ASSERT_TRUE(k.grad_mu.allFinite()) << "eps " << eps;
+    if (eps == 0.0) {
+      EXPECT_NEAR(k.w, 0.0, 1e-14);
+    }
+    for (int i = 0; i < 3; ++i) {
+      Eigen::VectorXd t = theta;
+      t(i) += 1e-5;
+      compute_kinematics(model, t, kp, KinematicsLevel::kManipulability);
+      t(i) -= 2e-5;
+      compute_kinematics(model, t, km, KinematicsLevel::kManipulability);
+      EXPECT_NEAR(k.grad_w(i), (kp.w - km.w) / 2e-5, 1e-8) << "eps " << eps << ", joint " << i + 1;
+    }
+  }
+  // At the singularity w has a minimum (w >= 0), so its gradient vanishes.
+  Eigen::VectorXd stretched = Eigen::VectorXd::Zero(3);
+  compute_kinematics(model, stretched, k, KinematicsLevel::kAll);
+  EXPECT_LT(k.grad_w.norm(), 1e-14);
+  // The adjugate's defining identity adj(A) A = det(A) I, on SPD matrices of the cofactor sizes and of the
+  // eigen-decomposition path.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(5);
+  for (int m : {2, 3, 5}) {
+    Eigen::MatrixXd B(m, m + 2);
+    for (int r = 0; r < m; ++r)
+      for (int c = 0; c < m + 2; ++c) B(r, c) = std::sin(1.0 + 3.0 * r + 7.0 * c);
+    const Eigen::MatrixXd A = B * B.transpose();
+    Eigen::MatrixXd adj(m, m);
+    const double det = symmetric_det_adjugate(A, adj, eig);
+    EXPECT_NEAR(det, A.determinant(), 1e-10 * std::abs(A.determinant()) + 1e-12) << "m = " << m;
+    EXPECT_LT((adj * A - det * Eigen::MatrixXd::Identity(m, m)).norm(), 1e-9 * (1.0 + std::abs(det))) << "m = " << m;
+  }
+}
+
+TEST(KinematicsInput, WrongSizeAndNanThrowWithTheCondition) {
+  const RobotModel model = load_robot(source_path("robots/paper_pushrod_6dof.toml"));
+  KinematicsData k(model);
+  try {
+    compute_kinematics(model, Eigen::VectorXd::Zero(5), k);
+    FAIL() << "wrong size accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("theta.size() == dof() (got 5, expected 6)"), std::string::npos) << e.what();
+  }
+  Eigen::VectorXd bad = paper_theta0();
+  bad(3) = std::nan("");
+  try {
+    compute_kinematics(model, bad, k);
+    FAIL() << "NaN accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("theta is finite"), std::string::npos) << e.what();
+  }
+}
+
+TEST(KinematicsRealTime, ComputeAllocatesNothing) {
+  if (!testing::allocation_counting_available()) {
+    GTEST_SKIP() << "AddressSanitizer owns malloc here; the release build runs this check";
+  }
+  for (const char* file : {"robots/paper_pushrod_6dof.toml", "robots/franka_panda.toml", "robots/kuka_iiwa14.toml",
+                           "robots/planar_4link.toml"}) {
+    const RobotModel model = load_robot(source_path(file));
+    KinematicsData k(model);
+    Eigen::VectorXd lo(model.dof()), hi(model.dof());
+    const Eigen::VectorXd theta = model.home();
+    compute_kinematics(model, theta, k, KinematicsLevel::kAll);  // warm-up
+    long count = 0;
+    {
+      const testing::AllocationCounter counter;
+      for (int rep = 0; rep < 10; ++rep) {
+        compute_kinematics(model, theta, k, KinematicsLevel::kAll);
+        model.velocity_limits(theta, lo, hi);
+      }
+      count = counter.count();
+    }
+    EXPECT_EQ(count, 0) << file;
+  }
+  // The counter itself works: an allocation is seen.
+  const testing::AllocationCounter counter;
+  auto* p = new std::vector<double>(100);
+  delete p;
+  EXPECT_GE(counter.count(), 1);
+}
+
+}  // namespace
+}  // namespace redres

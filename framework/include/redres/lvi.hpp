@@ -1,0 +1,118 @@
+#pragma once
+/// @file
+/// LVI engines: solve the step's QP through its linear variational inequality (eqs. 13-15, DESIGN section 2).
+///
+/// With u = [x; y; z] (x = theta_dot, y duals of J x = d, z duals of A x <= b),
+///   M = [W -J' A'; J 0 0; -A 0 0],  g = [zeta; -d; b],
+///   Omega = {u : [lo; -varpi; 0] <= u <= [hi; varpi; varpi]},
+/// u* solves P_Omega(u - (M u + g)) - u = 0 (eq. 14); the stopping test is ||e(u)||_2 <= tolerance with
+/// e(u) = u - P_Omega(u - (M u + g)).
+///
+/// Engines (selected by `engine` in the scenario's [solver] table):
+/// - `projection`: the paper's eq. 15, u <- u - (||e||^2 / ||phi||^2) phi with phi = (M' + I) e;
+/// - `newton`: semismooth Newton on the reduced eq. 14 (exact and fast; see newton.cpp for its fallback);
+/// - `nlopt`: NLopt's SLSQP on the QP itself, an independent cross-check.
+///
+/// Outcomes are statuses, never exceptions: a bound conflict lo_i > hi_i, or equality rows that cannot be met
+/// inside the bounds, is `infeasible` with a diagnosis naming the joint, the bound and the plugins.
+
+#include <memory>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "redres/qp.hpp"
+#include "redres/registry.hpp"
+
+namespace redres {
+
+/// Settings shared by every engine (the scenario's [solver] table).
+struct SolverSettings {
+  double tolerance = 1e-6;     //!< stopping test ||e(u)||_2 <= tolerance (the paper's 1e-6)
+  double varpi = 1e6;          //!< bound on the duals standing for infinity (the paper's 1e6)
+  int max_iterations = 20000;  //!< iteration cap per solve
+  bool warm_start = true;      //!< start from the previous solve's u
+};
+
+/// Outcome of one solve.
+enum class SolverStatus {
+  kSolved,         //!< ||e(u)|| <= tolerance
+  kMaxIterations,  //!< the iteration cap was reached first
+  kInfeasible,     //!< bounds conflict, or J x = d cannot be met inside the bounds
+  kNumericalError, //!< the iteration broke down (e.g. a zero step); see the diagnosis
+};
+
+/// "solved", "max_iterations", "infeasible", "numerical_error".
+[[nodiscard]] const char* to_string(SolverStatus status);
+
+/// What a solve reports besides its answer.
+struct SolverInfo {
+  SolverStatus status = SolverStatus::kSolved;  //!< outcome
+  int iterations = 0;                           //!< iterations of the engine that ran
+  double residual = 0.0;                        //!< ||e(u)||_2 at the returned u
+  const char* engine = "";                      //!< the engine that actually ran (a fallback names itself)
+  std::string diagnosis;                        //!< empty when solved; otherwise which joint, bound, plugin
+};
+
+/// The answer: x = theta_dot and the duals. Sized once by LviEngine::setup.
+struct SolverResult {
+  Eigen::VectorXd x;  //!< joint velocities (n), inside [lo, hi]
+  Eigen::VectorXd y;  //!< duals of J x = d (m_e)
+  Eigen::VectorXd z;  //!< duals of A x <= b (m_i), >= 0
+  SolverInfo info;    //!< status, iterations, residual
+};
+
+/// An LVI engine. setup() sizes everything; solve() then allocates nothing (except the diagnosis text of a
+/// failed solve).
+class LviEngine {
+ public:
+  LviEngine() = default;
+  LviEngine(const LviEngine&) = delete;
+  LviEngine& operator=(const LviEngine&) = delete;
+  virtual ~LviEngine() = default;
+
+  /// Sizes the engine and `result` for n variables, m_e equality and m_i inequality rows.
+  void setup(int n, int m_e, int m_i, SolverResult& result);
+  /// Solves `qp` into `result`. Checks sizes and values (throws std::invalid_argument on misuse), reports a
+  /// bound conflict as infeasible, runs the engine, and diagnoses a failure. After an infeasible or failed solve
+  /// the warm start is reset, so that runaway duals do not slow the next steps down.
+  void solve(const QpProblem& qp, SolverResult& result);
+  /// Forgets the warm start.
+  void reset() { warm_ = false; }
+  /// Engine name ("projection", ...).
+  [[nodiscard]] virtual const char* name() const = 0;
+  /// The settings.
+  [[nodiscard]] const SolverSettings& settings() const noexcept { return settings_; }
+  /// Replaces the settings.
+  void set_settings(const SolverSettings& s) { settings_ = s; }
+
+ protected:
+  /// Whether `result` holds a previous solution to start from.
+  [[nodiscard]] bool warm() const noexcept { return warm_ && settings_.warm_start; }
+
+ private:
+  virtual void do_setup(int n, int m_e, int m_i) = 0;
+  /// Runs the engine. `result` holds the previous u when warm(). Must set status, iterations, residual, engine.
+  virtual void do_solve(const QpProblem& qp, SolverResult& result) = 0;
+
+  SolverSettings settings_;
+  bool warm_ = false;
+  int n_ = 0, m_e_ = 0, m_i_ = 0;
+};
+
+/// ||e(u)||_2 of the LVI (eq. 14) at u = [x; y; z].
+[[nodiscard]] double lvi_residual(const QpProblem& qp, const SolverResult& u, double varpi);
+
+/// The registry of engines; factories read engine-specific keys (if any) from the [solver] table.
+using EngineRegistry = Registry<LviEngine, const SolverSettings&>;
+/// The process-wide engine registry.
+EngineRegistry& engine_registry();
+
+/// Reads the [solver] table's common keys (`engine`, `tolerance`, `varpi`, `max_iterations`, `warm_start`) and
+/// builds the engine; unknown keys are ConfigErrors.
+[[nodiscard]] std::unique_ptr<LviEngine> make_engine(const TableReader& solver);
+
+/// Builds an engine by name with the given settings (for code that does not read TOML).
+[[nodiscard]] std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSettings& settings = {});
+
+}  // namespace redres

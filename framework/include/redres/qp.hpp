@@ -1,0 +1,76 @@
+#pragma once
+/// @file
+/// The quadratic program built at every control step (eqs. 10-12, DESIGN section 2), with x = theta_dot in R^n:
+///
+///   minimise   x'Wx/2 + zeta'x
+///   subject to J x = d          (m_e equality rows, e.g. the end-effector task, eq. 11)
+///              A x <= b         (m_i inequality rows)
+///              lo <= x <= hi    (eq. 12: lo_i = max of all lower bounds, hi_i = min of all upper bounds)
+///
+/// Every buffer is sized once (QpProblem::resize); building and solving allocate nothing afterwards. Each bound
+/// remembers which source (plugin) set it, so a conflict lo_i > hi_i names the plugins that caused it.
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace redres {
+
+/// Value standing for "no bound" on a joint velocity before any constraint tightens it.
+inline constexpr double kNoBound = std::numeric_limits<double>::infinity();
+
+/// One QP (eqs. 10-12 plus inequality rows). Sized once; then filled each step.
+struct QpProblem {
+  Eigen::MatrixXd W;     //!< Hessian (n x n), symmetric positive definite
+  Eigen::VectorXd zeta;  //!< linear term (n)
+  Eigen::MatrixXd J;     //!< equality rows (m_e x n)
+  Eigen::VectorXd d;     //!< equality right-hand side (m_e)
+  Eigen::MatrixXd A;     //!< inequality rows (m_i x n)
+  Eigen::VectorXd b;     //!< inequality right-hand side (m_i)
+  Eigen::VectorXd lo;    //!< lower bounds (n); -inf where unbounded
+  Eigen::VectorXd hi;    //!< upper bounds (n); +inf where unbounded
+  bool w_diagonal = true;  //!< true while only diagonal terms were added to W
+  std::vector<int> lo_source;  //!< index of the source that set lo_i (-1: none)
+  std::vector<int> hi_source;  //!< index of the source that set hi_i (-1: none)
+  std::vector<std::string> source_names;  //!< names of the bound and row sources, indexed as above
+  std::vector<std::string> variable_names;  //!< joint names, for diagnoses (may be empty)
+  std::vector<int> eq_source;  //!< source of each equality row
+  std::vector<int> in_source;  //!< source of each inequality row
+  Eigen::VectorXd scratch;     //!< n-vector a plugin may use as workspace while it contributes
+
+  /// Sizes every buffer: n variables, m_e equality rows, m_i inequality rows.
+  void resize(int n, int m_e, int m_i);
+  /// Number of variables n.
+  [[nodiscard]] int n() const noexcept { return static_cast<int>(zeta.size()); }
+  /// Number of equality rows m_e.
+  [[nodiscard]] int m_eq() const noexcept { return static_cast<int>(d.size()); }
+  /// Number of inequality rows m_i.
+  [[nodiscard]] int m_in() const noexcept { return static_cast<int>(b.size()); }
+  /// Zeroes W, zeta, rows, and opens the bounds (-inf, +inf) with no sources.
+  void clear();
+  /// Throws std::invalid_argument naming the first wrong size or non-finite entry (NaN in a bound too).
+  void validate() const;
+};
+
+/// The conflict lo_i > hi_i of the first such joint, or index -1 when the box is consistent.
+struct BoundConflict {
+  int joint = -1;          //!< 0-based joint index, -1 if none
+  double lo = 0.0;         //!< the merged lower bound
+  double hi = 0.0;         //!< the merged upper bound
+  std::string lo_source;   //!< plugin that set lo
+  std::string hi_source;   //!< plugin that set hi
+};
+
+/// Finds the first joint whose merged bounds conflict (lo_i > hi_i).
+[[nodiscard]] BoundConflict find_bound_conflict(const QpProblem& qp);
+
+/// "joint 3 ('j3'): lower bound 0.2 (from 'joint_angle_margin') > upper bound 0.1 (from
+/// 'joint_velocity_limits')".
+[[nodiscard]] std::string describe(const BoundConflict& conflict, const std::vector<std::string>& joint_names = {});
+
+/// The name of source `s` of `qp` ("(none)" when unset).
+[[nodiscard]] std::string source_name(const QpProblem& qp, int s);
+
+}  // namespace redres

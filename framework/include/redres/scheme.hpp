@@ -1,0 +1,47 @@
+#pragma once
+/// @file
+/// A redundancy-resolution scheme: the objectives and constraints that together build one QP per step.
+
+#include <memory>
+#include <vector>
+
+#include "redres/plugin.hpp"
+
+namespace redres {
+
+/// Objectives and constraints assembled into one QP. Immutable after construction; build() allocates nothing.
+class Scheme {
+ public:
+  /// Takes ownership of the plugins; sizes follow from the robot and the constraints' row counts.
+  Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
+         std::vector<std::unique_ptr<Constraint>> constraints);
+
+  /// Reads `[[objectives]]` and `[[constraints]]` arrays of tables from `root`.
+  static Scheme from_toml(const TableReader& root, const RobotModel& robot);
+
+  /// Sizes `qp` for this scheme (n, m_e, m_i) and names its sources.
+  void setup(QpProblem& qp) const;
+  /// Clears `qp` and lets every active plugin contribute. `ctx.kinematics` must be at kinematics_level().
+  void build(const Context& ctx, QpProblem& qp) const;
+
+  /// The deepest kinematics any plugin reads.
+  [[nodiscard]] KinematicsLevel kinematics_level() const noexcept { return level_; }
+  /// Total equality and inequality rows.
+  [[nodiscard]] int equality_rows() const noexcept { return m_eq_; }
+  [[nodiscard]] int inequality_rows() const noexcept { return m_in_; }
+  /// The plugins.
+  [[nodiscard]] const std::vector<std::unique_ptr<Objective>>& objectives() const noexcept { return objectives_; }
+  [[nodiscard]] const std::vector<std::unique_ptr<Constraint>>& constraints() const noexcept { return constraints_; }
+  /// The robot (not owned; must outlive the scheme).
+  [[nodiscard]] const RobotModel& robot() const noexcept { return *robot_; }
+
+ private:
+  const RobotModel* robot_;
+  std::vector<std::unique_ptr<Objective>> objectives_;
+  std::vector<std::unique_ptr<Constraint>> constraints_;
+  std::vector<int> eq_offset_, eq_rows_, in_offset_, in_rows_;
+  int m_eq_ = 0, m_in_ = 0;
+  KinematicsLevel level_ = KinematicsLevel::kPosition;
+};
+
+}  // namespace redres

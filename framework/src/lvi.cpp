@@ -1,0 +1,188 @@
+#include "redres/lvi.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace redres {
+
+const char* to_string(SolverStatus status) {
+  switch (status) {
+    case SolverStatus::kSolved: return "solved";
+    case SolverStatus::kMaxIterations: return "max_iterations";
+    case SolverStatus::kInfeasible: return "infeasible";
+    case SolverStatus::kNumericalError: return "numerical_error";
+  }
+  return "unknown";
+}
+
+EngineRegistry& engine_registry() {
+  static EngineRegistry registry("LVI engine");
+  return registry;
+}
+
+double lvi_residual(const QpProblem& qp, const SolverResult& u, double varpi) {
+  const Eigen::VectorXd rx = qp.W * u.x - qp.J.transpose() * u.y + qp.A.transpose() * u.z + qp.zeta;
+  const Eigen::VectorXd ry = qp.J * u.x - qp.d;
+  const Eigen::VectorXd rz = qp.b - qp.A * u.x;
+  const double ex = (u.x - (u.x - rx).cwiseMax(qp.lo).cwiseMin(qp.hi)).squaredNorm();
+  const double ey = (u.y - (u.y - ry).cwiseMax(-varpi).cwiseMin(varpi)).squaredNorm();
+  const double ez = (u.z - (u.z - rz).cwiseMax(0.0).cwiseMin(varpi)).squaredNorm();
+  return std::sqrt(ex + ey + ez);
+}
+
+namespace {
+
+std::string joint_label(const QpProblem& qp, int i) {
+  std::string s = "joint " + std::to_string(i + 1);
+  if (i < static_cast<int>(qp.variable_names.size())) s += " ('" + qp.variable_names[static_cast<std::size_t>(i)] + "')";
+  return s;
+}
+
+// Why the rows cannot be met: the box-constrained least-squares residual min |J x - d| (and the inequality
+// violation), found by projected gradient, and the joints held at a bound there. Runs only after a failure.
+std::string diagnose_rows(const QpProblem& qp, double tolerance, bool* infeasible) {
+  const int n = qp.n();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n).cwiseMax(qp.lo).cwiseMin(qp.hi);
+  const double lipschitz = qp.J.squaredNorm() + qp.A.squaredNorm() + 1e-300;
+  for (int k = 0; k < 5000; ++k) {
+    const Eigen::VectorXd viol = (qp.A * x - qp.b).cwiseMax(0.0);
+    const Eigen::VectorXd grad = qp.J.transpose() * (qp.J * x - qp.d) + qp.A.transpose() * viol;
+    x = (x - grad / lipschitz).cwiseMax(qp.lo).cwiseMin(qp.hi);
+  }
+  const Eigen::VectorXd eq = qp.J * x - qp.d;
+  const Eigen::VectorXd in = (qp.A * x - qp.b).cwiseMax(0.0);
+  const double worst = std::max(eq.size() ? eq.cwiseAbs().maxCoeff() : 0.0, in.size() ? in.maxCoeff() : 0.0);
+  *infeasible = worst > 10.0 * tolerance;
+  std::ostringstream s;
+  s.precision(6);
+  if (!*infeasible) return "the rows can be met inside the bounds (best residual " + std::to_string(worst) + ")";
+  s << "the constraint rows cannot be met inside the bounds:";
+  for (Eigen::Index r = 0; r < eq.size(); ++r) {
+    if (std::abs(eq(r)) > 10.0 * tolerance) {
+      s << " equality row " << r + 1 << " (from '" << source_name(qp, qp.eq_source[static_cast<std::size_t>(r)])
+        << "') misses by " << std::abs(eq(r)) << " at best;";
+    }
+  }
+  for (Eigen::Index r = 0; r < in.size(); ++r) {
+    if (in(r) > 10.0 * tolerance) {
+      s << " inequality row " << r + 1 << " (from '" << source_name(qp, qp.in_source[static_cast<std::size_t>(r)])
+        << "') is exceeded by " << in(r) << " at best;";
+    }
+  }
+  s << " joints held at a bound there:";
+  bool any = false;
+  for (int i = 0; i < n; ++i) {
+    const bool at_lo = std::isfinite(qp.lo(i)) && x(i) <= qp.lo(i) + 1e-12;
+    const bool at_hi = std::isfinite(qp.hi(i)) && x(i) >= qp.hi(i) - 1e-12;
+    if (!at_lo && !at_hi) continue;
+    any = true;
+    s << " " << joint_label(qp, i) << " at its " << (at_lo ? "lower" : "upper") << " bound "
+      << (at_lo ? qp.lo(i) : qp.hi(i)) << " (from '"
+      << source_name(qp, at_lo ? qp.lo_source[static_cast<std::size_t>(i)] : qp.hi_source[static_cast<std::size_t>(i)])
+      << "');";
+  }
+  if (!any) s << " none (the rows are inconsistent by themselves);";
+  std::string out = s.str();
+  out.pop_back();
+  return out;
+}
+
+}  // namespace
+
+void LviEngine::setup(int n, int m_e, int m_i, SolverResult& result) {
+  REDRES_REQUIRE(n > 0 && m_e >= 0 && m_i >= 0, "LviEngine::setup", "n > 0, m_e >= 0, m_i >= 0");
+  n_ = n;
+  m_e_ = m_e;
+  m_i_ = m_i;
+  result.x = Eigen::VectorXd::Zero(n);
+  result.y = Eigen::VectorXd::Zero(m_e);
+  result.z = Eigen::VectorXd::Zero(m_i);
+  result.info = SolverInfo{};
+  result.info.diagnosis.reserve(256);
+  warm_ = false;
+  do_setup(n, m_e, m_i);
+}
+
+void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
+  REDRES_REQUIRE(n_ > 0, "LviEngine::solve", "setup() was called");
+  REDRES_REQUIRE(qp.n() == n_ && qp.m_eq() == m_e_ && qp.m_in() == m_i_, "LviEngine::solve",
+                 "the QP has the sizes given to setup() (n " + std::to_string(n_) + ", m_e " + std::to_string(m_e_) +
+                     ", m_i " + std::to_string(m_i_) + ")");
+  REDRES_REQUIRE(result.x.size() == n_ && result.y.size() == m_e_ && result.z.size() == m_i_, "LviEngine::solve",
+                 "result was sized by setup()");
+  qp.validate();
+  SolverInfo& info = result.info;
+  info.diagnosis.clear();
+  info.iterations = 0;
+  info.engine = name();
+
+  const BoundConflict conflict = find_bound_conflict(qp);
+  if (conflict.joint >= 0) {
+    info.status = SolverStatus::kInfeasible;
+    info.residual = std::numeric_limits<double>::infinity();
+    info.diagnosis = "bounds conflict at " + describe(conflict, qp.variable_names);
+    result.x.setZero();  // a definite value; callers must check the status
+    result.y.setZero();
+    result.z.setZero();
+    warm_ = false;
+    return;
+  }
+
+  do_solve(qp, result);
+
+  // Duals at the +-varpi cap mean the LVI met its box only because the rows were given up: infeasible.
+  const double cap = settings_.varpi * (1.0 - 1e-9);
+  const bool capped = (m_e_ > 0 && result.y.cwiseAbs().maxCoeff() >= cap) ||
+                      (m_i_ > 0 && result.z.maxCoeff() >= cap);
+  if (info.status != SolverStatus::kSolved || capped) {
+    bool infeasible = false;
+    const std::string rows = diagnose_rows(qp, settings_.tolerance, &infeasible);
+    if (infeasible || capped) {
+      info.status = SolverStatus::kInfeasible;
+      info.diagnosis = rows;
+    } else if (info.diagnosis.empty()) {
+      std::ostringstream s;
+      s << info.engine << " stopped with residual " << info.residual << " > tolerance " << settings_.tolerance
+        << " after " << info.iterations << " iterations; " << rows;
+      info.diagnosis = s.str();
+    }
+    warm_ = false;
+    result.y.setZero();
+    result.z.setZero();
+    return;
+  }
+  warm_ = true;
+}
+
+std::unique_ptr<LviEngine> make_engine(const TableReader& solver) {
+  const EngineRegistry& reg = engine_registry();
+  std::vector<std::string> names;
+  for (const auto* e : reg.entries()) names.push_back(e->type);
+  const std::string engine = solver.choice("engine", names, "projection");
+  SolverSettings s;
+  s.tolerance = solver.number("tolerance", s.tolerance);
+  s.varpi = solver.number("varpi", s.varpi);
+  s.max_iterations = static_cast<int>(solver.integer("max_iterations", s.max_iterations));
+  s.warm_start = solver.boolean("warm_start", s.warm_start);
+  if (!(s.tolerance > 0.0)) solver.fail("tolerance", "expected a tolerance > 0");
+  if (!(s.varpi > 0.0)) solver.fail("varpi", "expected varpi > 0");
+  if (s.max_iterations < 1) solver.fail("max_iterations", "expected max_iterations >= 1");
+  const auto* entry = reg.find(engine);
+  if (entry == nullptr) solver.fail("engine", "unknown engine '" + engine + "'");
+  auto out = entry->make(solver, s);
+  solver.finish();
+  return out;
+}
+
+std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSettings& settings) {
+  const auto* e = engine_registry().find(name);
+  if (e == nullptr) {
+    throw std::invalid_argument("make_engine: unknown engine '" + name + "'; known engines: " +
+                                engine_registry().names());
+  }
+  const auto file = parse_toml_string("", "<defaults>");
+  return e->make(TableReader::root(file), settings);
+}
+
+}  // namespace redres

@@ -1,0 +1,91 @@
+#include "redres/scheme.hpp"
+
+#include <algorithm>
+#include <set>
+
+namespace redres {
+
+Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
+               std::vector<std::unique_ptr<Constraint>> constraints)
+    : robot_(&robot), objectives_(std::move(objectives)), constraints_(std::move(constraints)) {
+  for (const auto& o : objectives_) {
+    REDRES_REQUIRE(o != nullptr, "Scheme", "every objective is non-null");
+    level_ = std::max(level_, o->kinematics_level());
+  }
+  for (const auto& c : constraints_) {
+    REDRES_REQUIRE(c != nullptr, "Scheme", "every constraint is non-null");
+    level_ = std::max(level_, c->kinematics_level());
+    const int e = c->equality_rows(robot);
+    const int i = c->inequality_rows(robot);
+    REDRES_REQUIRE(e >= 0 && i >= 0, "Scheme", "constraint '" + c->name() + "' declares non-negative row counts");
+    eq_offset_.push_back(m_eq_);
+    eq_rows_.push_back(e);
+    in_offset_.push_back(m_in_);
+    in_rows_.push_back(i);
+    m_eq_ += e;
+    m_in_ += i;
+  }
+}
+
+Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot) {
+  std::vector<std::unique_ptr<Objective>> objectives;
+  std::vector<std::unique_ptr<Constraint>> constraints;
+  std::set<std::string> names;
+  const auto unique = [&](const TableReader& t, const std::string& name) {
+    if (!names.insert(name).second) {
+      t.fail("name", "duplicate plugin name '" + name + "'; give one of them a different `name`");
+    }
+  };
+  if (root.has("objectives")) {
+    for (const TableReader& t : root.tables("objectives")) {
+      objectives.push_back(make_objective(t, robot));
+      unique(t, objectives.back()->name());
+    }
+  }
+  if (root.has("constraints")) {
+    for (const TableReader& t : root.tables("constraints")) {
+      constraints.push_back(make_constraint(t, robot));
+      unique(t, constraints.back()->name());
+    }
+  }
+  if (objectives.empty()) root.fail("expected at least one [[objectives]] entry (e.g. type = \"min_velocity_norm\")");
+  return Scheme(robot, std::move(objectives), std::move(constraints));
+}
+
+void Scheme::setup(QpProblem& qp) const {
+  qp.resize(robot_->dof(), m_eq_, m_in_);
+  qp.source_names.clear();
+  qp.variable_names.clear();
+  for (const auto& j : robot_->joints()) qp.variable_names.push_back(j.name);
+  for (const auto& o : objectives_) qp.source_names.push_back(o->name());
+  for (const auto& c : constraints_) qp.source_names.push_back(c->name());
+  const int base = static_cast<int>(objectives_.size());
+  for (std::size_t k = 0; k < constraints_.size(); ++k) {
+    for (int r = 0; r < eq_rows_[k]; ++r) qp.eq_source[static_cast<std::size_t>(eq_offset_[k] + r)] = base + static_cast<int>(k);
+    for (int r = 0; r < in_rows_[k]; ++r) qp.in_source[static_cast<std::size_t>(in_offset_[k] + r)] = base + static_cast<int>(k);
+  }
+}
+
+void Scheme::build(const Context& ctx, QpProblem& qp) const {
+  REDRES_REQUIRE(qp.n() == robot_->dof() && qp.m_eq() == m_eq_ && qp.m_in() == m_in_, "Scheme::build",
+                 "qp was sized by setup()");
+  REDRES_REQUIRE(ctx.kinematics != nullptr && ctx.robot == robot_, "Scheme::build",
+                 "ctx.robot is the scheme's robot and ctx.kinematics is set");
+  REDRES_REQUIRE(ctx.kinematics->level >= level_, "Scheme::build",
+                 "ctx.kinematics was computed at kinematics_level() or deeper");
+  qp.clear();
+  QpBuilder builder(qp);
+  int source = 0;
+  for (const auto& o : objectives_) {
+    builder.begin(source++, o->weight(), 0, 0, 0, 0);
+    o->contribute(ctx, builder);
+  }
+  for (std::size_t k = 0; k < constraints_.size(); ++k) {
+    const auto& c = constraints_[k];
+    builder.begin(source++, c->weight(), eq_offset_[k], eq_rows_[k], in_offset_[k], in_rows_[k]);
+    c->contribute(ctx, builder);
+    // Inactive constraints leave their rows empty: 0 x = 0 and 0 x <= 0 are always met.
+  }
+}
+
+}  // namespace redres

@@ -18,4 +18,7 @@ using Action = std::function<int()>;
 /// `redres robot FILE [--theta v1,v2,...] [--json]`.
 void add_robot_command(CLI::App& app, Action& action);
 
+/// `redres plugins [--json]`.
+void add_plugins_command(CLI::App& app, Action& action);
+
 }  // namespace redres::cli

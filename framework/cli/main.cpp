@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "redres 0.1.0");
   redres::cli::Action action;
   redres::cli::add_robot_command(app, action);
+  redres::cli::add_plugins_command(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -106,7 +106,7 @@ const bool kRegistered = objective_registry().add({
      {"schedule", "\"sine\"", "\"constant\", \"sine\" (p sin(pi t/T)), \"smoothstep\" or \"expression\""},
      {"p", "2.0", "coefficient magnitude (constant, sine, smoothstep)"},
      {"ramp_fraction", "0.25", "smoothstep: ramp length as a fraction of T"},
-     {"formula", "", "expression: p(t) as a formula of t and T"}},
+     {"formula", "(none)", "expression schedule only: p(t) as a formula of t and T"}},
     [](const TableReader& r, const RobotModel& /*robot*/) -> std::unique_ptr<Objective> {
       return std::make_unique<Manipulability>(r);
     },

@@ -61,15 +61,20 @@ void QpProblem::validate() const {
   REDRES_REQUIRE(J.cols() == nn && J.rows() == d.size(), "QpProblem", "J is m_e x n and d has m_e entries");
   REDRES_REQUIRE(A.cols() == nn && A.rows() == b.size(), "QpProblem", "A is m_i x n and b has m_i entries");
   REDRES_REQUIRE(lo.size() == nn && hi.size() == nn, "QpProblem", "lo and hi have n entries");
-  check_finite(W, "W");
-  check_finite(zeta, "zeta");
-  check_finite(J, "J");
-  check_finite(d, "d");
-  check_finite(A, "A");
-  check_finite(b, "b");
-  for (Eigen::Index i = 0; i < nn; ++i) {
-    REDRES_REQUIRE(!std::isnan(lo(i)) && !std::isnan(hi(i)), "QpProblem",
-                   "lo(" + std::to_string(i) + ") and hi(" + std::to_string(i) + ") are not NaN");
+  // Fast vectorised checks first; the entry-by-entry search that names the culprit runs only on failure.
+  if (!(W.allFinite() && zeta.allFinite() && J.allFinite() && d.allFinite() && A.allFinite() && b.allFinite())) {
+    check_finite(W, "W");
+    check_finite(zeta, "zeta");
+    check_finite(J, "J");
+    check_finite(d, "d");
+    check_finite(A, "A");
+    check_finite(b, "b");
+  }
+  if (lo.array().isNaN().any() || hi.array().isNaN().any()) {
+    for (Eigen::Index i = 0; i < nn; ++i) {
+      REDRES_REQUIRE(!std::isnan(lo(i)) && !std::isnan(hi(i)), "QpProblem",
+                     "lo(" + std::to_string(i) + ") and hi(" + std::to_string(i) + ") are not NaN");
+    }
   }
 }
 

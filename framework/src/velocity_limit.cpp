@@ -16,14 +16,14 @@ std::optional<UndefinedAt> check_velocity_law(const VelocityLimitLaw& law, doubl
     const double theta =
         k == kVelocityLawSamples - 1 ? hi : lo + (hi - lo) * static_cast<double>(k) / (kVelocityLawSamples - 1);
     const VelocityBounds b = law.bounds(theta);
+    const bool finite = std::isfinite(b.lower) && std::isfinite(b.upper);
+    if (finite && b.lower < 0.0 && 0.0 < b.upper) continue;
     std::ostringstream why;
     why.precision(10);
-    if (!std::isfinite(b.lower) || !std::isfinite(b.upper)) {
+    if (!finite) {
       why << "limits are not finite (lower " << b.lower << ", upper " << b.upper << ")";
-    } else if (!(b.lower < 0.0 && 0.0 < b.upper)) {
-      why << "expected lower < 0 < upper, got lower " << b.lower << ", upper " << b.upper;
     } else {
-      continue;
+      why << "expected lower < 0 < upper, got lower " << b.lower << ", upper " << b.upper;
     }
     return UndefinedAt{theta, why.str()};
   }

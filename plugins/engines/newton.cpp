@@ -40,6 +40,7 @@ class Newton final : public LviEngine {
     free_.assign(static_cast<std::size_t>(n), 0);
     v_.setZero(n);
     jtd_.setZero(n);
+    inv_w_.setZero(n);
     dv_.setZero(n);
     breaks_.assign(2 * static_cast<std::size_t>(n), 0.0);
     y_.setZero(m_e);
@@ -52,28 +53,30 @@ class Newton final : public LviEngine {
     fallback_->setup(n, m_e, m_i, fallback_result_);
   }
 
-  // x(y), the free set and F(y); returns phi(y).
-  static double evaluate(const QpProblem& qp, const Eigen::VectorXd& y, Eigen::VectorXd& v, Eigen::VectorXd& x,
-                         std::vector<char>& free, Eigen::VectorXd& F) {
+  // x(y), v(y), the free set and F(y) = J x(y) - d; returns |F|^2.
+  double evaluate(const QpProblem& qp) {
     const int n = qp.n(), me = qp.m_eq();
-    const double* J = qp.J.data();
-    double phi = 0.0;
-    for (int r = 0; r < me; ++r) F(r) = -qp.d(r);
+    const double* __restrict J = qp.J.data();
+    const double* __restrict zeta = qp.zeta.data();
+    const double* __restrict lo = qp.lo.data();
+    const double* __restrict hi = qp.hi.data();
+    const double* __restrict y = y_.data();
+    double* __restrict F = F_.data();
+    for (int r = 0; r < me; ++r) F[r] = -qp.d(r);
     for (int i = 0; i < n; ++i) {
       const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
       double jty = 0.0;
-      for (int r = 0; r < me; ++r) jty += Ji[r] * y(r);
-      const double w = qp.W(i, i);
-      const double vi = (jty - qp.zeta(i)) / w;
-      const double xi = std::clamp(vi, qp.lo(i), qp.hi(i));
-      v(i) = vi;
-      x(i) = xi;
-      free[static_cast<std::size_t>(i)] = (vi > qp.lo(i) && vi < qp.hi(i)) ? 1 : 0;
-      for (int r = 0; r < me; ++r) F(r) += Ji[r] * xi;
-      phi += 0.5 * w * xi * xi + qp.zeta(i) * xi;
+      for (int r = 0; r < me; ++r) jty += Ji[r] * y[r];
+      const double vi = (jty - zeta[i]) * inv_w_(i);
+      const double xi = std::clamp(vi, lo[i], hi[i]);
+      v_(i) = vi;
+      x_(i) = xi;
+      free_[static_cast<std::size_t>(i)] = (vi > lo[i] && vi < hi[i]) ? 1 : 0;
+      for (int r = 0; r < me; ++r) F[r] += Ji[r] * xi;
     }
-    for (int r = 0; r < me; ++r) phi -= y(r) * F(r);
-    return phi;
+    double f2 = 0.0;
+    for (int r = 0; r < me; ++r) f2 += F[r] * F[r];
+    return f2;
   }
 
   // Solves (G + (reg + prox) I) delta = -F by Cholesky, in place in G_, with G = J D W^-1 J' over the free
@@ -82,15 +85,11 @@ class Newton final : public LviEngine {
     const int n = qp.n(), me = qp.m_eq();
     const double* J = qp.J.data();
     G_.setZero();
-    double full_scale = 0.0;
-    for (int i = 0; i < n; ++i) {
-      const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
-      for (int r = 0; r < me; ++r) full_scale = std::max(full_scale, Ji[r] * Ji[r] / qp.W(i, i));
-    }
+    const double full_scale = full_scale_;
     for (int i = 0; i < n; ++i) {
       if (!free_[static_cast<std::size_t>(i)]) continue;
       const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
-      const double inv_w = 1.0 / qp.W(i, i);
+      const double inv_w = inv_w_(i);
       for (int c = 0; c < me; ++c) {
         for (int r = c; r < me; ++r) G_(r, c) += Ji[r] * Ji[c] * inv_w;
       }
@@ -145,34 +144,48 @@ class Newton final : public LviEngine {
   double exact_step(const QpProblem& qp) {
     const int n = qp.n(), me = qp.m_eq();
     const double* J = qp.J.data();
-    int count = 0;
+    // The usual case: no joint changes status between s = 0 and the full Newton step s = 1 (v is linear in s,
+    // so equal status at both ends means no crossing); phi' is then linear on [0, 1] and its root is at s = 1 up
+    // to rounding. Checked without divisions or sorting.
+    bool same_status = true;
     for (int i = 0; i < n; ++i) {
       const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
       double jtd = 0.0;
       for (int r = 0; r < me; ++r) jtd += Ji[r] * delta_(r);
       jtd_(i) = jtd;
-      dv_(i) = jtd / qp.W(i, i);
-      if (dv_(i) != 0.0) {
-        for (const double bound : {qp.lo(i), qp.hi(i)}) {
-          const double s = (bound - v_(i)) / dv_(i);
-          if (std::isfinite(s) && s > 0.0) breaks_[static_cast<std::size_t>(count++)] = s;
-        }
+      dv_(i) = jtd * inv_w_(i);
+      const double v1 = v_(i) + dv_(i);
+      const int s0 = v_(i) <= qp.lo(i) ? -1 : (v_(i) >= qp.hi(i) ? 1 : 0);
+      const int s1 = v1 <= qp.lo(i) ? -1 : (v1 >= qp.hi(i) ? 1 : 0);
+      same_status = same_status && s0 == s1;
+    }
+    const double g0 = -F_.dot(delta_);
+    if (!(g0 > 0.0)) return 0.0;
+    if (same_status) {
+      const double g1 = slope_at(qp, 1.0);
+      if (g1 <= 0.0) return g0 / (g0 - g1);
+    }
+    int count = 0;
+    for (int i = 0; i < n; ++i) {
+      if (dv_(i) == 0.0) continue;
+      for (const double bound : {qp.lo(i), qp.hi(i)}) {
+        const double s = (bound - v_(i)) / dv_(i);
+        if (std::isfinite(s) && s > 0.0) breaks_[static_cast<std::size_t>(count++)] = s;
       }
     }
     std::sort(breaks_.begin(), breaks_.begin() + count);
     double s0 = 0.0;
-    double g0 = slope_at(qp, 0.0);
-    if (!(g0 > 0.0)) return 0.0;
+    double g_prev = g0;
     for (int k = 0; k <= count; ++k) {
       // Beyond the last breakpoint phi' is linear for ever; probe it one unit further.
       const double s1 = k < count ? breaks_[static_cast<std::size_t>(k)] : s0 + std::max(1.0, s0);
       if (s1 <= s0) continue;
       const double g1 = slope_at(qp, s1);
-      if (g1 <= 0.0) return s0 + (s1 - s0) * g0 / (g0 - g1);  // root of the linear piece
-      if (k == count && !(g1 < g0 * (1.0 - 1e-12))) return std::numeric_limits<double>::infinity();
-      if (k == count) return s1 + (s1 - s0) * g1 / (g0 - g1);
+      if (g1 <= 0.0) return s0 + (s1 - s0) * g_prev / (g_prev - g1);  // root of the linear piece
+      if (k == count && !(g1 < g_prev * (1.0 - 1e-12))) return std::numeric_limits<double>::infinity();
+      if (k == count) return s1 + (s1 - s0) * g1 / (g_prev - g1);
       s0 = s1;
-      g0 = g1;
+      g_prev = g1;
     }
     return s0;
   }
@@ -197,69 +210,69 @@ class Newton final : public LviEngine {
       run_fallback(qp, result);
       return;
     }
+    double d_max = 0.0;
+    full_scale_ = 0.0;
+    for (int i = 0; i < n; ++i) {
+      inv_w_(i) = 1.0 / qp.W(i, i);
+      for (int r = 0; r < me; ++r) full_scale_ = std::max(full_scale_, qp.J(r, i) * qp.J(r, i) * inv_w_(i));
+    }
+    for (int r = 0; r < me; ++r) d_max = std::max(d_max, std::abs(qp.d(r)));
     if (!warm()) y_.setZero();
     const double varpi = settings().varpi;
-    const double target = std::min(settings().tolerance, 1e-12 * (1.0 + (me > 0 ? qp.d.cwiseAbs().maxCoeff() : 0.0)));
+    const double target = std::min(settings().tolerance, 1e-12 * (1.0 + d_max));
 
-    evaluate(qp, y_, v_, x_, free_, F_);
+    double f2 = evaluate(qp);
     int k = 0;
     bool converged = false;
     for (;; ++k) {
-      const double fnorm = F_.norm();
-      if (fnorm <= target) {
+      if (f2 <= target * target) {
         converged = true;
         break;
       }
       if (k >= kMaxNewtonIterations) break;
-      // Where the free joints do not span the rows (at a degenerate solution some v_i sits exactly on its
-      // bound), the generalised Jacobian also takes the clamped joints nearest to their bounds, nearest first,
-      // until the rows are spanned. If phi grows linearly for ever along the step, the rows cannot be met.
       // Where the free joints do not span the rows (a degenerate solution, where some v_i sits on its bound),
       // G is singular: regularise it proximally with |F| (Levenberg-Marquardt), which vanishes at the solution.
-      if (!solve_newton_system(qp, 0.0) && !solve_newton_system(qp, F_.norm())) break;
+      if (!solve_newton_system(qp, 0.0) && !solve_newton_system(qp, std::sqrt(f2))) break;
       const double step = exact_step(qp);
-
-      if (!std::isfinite(step) || !(step > 0.0)) {
-        if (std::isinf(step)) {
-          info.iterations = k + 1;
-          info.residual = F_.norm();
-          info.status = SolverStatus::kInfeasible;
-          result.x = x_;
-          result.y = y_;
-          result.z.setZero();
-          return;
-        }
-        break;  // no ascent: leave it to the fallback
+      if (std::isinf(step)) {
+        // phi grows linearly for ever along delta: the dual is unbounded, so J x = d cannot be met.
+        finish(result, SolverStatus::kInfeasible, k + 1, f2);
+        return;
       }
-      y_ += step * delta_;
-      evaluate(qp, y_, v_, x_, free_, F_);
-      if (y_.cwiseAbs().maxCoeff() > varpi) {
+      if (!(step > 0.0)) break;  // no ascent: leave it to the fallback
+      bool outside = false;
+      for (int r = 0; r < me; ++r) {
+        y_(r) += step * delta_(r);
+        outside = outside || std::abs(y_(r)) > varpi;
+      }
+      f2 = evaluate(qp);
+      if (outside) {
         // The duals left the LVI's box: J x = d cannot be met inside the bounds.
-        info.iterations = k + 1;
-        info.residual = F_.norm();
-        info.status = SolverStatus::kInfeasible;
         y_ = y_.cwiseMax(-varpi).cwiseMin(varpi);
-        result.x = x_;
-        result.y = y_;
-        result.z.setZero();
+        finish(result, SolverStatus::kInfeasible, k + 1, f2);
         return;
       }
     }
     if (!converged) {
       info.diagnosis = "newton did not converge in " + std::to_string(k) + " iterations (residual " +
-                       std::to_string(F_.norm()) + "); fell back to projection";
+                       std::to_string(std::sqrt(f2)) + "); fell back to projection";
       run_fallback(qp, result);
       return;
     }
-    info.iterations = k;
-    info.residual = F_.norm();
-    info.status = SolverStatus::kSolved;
+    finish(result, SolverStatus::kSolved, k, f2);
+  }
+
+  void finish(SolverResult& result, SolverStatus status, int iterations, double f2) const {
+    result.info.status = status;
+    result.info.iterations = iterations;
+    result.info.residual = std::sqrt(f2);
     result.x = x_;
     result.y = y_;
     result.z.setZero();
   }
 
-  Eigen::VectorXd v_, x_, y_, F_, delta_, diag_, jtd_, dv_;
+  double full_scale_ = 0.0;
+  Eigen::VectorXd v_, x_, y_, F_, delta_, diag_, jtd_, dv_, inv_w_;
   std::vector<char> free_;
   std::vector<double> breaks_;
   Eigen::MatrixXd G_;

@@ -29,65 +29,119 @@ class Projection final : public LviEngine {
  private:
   void do_setup(int n, int m_e, int m_i) override {
     for (Eigen::VectorXd* v : {&ux_, &rx_, &ex_, &px_}) v->setZero(n);
-    for (Eigen::VectorXd* v : {&uy_, &ry_, &ey_, &py_}) v->setZero(m_e);
+    for (Eigen::VectorXd* v : {&uy_, &ry_, &ey_, &py_, &ry2_, &py2_}) v->setZero(m_e);
     for (Eigen::VectorXd* v : {&uz_, &rz_, &ez_, &pz_}) v->setZero(m_i);
   }
 
   void do_solve(const QpProblem& qp, SolverResult& result) override {
-    const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
-    const double varpi = settings().varpi;
-    const double tol2 = settings().tolerance * settings().tolerance;
     if (!warm()) {
       ux_.setZero();
       uy_.setZero();
       uz_.setZero();
     }
-    const double* W = qp.W.data();
-    const double* J = qp.J.data();
-    const double* A = qp.A.data();
-    const bool diag = qp.w_diagonal;
-    double* x = ux_.data();
-    double* y = uy_.data();
-    double* z = uz_.data();
-    double *rx = rx_.data(), *ry = ry_.data(), *rz = rz_.data();
-    double *ex = ex_.data(), *ey = ey_.data(), *ez = ez_.data();
-    double *px = px_.data(), *py = py_.data(), *pz = pz_.data();
-
+    // The variants differ only in which loops exist; each performs the same floating-point operations in the
+    // same order, so the iterates are identical.
+    Outcome out;
+    if (qp.w_diagonal && qp.m_in() == 0 && qp.m_eq() == 2 && qp.n() == 6) {
+      out = iterate<true, false, 2, 6>(qp);  // the paper's case: every loop unrolls
+    } else if (qp.w_diagonal && qp.m_in() == 0 && qp.m_eq() == 2) {
+      out = iterate<true, false, 2>(qp);
+    } else if (qp.w_diagonal) {
+      out = qp.m_in() == 0 ? iterate<true, false>(qp) : iterate<true, true>(qp);
+    } else {
+      out = qp.m_in() == 0 ? iterate<false, false>(qp) : iterate<false, true>(qp);
+    }
     SolverInfo& info = result.info;
-    int k = 0;
+    info.iterations = out.iterations;
+    info.residual = std::sqrt(out.e2);
+    const double tol2 = settings().tolerance * settings().tolerance;
+    if (out.broke_down) {
+      info.status = SolverStatus::kNumericalError;
+      info.diagnosis = "eq. 15 broke down: ||phi|| = 0 with ||e|| = " + std::to_string(info.residual);
+    } else {
+      info.status = out.e2 <= tol2 ? SolverStatus::kSolved : SolverStatus::kMaxIterations;
+    }
+    result.x = ux_.cwiseMax(qp.lo).cwiseMin(qp.hi);
+    result.y = uy_;
+    result.z = uz_;
+  }
+
+  struct Outcome {
+    int iterations = 0;
     double e2 = 0.0;
     bool broke_down = false;
+  };
+
+  template <bool kDiagonal, bool kInequalities, int kRows = 0, int kCols = 0>
+  Outcome iterate(const QpProblem& qp) {
+    const int n = kCols > 0 ? kCols : qp.n(), me = kRows > 0 ? kRows : qp.m_eq(), mi = kInequalities ? qp.m_in() : 0;
+    const double varpi = settings().varpi;
+    const double tol2 = settings().tolerance * settings().tolerance;
+    const int max_iterations = settings().max_iterations;
+    const double* __restrict W = qp.W.data();
+    const double* __restrict J = qp.J.data();
+    const double* __restrict A = qp.A.data();
+    const double* __restrict lo = qp.lo.data();
+    const double* __restrict hi = qp.hi.data();
+    const double* __restrict zeta = qp.zeta.data();
+    const double* __restrict d = qp.d.data();
+    const double* __restrict b = qp.b.data();
+    double* __restrict x = ux_.data();
+    double* __restrict y = uy_.data();
+    double* __restrict z = uz_.data();
+    double* __restrict rx = rx_.data();
+    double* __restrict ry = ry_.data();
+    double* __restrict ry2 = ry2_.data();
+    double* __restrict py2 = py2_.data();
+    double* __restrict rz = rz_.data();
+    double* __restrict ex = ex_.data();
+    double* __restrict ey = ey_.data();
+    double* __restrict ez = ez_.data();
+    double* __restrict px = px_.data();
+    double* __restrict py = py_.data();
+    double* __restrict pz = pz_.data();
+
+    Outcome out;
+    int k = 0;
     for (;; ++k) {
       // r = M u + g.
-      for (int r = 0; r < me; ++r) ry[r] = -qp.d(r);
-      for (int r = 0; r < mi; ++r) rz[r] = qp.b(r);
+      for (int r = 0; r < me; ++r) {
+        ry[r] = -d[r];
+        ry2[r] = 0.0;
+      }
+      for (int r = 0; r < mi; ++r) rz[r] = b[r];
       for (int i = 0; i < n; ++i) {
+        double* ry_part = (i & 1) ? ry2 : ry;  // two partial sums halve the dependency chain
         const double* Wi = W + static_cast<std::ptrdiff_t>(i) * n;  // column i (W symmetric)
         double wx = 0.0;
-        if (diag) {
+        if constexpr (kDiagonal) {
           wx = Wi[i] * x[i];
         } else {
           for (int j = 0; j < n; ++j) wx += Wi[j] * x[j];
         }
         const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
-        const double* Ai = A + static_cast<std::ptrdiff_t>(i) * mi;
         double jty = 0.0, atz = 0.0;
         for (int r = 0; r < me; ++r) {
           jty += Ji[r] * y[r];
-          ry[r] += Ji[r] * x[i];
+          ry_part[r] += Ji[r] * x[i];
         }
-        for (int r = 0; r < mi; ++r) {
-          atz += Ai[r] * z[r];
-          rz[r] -= Ai[r] * x[i];
+        if constexpr (kInequalities) {
+          const double* Ai = A + static_cast<std::ptrdiff_t>(i) * mi;
+          for (int r = 0; r < mi; ++r) {
+            atz += Ai[r] * z[r];
+            rz[r] -= Ai[r] * x[i];
+          }
         }
-        rx[i] = wx - jty + atz + qp.zeta(i);
+        rx[i] = wx - jty + atz + zeta[i];
       }
+      for (int r = 0; r < me; ++r) ry[r] += ry2[r];
       // e = u - P_Omega(u - r).
-      e2 = 0.0;
+      double e2 = 0.0, e2_odd = 0.0;
       for (int i = 0; i < n; ++i) {
-        ex[i] = x[i] - std::clamp(x[i] - rx[i], qp.lo(i), qp.hi(i));
-        e2 += ex[i] * ex[i];
+        ex[i] = x[i] - std::clamp(x[i] - rx[i], lo[i], hi[i]);
+        ((i & 1) ? e2_odd : e2) += ex[i] * ex[i];
       }
+      e2 += e2_odd;
       for (int r = 0; r < me; ++r) {
         ey[r] = y[r] - std::clamp(y[r] - ry[r], -varpi, varpi);
         e2 += ey[r] * ey[r];
@@ -96,38 +150,48 @@ class Projection final : public LviEngine {
         ez[r] = z[r] - std::clamp(z[r] - rz[r], 0.0, varpi);
         e2 += ez[r] * ez[r];
       }
-      if (e2 <= tol2 || k >= settings().max_iterations) break;
+      out.e2 = e2;
+      if (e2 <= tol2 || k >= max_iterations) break;
       // phi = (M' + I) e, M' = [W' J' -A'; -J 0 0; A 0 0].
-      for (int r = 0; r < me; ++r) py[r] = ey[r];
+      for (int r = 0; r < me; ++r) {
+        py[r] = ey[r];
+        py2[r] = 0.0;
+      }
       for (int r = 0; r < mi; ++r) pz[r] = ez[r];
-      double p2 = 0.0;
+      double p2 = 0.0, p2_odd = 0.0;
       for (int i = 0; i < n; ++i) {
+        double* py_part = (i & 1) ? py2 : py;
         const double* Wi = W + static_cast<std::ptrdiff_t>(i) * n;
         double we = 0.0;
-        if (diag) {
+        if constexpr (kDiagonal) {
           we = Wi[i] * ex[i];
         } else {
           for (int j = 0; j < n; ++j) we += Wi[j] * ex[j];
         }
         const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
-        const double* Ai = A + static_cast<std::ptrdiff_t>(i) * mi;
         double jte = 0.0, ate = 0.0;
         for (int r = 0; r < me; ++r) {
           jte += Ji[r] * ey[r];
-          py[r] -= Ji[r] * ex[i];
+          py_part[r] -= Ji[r] * ex[i];
         }
-        for (int r = 0; r < mi; ++r) {
-          ate += Ai[r] * ez[r];
-          pz[r] += Ai[r] * ex[i];
+        if constexpr (kInequalities) {
+          const double* Ai = A + static_cast<std::ptrdiff_t>(i) * mi;
+          for (int r = 0; r < mi; ++r) {
+            ate += Ai[r] * ez[r];
+            pz[r] += Ai[r] * ex[i];
+          }
         }
         px[i] = we + jte - ate + ex[i];
-        p2 += px[i] * px[i];
+        ((i & 1) ? p2_odd : p2) += px[i] * px[i];
       }
-      for (int r = 0; r < me; ++r) p2 += py[r] * py[r];
+      p2 += p2_odd;
+      for (int r = 0; r < me; ++r) {
+        py[r] += py2[r];
+        p2 += py[r] * py[r];
+      }
       for (int r = 0; r < mi; ++r) p2 += pz[r] * pz[r];
       if (!(p2 > 0.0) || !std::isfinite(p2)) {
-        broke_down = true;
-        info.diagnosis = "eq. 15 broke down: ||phi|| = 0 with ||e|| = " + std::to_string(std::sqrt(e2));
+        out.broke_down = true;
         break;
       }
       const double step = e2 / p2;
@@ -135,16 +199,11 @@ class Projection final : public LviEngine {
       for (int r = 0; r < me; ++r) y[r] -= step * py[r];
       for (int r = 0; r < mi; ++r) z[r] -= step * pz[r];
     }
-    info.iterations = k;
-    info.residual = std::sqrt(e2);
-    info.status = broke_down ? SolverStatus::kNumericalError
-                             : (e2 <= tol2 ? SolverStatus::kSolved : SolverStatus::kMaxIterations);
-    result.x = ux_.cwiseMax(qp.lo).cwiseMin(qp.hi);
-    result.y = uy_;
-    result.z = uz_;
+    out.iterations = k;
+    return out;
   }
 
-  Eigen::VectorXd ux_, uy_, uz_, rx_, ry_, rz_, ex_, ey_, ez_, px_, py_, pz_;
+  Eigen::VectorXd ux_, uy_, uz_, rx_, ry_, rz_, ex_, ey_, ez_, px_, py_, pz_, ry2_, py2_;
 };
 
 const bool kRegistered = engine_registry().add({

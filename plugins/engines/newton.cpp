@@ -54,8 +54,9 @@ class Newton final : public LviEngine {
   }
 
   // x(y), v(y), the free set and F(y) = J x(y) - d; returns |F|^2.
+  template <int kRows>
   double evaluate(const QpProblem& qp) {
-    const int n = qp.n(), me = qp.m_eq();
+    const int n = qp.n(), me = kRows > 0 ? kRows : qp.m_eq();
     const double* __restrict J = qp.J.data();
     const double* __restrict zeta = qp.zeta.data();
     const double* __restrict lo = qp.lo.data();
@@ -81,8 +82,9 @@ class Newton final : public LviEngine {
 
   // Solves (G + (reg + prox) I) delta = -F by Cholesky, in place in G_, with G = J D W^-1 J' over the free
   // joints. Without `prox`, false if a pivot is not clearly positive (the free joints do not span the rows).
+  template <int kRows>
   bool solve_newton_system(const QpProblem& qp, double prox) {
-    const int n = qp.n(), me = qp.m_eq();
+    const int n = qp.n(), me = kRows > 0 ? kRows : qp.m_eq();
     const double* J = qp.J.data();
     G_.setZero();
     const double full_scale = full_scale_;
@@ -141,8 +143,9 @@ class Newton final : public LviEngine {
   // The exact maximiser of the concave, piecewise quadratic phi along delta (phi' is piecewise linear between the
   // breakpoints where some v_i crosses a bound). Returns +inf when phi' stays positive for ever: the dual is then
   // unbounded, which proves that J x = d cannot be met inside the bounds.
+  template <int kRows>
   double exact_step(const QpProblem& qp) {
-    const int n = qp.n(), me = qp.m_eq();
+    const int n = qp.n(), me = kRows > 0 ? kRows : qp.m_eq();
     const double* J = qp.J.data();
     // The usual case: no joint changes status between s = 0 and the full Newton step s = 1 (v is linear in s,
     // so equal status at both ends means no crossing); phi' is then linear on [0, 1] and its root is at s = 1 up
@@ -202,14 +205,24 @@ class Newton final : public LviEngine {
   }
 
   void do_solve(const QpProblem& qp, SolverResult& result) override {
-    SolverInfo& info = result.info;
-    const int n = qp.n(), me = qp.m_eq();
     bool applicable = qp.w_diagonal && qp.m_in() == 0;
-    for (int i = 0; i < n && applicable; ++i) applicable = qp.W(i, i) > 0.0;
+    for (int i = 0; i < qp.n() && applicable; ++i) applicable = qp.W(i, i) > 0.0;
     if (!applicable) {
       run_fallback(qp, result);
       return;
     }
+    // Planar position tasks (2 rows) get loops of fixed length; the arithmetic is the same.
+    if (qp.m_eq() == 2) {
+      run<2>(qp, result);
+    } else {
+      run<0>(qp, result);
+    }
+  }
+
+  template <int kRows>
+  void run(const QpProblem& qp, SolverResult& result) {
+    SolverInfo& info = result.info;
+    const int n = qp.n(), me = kRows > 0 ? kRows : qp.m_eq();
     double d_max = 0.0;
     full_scale_ = 0.0;
     for (int i = 0; i < n; ++i) {
@@ -221,7 +234,7 @@ class Newton final : public LviEngine {
     const double varpi = settings().varpi;
     const double target = std::min(settings().tolerance, 1e-12 * (1.0 + d_max));
 
-    double f2 = evaluate(qp);
+    double f2 = evaluate<kRows>(qp);
     int k = 0;
     bool converged = false;
     for (;; ++k) {
@@ -232,8 +245,8 @@ class Newton final : public LviEngine {
       if (k >= kMaxNewtonIterations) break;
       // Where the free joints do not span the rows (a degenerate solution, where some v_i sits on its bound),
       // G is singular: regularise it proximally with |F| (Levenberg-Marquardt), which vanishes at the solution.
-      if (!solve_newton_system(qp, 0.0) && !solve_newton_system(qp, std::sqrt(f2))) break;
-      const double step = exact_step(qp);
+      if (!solve_newton_system<kRows>(qp, 0.0) && !solve_newton_system<kRows>(qp, std::sqrt(f2))) break;
+      const double step = exact_step<kRows>(qp);
       if (std::isinf(step)) {
         // phi grows linearly for ever along delta: the dual is unbounded, so J x = d cannot be met.
         finish(result, SolverStatus::kInfeasible, k + 1, f2);
@@ -245,7 +258,7 @@ class Newton final : public LviEngine {
         y_(r) += step * delta_(r);
         outside = outside || std::abs(y_(r)) > varpi;
       }
-      f2 = evaluate(qp);
+      f2 = evaluate<kRows>(qp);
       if (outside) {
         // The duals left the LVI's box: J x = d cannot be met inside the bounds.
         y_ = y_.cwiseMax(-varpi).cwiseMin(varpi);

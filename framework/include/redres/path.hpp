@@ -1,0 +1,130 @@
+#pragma once
+/// @file
+/// Desired end-effector paths r_d(t), r_d_dot(t) on [0, T] (position rows only: 2 for planar tasks, 3 for
+/// spatial ones). A path is geometry (lines, arcs, helices, grouped into strokes) plus a timing law:
+///
+/// - timing laws sigma(u), u in [0, 1], sigma(0) = 0, sigma(1) = 1 (the share of arc length covered):
+///   `cycloidal` u - sin(2 pi u) / (2 pi); `sin2` sin^2(pi u / 2) (the 2 pi sin^2(pi t / 2T) style law);
+///   `quintic` 10u^3 - 15u^4 + 6u^5. cycloidal and quintic start and stop with zero speed and acceleration,
+///   sin2 with zero speed;
+/// - scope `per_stroke` (each stroke gets a share of T proportional to its length and runs the law from rest to
+///   rest, so r_d_dot is continuous at every corner) or `whole` (one law over the total length).
+///
+/// Placement: the path's local coordinates are rotated (planar: `rotation_deg` about z; spatial: `rpy_deg`) and
+/// translated to `origin`, which is absolute (`placement = "absolute"`) or an offset from the end effector's
+/// initial position f(theta(0)) (`placement = "relative"`, the default).
+///
+/// Paths are plugins: `type` selects a factory in path_registry(); the common keys above are read by the
+/// framework, the geometry keys by the path type.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "redres/registry.hpp"
+
+namespace redres {
+
+/// One geometric piece, parameterised by arc length.
+struct PathSegment {
+  enum class Kind { kLine, kArc, kHelix };
+  Kind kind = Kind::kLine;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();   //!< line start, or arc/helix centre (m)
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();   //!< line end (m)
+  Eigen::Vector3d e1 = Eigen::Vector3d::UnitX(); //!< arc/helix plane axes (orthonormal)
+  Eigen::Vector3d e2 = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ(); //!< helix axis (unit)
+  double radius = 0.0;       //!< arc/helix radius (m)
+  double start_angle = 0.0;  //!< angle at the segment start (rad), measured from e1 towards e2
+  double sweep = 0.0;        //!< signed angle swept (rad); negative is clockwise about e1 x e2
+  double rise = 0.0;         //!< helix: advance along the axis over the whole segment (m)
+  double length = 0.0;       //!< arc length (m), set by finalise()
+
+  /// A line from p to q.
+  static PathSegment line(const Eigen::Vector3d& p, const Eigen::Vector3d& q);
+  /// An arc about `centre` in the plane (e1, e2).
+  static PathSegment arc(const Eigen::Vector3d& centre, double radius, double start_angle, double sweep,
+                         const Eigen::Vector3d& e1 = Eigen::Vector3d::UnitX(),
+                         const Eigen::Vector3d& e2 = Eigen::Vector3d::UnitY());
+  /// Point and unit tangent at arc length s in [0, length].
+  void at(double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent) const;
+  /// Start and end points.
+  [[nodiscard]] Eigen::Vector3d start() const;
+  [[nodiscard]] Eigen::Vector3d end() const;
+};
+
+/// Geometry in local path coordinates: strokes of consecutive segments.
+struct PathGeometry {
+  std::vector<std::vector<PathSegment>> strokes;  //!< each stroke is drawn from rest to rest (per_stroke timing)
+};
+
+/// Timing law sigma(u).
+enum class TimingLaw { kCycloidal, kSin2, kQuintic };
+/// Where the timing law applies.
+enum class TimingScope { kPerStroke, kWhole };
+
+/// sigma(u) and d sigma / du for u in [0, 1].
+void timing(TimingLaw law, double u, double& sigma, double& dsigma);
+
+/// A desired end-effector path on [0, T]. Immutable; evaluate() is allocation-free.
+class Path {
+ public:
+  /// Builds from geometry; `dim` is 2 (planar, z ignored) or 3. Throws std::invalid_argument on empty or
+  /// zero-length geometry.
+  Path(PathGeometry geometry, int dim, double duration, TimingLaw law, TimingScope scope,
+       const Eigen::Matrix3d& rotation, const Eigen::Vector3d& origin, std::string description);
+
+  /// r_d(t) and r_d_dot(t) (size dim); t is clamped to [0, T].
+  void evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot) const;
+  /// Rows it provides (2 or 3).
+  [[nodiscard]] int dim() const noexcept { return dim_; }
+  /// Duration T (s).
+  [[nodiscard]] double duration() const noexcept { return duration_; }
+  /// Total length (m).
+  [[nodiscard]] double length() const noexcept { return total_; }
+  /// One line, e.g. "letter_r (3 strokes, 0.4236 m, cycloidal per stroke)".
+  [[nodiscard]] const std::string& description() const noexcept { return description_; }
+
+ private:
+  std::vector<PathSegment> segments_;
+  std::vector<double> seg_start_;     // arc length at each segment start (whole path)
+  std::vector<int> stroke_first_;     // first segment of each stroke
+  std::vector<double> stroke_start_;  // arc length at each stroke start
+  std::vector<double> stroke_length_;
+  std::vector<double> stroke_t0_;     // start time of each stroke
+  std::vector<double> stroke_T_;      // duration of each stroke
+  int dim_;
+  double duration_;
+  double total_ = 0.0;
+  TimingLaw law_;
+  TimingScope scope_;
+  Eigen::Matrix3d rotation_;
+  Eigen::Vector3d origin_;
+  std::string description_;
+};
+
+/// What a path factory receives besides its table.
+struct PathContext {
+  int dim = 2;                        //!< 2 or 3
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();  //!< f(theta(0)) position (z = 0 for planar)
+  double duration = 0.0;              //!< T (s)
+};
+
+/// A path factory returns geometry and its default placement; the framework reads placement and timing keys.
+struct PathDefaults {
+  double rotation_deg = 0.0;  //!< default planar rotation
+  TimingScope scope = TimingScope::kPerStroke;
+};
+
+/// Path geometry factories. The factory reads its own keys and fills `defaults` where it differs.
+using PathRegistry = Registry<PathGeometry, const PathContext&, PathDefaults&>;
+/// The process-wide path registry.
+PathRegistry& path_registry();
+
+/// Builds a path from a [path] table: `type`, the geometry keys, and the common keys `placement`, `origin`,
+/// `rotation_deg` (planar) or `rpy_deg` (spatial), `timing`, `timing_scope`.
+[[nodiscard]] std::unique_ptr<Path> make_path(const TableReader& table, const PathContext& context);
+
+}  // namespace redres

@@ -1,0 +1,204 @@
+#include "redres/path.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+namespace redres {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}
+
+PathSegment PathSegment::line(const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+  PathSegment s;
+  s.kind = Kind::kLine;
+  s.a = p;
+  s.b = q;
+  s.length = (q - p).norm();
+  return s;
+}
+
+PathSegment PathSegment::arc(const Eigen::Vector3d& centre, double radius, double start_angle, double sweep,
+                             const Eigen::Vector3d& e1, const Eigen::Vector3d& e2) {
+  PathSegment s;
+  s.kind = Kind::kArc;
+  s.a = centre;
+  s.radius = radius;
+  s.start_angle = start_angle;
+  s.sweep = sweep;
+  s.e1 = e1;
+  s.e2 = e2;
+  s.length = std::abs(radius * sweep);
+  return s;
+}
+
+void PathSegment::at(double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent) const {
+  if (kind == Kind::kLine) {
+    const Eigen::Vector3d dir = length > 0.0 ? Eigen::Vector3d((b - a) / length) : Eigen::Vector3d::Zero();
+    point = a + s * dir;
+    tangent = dir;
+    return;
+  }
+  // Arc or helix: angle advances linearly with arc length.
+  const double frac = length > 0.0 ? s / length : 0.0;
+  const double angle = start_angle + frac * sweep;
+  const double c = std::cos(angle), sn = std::sin(angle);
+  point = a + radius * (c * e1 + sn * e2) + frac * rise * axis;
+  // d point / d s = (dangle/ds) radius (-sin e1 + cos e2) + (rise / length) axis.
+  const double dangle = length > 0.0 ? sweep / length : 0.0;
+  tangent = dangle * radius * (-sn * e1 + c * e2) + (length > 0.0 ? rise / length : 0.0) * axis;
+}
+
+Eigen::Vector3d PathSegment::start() const {
+  Eigen::Vector3d p, t;
+  at(0.0, p, t);
+  return p;
+}
+
+Eigen::Vector3d PathSegment::end() const {
+  Eigen::Vector3d p, t;
+  at(length, p, t);
+  return p;
+}
+
+void timing(TimingLaw law, double u, double& sigma, double& dsigma) {
+  u = std::clamp(u, 0.0, 1.0);
+  switch (law) {
+    case TimingLaw::kCycloidal:
+      sigma = u - std::sin(2.0 * kPi * u) / (2.0 * kPi);
+      dsigma = 1.0 - std::cos(2.0 * kPi * u);
+      return;
+    case TimingLaw::kSin2: {
+      const double s = std::sin(0.5 * kPi * u);
+      sigma = s * s;
+      dsigma = 0.5 * kPi * std::sin(kPi * u);
+      return;
+    }
+    case TimingLaw::kQuintic:
+      sigma = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u);
+      dsigma = 30.0 * u * u * (1.0 - u) * (1.0 - u);
+      return;
+  }
+}
+
+Path::Path(PathGeometry geometry, int dim, double duration, TimingLaw law, TimingScope scope,
+           const Eigen::Matrix3d& rotation, const Eigen::Vector3d& origin, std::string description)
+    : dim_(dim), duration_(duration), law_(law), scope_(scope), rotation_(rotation), origin_(origin),
+      description_(std::move(description)) {
+  REDRES_REQUIRE(dim == 2 || dim == 3, "Path", "dim is 2 or 3");
+  REDRES_REQUIRE(duration > 0.0, "Path", "duration > 0");
+  for (const auto& stroke : geometry.strokes) {
+    double len = 0.0;
+    for (const auto& seg : stroke) len += seg.length;
+    if (stroke.empty() || !(len > 0.0)) continue;  // nothing to draw
+    stroke_first_.push_back(static_cast<int>(segments_.size()));
+    stroke_start_.push_back(total_);
+    stroke_length_.push_back(len);
+    for (const auto& seg : stroke) {
+      seg_start_.push_back(total_);
+      segments_.push_back(seg);
+      total_ += seg.length;
+    }
+  }
+  REDRES_REQUIRE(!segments_.empty() && total_ > 0.0, "Path", "the geometry has a positive length");
+  double t0 = 0.0;
+  for (double len : stroke_length_) {
+    stroke_t0_.push_back(t0);
+    stroke_T_.push_back(duration * len / total_);
+    t0 += duration * len / total_;
+  }
+}
+
+void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot) const {
+  REDRES_REQUIRE(r.size() == dim_ && r_dot.size() == dim_, "Path::evaluate", "r and r_dot have dim() entries");
+  t = std::clamp(t, 0.0, duration_);
+  double s = 0.0, speed = 0.0;  // arc length from the path start, and ds/dt
+  if (scope_ == TimingScope::kWhole) {
+    double sigma = 0.0, dsigma = 0.0;
+    timing(law_, t / duration_, sigma, dsigma);
+    s = total_ * sigma;
+    speed = total_ * dsigma / duration_;
+  } else {
+    // The stroke running at t (the last one whose start time is <= t).
+    const auto it = std::upper_bound(stroke_t0_.begin(), stroke_t0_.end(), t);
+    const auto k = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - stroke_t0_.begin()) - 1));
+    double sigma = 0.0, dsigma = 0.0;
+    timing(law_, (t - stroke_t0_[k]) / stroke_T_[k], sigma, dsigma);
+    s = stroke_start_[k] + stroke_length_[k] * sigma;
+    speed = stroke_length_[k] * dsigma / stroke_T_[k];
+  }
+  s = std::clamp(s, 0.0, total_);
+  const auto it = std::upper_bound(seg_start_.begin(), seg_start_.end(), s);
+  const auto j = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - seg_start_.begin()) - 1));
+  Eigen::Vector3d p, tangent;
+  segments_[j].at(std::min(s - seg_start_[j], segments_[j].length), p, tangent);
+  const Eigen::Vector3d world = origin_ + rotation_ * p;
+  const Eigen::Vector3d velocity = rotation_ * tangent * speed;
+  r = world.head(dim_);
+  r_dot = velocity.head(dim_);
+}
+
+PathRegistry& path_registry() {
+  static PathRegistry registry("path");
+  return registry;
+}
+
+std::unique_ptr<Path> make_path(const TableReader& table, const PathContext& context) {
+  PathDefaults defaults;
+  std::unique_ptr<PathGeometry> geometry = path_registry().create(table, context, defaults);
+  const std::string placement = table.choice("placement", {"relative", "absolute"}, "relative");
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  if (table.has("origin")) {
+    const std::vector<double> o = table.numbers("origin", static_cast<std::size_t>(context.dim));
+    for (int k = 0; k < context.dim; ++k) origin(k) = o[static_cast<std::size_t>(k)];
+  } else if (placement == "absolute") {
+    table.fail("origin", "expected `origin` (the path origin in base coordinates, m) with placement = \"absolute\"");
+  }
+  if (placement == "relative") origin += context.start;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  if (context.dim == 2) {
+    const double deg = table.number("rotation_deg", defaults.rotation_deg);
+    rotation = Eigen::AngleAxisd(deg * kPi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  } else if (table.has("rpy_deg")) {
+    const std::vector<double> rpy = table.numbers("rpy_deg", 3);
+    rotation = (Eigen::AngleAxisd(rpy[2] * kPi / 180.0, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(rpy[1] * kPi / 180.0, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(rpy[0] * kPi / 180.0, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  }
+  const std::string law = table.choice("timing", {"cycloidal", "sin2", "quintic"}, "cycloidal");
+  const std::string scope = table.choice("timing_scope", {"per_stroke", "whole"},
+                                         defaults.scope == TimingScope::kPerStroke ? "per_stroke" : "whole");
+  table.finish();
+  const TimingLaw tl = law == "cycloidal" ? TimingLaw::kCycloidal
+                                          : (law == "sin2" ? TimingLaw::kSin2 : TimingLaw::kQuintic);
+  const TimingScope ts = scope == "per_stroke" ? TimingScope::kPerStroke : TimingScope::kWhole;
+  if (context.dim == 2) {
+    for (auto& stroke : geometry->strokes) {
+      for (auto& seg : stroke) {
+        if (seg.kind == PathSegment::Kind::kHelix || seg.a.z() != 0.0 || seg.b.z() != 0.0) {
+          table.fail("type", "this path is spatial, but the robot's task is planar");
+        }
+      }
+    }
+  }
+  const std::string type = table.string("type");
+  std::size_t strokes = 0;
+  double length = 0.0;
+  for (const auto& stroke : geometry->strokes) {
+    strokes += stroke.empty() ? 0 : 1;
+    for (const auto& seg : stroke) length += seg.length;
+  }
+  if (!(length > 0.0)) table.fail("type", "the path has zero length");
+  std::ostringstream d;
+  d.precision(4);
+  d << type << " (" << strokes << (strokes == 1 ? " stroke, " : " strokes, ") << length << " m, " << law << " "
+    << (ts == TimingScope::kPerStroke ? "per stroke" : "over the whole path") << ")";
+  return std::make_unique<Path>(std::move(*geometry), context.dim, context.duration, tl, ts, rotation, origin,
+                                d.str());
+}
+
+}  // namespace redres

@@ -18,6 +18,9 @@ using Action = std::function<int()>;
 /// `redres robot FILE [--theta v1,v2,...] [--json]`.
 void add_robot_command(CLI::App& app, Action& action);
 
+/// `redres run`, `redres validate`, `redres compare`.
+void add_run_commands(CLI::App& app, Action& action);
+
 /// `redres plugins [--json]`.
 void add_plugins_command(CLI::App& app, Action& action);
 

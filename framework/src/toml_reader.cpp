@@ -54,8 +54,10 @@ std::shared_ptr<const TomlFile> parse_toml_string(std::string_view text, const s
 }
 
 SourceLocation location_of(const TomlFile& file, const toml::node& node) {
-  const auto& b = node.source().begin;
-  return {file.path.string(), b.line, b.column};
+  const auto& src = node.source();
+  // A value spliced in from elsewhere (e.g. a --set override) keeps the name of where it came from.
+  const std::string where = src.path && !src.path->empty() ? *src.path : file.path.string();
+  return {where, src.begin.line, src.begin.column};
 }
 
 std::string describe_type(const toml::node& node) {

@@ -1,0 +1,70 @@
+#pragma once
+/// @file
+/// The per-step API for a caller's own control loop: step(theta, t) evaluates the kinematics, the desired path,
+/// builds the QP from the scheme's plugins, solves it with the LVI engine and returns theta_dot with the solver's
+/// status. Everything is sized at construction; step() allocates nothing and takes bounded time (the engine's
+/// iteration cap).
+
+#include <algorithm>
+
+#include <Eigen/Core>
+
+#include "redres/lvi.hpp"
+#include "redres/path.hpp"
+#include "redres/scheme.hpp"
+
+namespace redres {
+
+/// One control step's outcome; refers to buffers inside the Controller (valid until the next step).
+struct StepOutput {
+  const Eigen::VectorXd& theta_dot;  //!< x = theta_dot (n), inside the merged bounds
+  const SolverInfo& info;            //!< status, iterations, residual, engine, diagnosis
+};
+
+/// Runs the scheme for one robot. The robot, scheme, engine and path must outlive the controller.
+class Controller {
+ public:
+  /// `path` may be null when the caller supplies r_d and r_d_dot itself. T is the task duration (s), tau the
+  /// step (s), both visible to plugins through the Context.
+  Controller(const RobotModel& robot, const Scheme& scheme, LviEngine& engine, const Path* path, double T,
+             double tau);
+
+  /// One step at (theta, t) with the desired values from the path (orientation rows, if the task has them,
+  /// hold the reference orientation).
+  StepOutput step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t);
+  /// One step with caller-supplied r_d and r_d_dot (size task_dim()).
+  StepOutput step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
+                  const Eigen::Ref<const Eigen::VectorXd>& r_d, const Eigen::Ref<const Eigen::VectorXd>& r_d_dot);
+
+  /// For pose tasks: the orientation (rotation vector) the path's steps hold. Default: zero.
+  void set_orientation_reference(const Eigen::Vector3d& rotation_vector) { orientation_ = rotation_vector; }
+  /// Computes at least this much kinematics each step (e.g. kManipulability to record w with any scheme).
+  void set_kinematics_level(KinematicsLevel level) { level_ = std::max(level_, level); }
+  /// Forgets the engine's warm start.
+  void reset() { engine_->reset(); }
+
+  /// Kinematics, QP, desired values and the full solver result of the last step.
+  [[nodiscard]] const KinematicsData& kinematics() const noexcept { return kin_; }
+  [[nodiscard]] const QpProblem& qp() const noexcept { return qp_; }
+  [[nodiscard]] const Eigen::VectorXd& r_d() const noexcept { return r_d_; }
+  [[nodiscard]] const Eigen::VectorXd& r_d_dot() const noexcept { return r_d_dot_; }
+  [[nodiscard]] const SolverResult& result() const noexcept { return result_; }
+  [[nodiscard]] const RobotModel& robot() const noexcept { return *robot_; }
+
+ private:
+  StepOutput solve(double t);
+
+  const RobotModel* robot_;
+  const Scheme* scheme_;
+  LviEngine* engine_;
+  const Path* path_;
+  KinematicsData kin_;
+  QpProblem qp_;
+  SolverResult result_;
+  Eigen::VectorXd r_d_, r_d_dot_;
+  Eigen::Vector3d orientation_ = Eigen::Vector3d::Zero();
+  KinematicsLevel level_ = KinematicsLevel::kPosition;
+  Context ctx_;
+};
+
+}  // namespace redres

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# The main job: installs what is missing, builds the release configuration, and runs the paper's case.
-# Until the scenario runner exists, it prints the paper's push-rod arm at theta(0).
+# The main job: installs what is missing, builds the release configuration, and reproduces the paper's
+# comparison: TVCMM (p = 2 sin(pi t / T)), constant p = 1 and MVN (p = 0) writing the letter R in T = 40 s.
+# Writes out/paper/comparison.md, the per-scheme trajectories and summaries, and the figures (Figs. 3-7, 9(b)).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/build.sh release
-./build/release/bin/redres robot robots/paper_pushrod_6dof.toml
+./build/release/bin/redres compare configs/paper_r_tvcmm.toml configs/paper_r_constant_p.toml \
+  configs/paper_r_mvn.toml --out out/paper "$@"

@@ -73,6 +73,7 @@ void render_plots(const std::string& args, bool quiet) {
     std::cerr << "warning: " << script.string() << " not found; no plots (set REDRES_TOOLS_DIR)\n";
     return;
   }
+  std::cout.flush();
   // Debian's interpreter has Debian's matplotlib and numpy; another python3 on PATH may not.
   const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   const std::string cmd = python + " \"" + script.string() + "\" " + args + (quiet ? " --quiet" : "");
@@ -160,7 +161,7 @@ void add_run_commands(CLI::App& app, Action& action) {
       const std::filesystem::path out = opts->out;
       std::filesystem::create_directories(out);
       std::string md = table_row({"scenario", "engine", "max position error (m)", "w(0)", "w(T)", "min w",
-                                  "mean w", "|theta_dot(0)|", "|theta_dot(T)|", "mean iterations", "failures",
+                                  "mean w", "norm theta_dot(0)", "norm theta_dot(T)", "mean iterations", "failures",
                                   "wall time (s)"});
       md += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       std::string csv =

@@ -1,0 +1,239 @@
+#!/usr/bin/env python3
+"""Renders the paper's figures from redres runs (trajectory.csv and summary.json), as PNG files.
+
+    plot_run.py RUN_DIR                      figures of one run, written into RUN_DIR
+    plot_run.py --compare DIR... --out OUT   Fig. 5 (w of every run) into OUT, and each run's figures
+
+Per run:
+  fig3_profiles.png         theta_dot and theta profiles (Fig. 3 for the p = 1 run; Fig. 4(c), (d) otherwise)
+  fig4_task.png             (a) arm snapshots, (b) desired path and trajectory, (c) theta_dot, (d) theta
+  fig6_joint_angles.png     each theta with its limits and its safety region
+  fig7_joint_velocities.png each theta_dot with its velocity limits and the merged bounds
+  fig9b_position_error.png  the position error over time
+Uses Debian's python3-matplotlib and python3-numpy.
+"""
+import argparse
+import json
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def load(run_dir):
+    data = np.genfromtxt(os.path.join(run_dir, "trajectory.csv"), delimiter=",", names=True)
+    with open(os.path.join(run_dir, "summary.json")) as f:
+        summary = json.load(f)
+    return data, summary
+
+
+def joints(summary):
+    return len(summary["robot"]["joint_names"])
+
+
+def profiles(ax_v, ax_q, data, n):
+    t = data["t"]
+    for j in range(1, n + 1):
+        ax_v.plot(t, data[f"theta_dot_{j}"], label=rf"$\dot\theta_{j}$")
+        ax_q.plot(t, data[f"theta_{j}"], label=rf"$\theta_{j}$")
+    ax_v.set_xlabel("t (s)")
+    ax_v.set_ylabel("rad/s")
+    ax_q.set_xlabel("t (s)")
+    ax_q.set_ylabel("rad")
+    ax_v.legend(fontsize=7, ncol=2)
+    ax_q.legend(fontsize=7, ncol=2)
+    ax_v.grid(alpha=0.3)
+    ax_q.grid(alpha=0.3)
+
+
+def planar_chain(summary, theta):
+    """Joint positions of a planar chain with relative joint angles."""
+    lengths = summary["robot"]["link_lengths"]
+    pts = [(0.0, 0.0)]
+    angle = 0.0
+    x = y = 0.0
+    for q, length in zip(theta, lengths):
+        angle += q
+        x += length * np.cos(angle)
+        y += length * np.sin(angle)
+        pts.append((x, y))
+    return np.array(pts)
+
+
+def fig_task(run_dir, data, summary, n, name):
+    planar = summary["robot"]["kind"] == "planar"
+    fig = plt.figure(figsize=(12, 9))
+    t = data["t"]
+    if planar:
+        ax_a = fig.add_subplot(2, 2, 1)
+        for k in np.linspace(0, len(t) - 1, 25).astype(int):
+            pts = planar_chain(summary, [data[f"theta_{j}"][k] for j in range(1, n + 1)])
+            ax_a.plot(pts[:, 0], pts[:, 1], "-o", color="0.6", lw=0.8, ms=2)
+        ax_a.plot(data["r_x"], data["r_y"], "r", lw=1.2)
+        ax_a.set_aspect("equal")
+        ax_a.set_title("(a) motion trajectories")
+        ax_a.set_xlabel("x (m)")
+        ax_a.set_ylabel("y (m)")
+        ax_b = fig.add_subplot(2, 2, 2)
+        ax_b.plot(data["rd_x"], data["rd_y"], "b-", lw=3, alpha=0.4, label="desired path")
+        ax_b.plot(data["r_x"], data["r_y"], "r--", lw=1, label="end-effector trajectory")
+        ax_b.set_aspect("equal")
+        ax_b.set_xlabel("x (m)")
+        ax_b.set_ylabel("y (m)")
+    else:
+        ax_a = fig.add_subplot(2, 2, 1, projection="3d")
+        ax_a.plot(data["rd_x"], data["rd_y"], data["rd_z"], "b-", lw=3, alpha=0.4, label="desired path")
+        ax_a.plot(data["r_x"], data["r_y"], data["r_z"], "r--", lw=1, label="end-effector trajectory")
+        ax_a.set_title("(a) path in space")
+        ax_b = fig.add_subplot(2, 2, 2)
+        ax_b.plot(t, data["rd_x"] - data["rd_x"][0], label="x")
+        ax_b.plot(t, data["rd_y"] - data["rd_y"][0], label="y")
+        ax_b.plot(t, data["rd_z"] - data["rd_z"][0], label="z")
+        ax_b.set_xlabel("t (s)")
+        ax_b.set_ylabel("desired displacement (m)")
+    ax_b.set_title("(b) end-effector path and trajectory")
+    ax_b.legend(fontsize=8)
+    profiles(fig.add_subplot(2, 2, 3), fig.add_subplot(2, 2, 4), data, n)
+    fig.axes[-2].set_title(r"(c) $\dot\theta$ profiles")
+    fig.axes[-1].set_title(r"(d) $\theta$ profiles")
+    fig.suptitle(f"{name}: end-effector task")
+    fig.tight_layout()
+    fig.savefig(os.path.join(run_dir, "fig4_task.png"), dpi=110)
+    plt.close(fig)
+
+
+def grid(n):
+    cols = 3 if n > 4 else 2
+    rows = (n + cols - 1) // cols
+    return rows, cols
+
+
+def fig_angles(run_dir, data, summary, n, name):
+    rows, cols = grid(n)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3 * rows), squeeze=False)
+    lo, hi = summary["robot"]["lower_limits"], summary["robot"]["upper_limits"]
+    margin = summary["robot"]["safety_margin"]
+    t = data["t"]
+    for j in range(n):
+        ax = axes[j // cols][j % cols]
+        ax.plot(t, data[f"theta_{j + 1}"], "b", label=rf"$\theta_{j + 1}$")
+        ax.axhline(hi[j], color="r", lw=1, label=r"$\theta^\pm$")
+        ax.axhline(lo[j], color="r", lw=1)
+        if margin[j] > 0:
+            ax.axhspan(hi[j] - margin[j], hi[j], color="r", alpha=0.15, label="safety region")
+            ax.axhspan(lo[j], lo[j] + margin[j], color="r", alpha=0.15)
+        ax.set_title(f"({chr(97 + j)}) " + rf"$\theta_{j + 1}$ and limits", fontsize=9)
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel("rad")
+        ax.legend(fontsize=6)
+    for k in range(n, rows * cols):
+        axes[k // cols][k % cols].axis("off")
+    fig.suptitle(f"{name}: joint angles, limits and safety regions")
+    fig.tight_layout()
+    fig.savefig(os.path.join(run_dir, "fig6_joint_angles.png"), dpi=110)
+    plt.close(fig)
+
+
+def fig_velocities(run_dir, data, n, name):
+    rows, cols = grid(n)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3 * rows), squeeze=False)
+    t = data["t"]
+    for j in range(1, n + 1):
+        ax = axes[(j - 1) // cols][(j - 1) % cols]
+        ax.plot(t, data[f"theta_dot_{j}"], "b", label=rf"$\dot\theta_{j}$")
+        ax.plot(t, data[f"vel_hi_{j}"], "r", lw=1, label="velocity limits")
+        ax.plot(t, data[f"vel_lo_{j}"], "r", lw=1)
+        ax.plot(t, data[f"hi_{j}"], "g--", lw=1, label=r"bounds $\zeta^\pm$")
+        ax.plot(t, data[f"lo_{j}"], "g--", lw=1)
+        span = max(np.abs(data[f"vel_hi_{j}"]).max(), np.abs(data[f"vel_lo_{j}"]).max())
+        ax.set_ylim(-1.1 * span, 1.1 * span)
+        ax.set_title(f"({chr(96 + j)}) " + rf"$\dot\theta_{j}$, limits and bounds", fontsize=9)
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel("rad/s")
+        ax.legend(fontsize=6)
+    for k in range(n, rows * cols):
+        axes[k // cols][k % cols].axis("off")
+    fig.suptitle(f"{name}: joint velocities, velocity limits and merged bounds")
+    fig.tight_layout()
+    fig.savefig(os.path.join(run_dir, "fig7_joint_velocities.png"), dpi=110)
+    plt.close(fig)
+
+
+def fig_error(run_dir, data, name):
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    ax.plot(data["t"], data["position_error"], "b")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel(r"$\|r_d - f(\theta)\|$ (m)")
+    ax.set_title(f"{name}: position error (max {data['position_error'].max():.3g} m)")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(run_dir, "fig9b_position_error.png"), dpi=110)
+    plt.close(fig)
+
+
+def fig_profiles(run_dir, data, n, name):
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4))
+    profiles(a, b, data, n)
+    a.set_title(r"(a) $\dot\theta$ profiles")
+    b.set_title(r"(b) $\theta$ profiles")
+    fig.suptitle(f"{name}: joint-velocity and joint-angle profiles")
+    fig.tight_layout()
+    fig.savefig(os.path.join(run_dir, "fig3_profiles.png"), dpi=110)
+    plt.close(fig)
+
+
+def plot_run(run_dir, quiet):
+    data, summary = load(run_dir)
+    n = joints(summary)
+    name = summary.get("name", os.path.basename(os.path.normpath(run_dir)))
+    fig_profiles(run_dir, data, n, name)
+    fig_task(run_dir, data, summary, n, name)
+    fig_angles(run_dir, data, summary, n, name)
+    fig_velocities(run_dir, data, n, name)
+    fig_error(run_dir, data, name)
+    if not quiet:
+        print(f"figures written to {run_dir}")
+
+
+def plot_compare(dirs, out, quiet):
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for d in dirs:
+        data, summary = load(d)
+        ax.plot(data["t"], data["manipulability"], label=summary.get("name", d))
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel(r"$w = \det(JJ^T)$")
+    ax.set_title("Manipulability of the compared schemes")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    os.makedirs(out, exist_ok=True)
+    fig.savefig(os.path.join(out, "fig5_manipulability.png"), dpi=110)
+    plt.close(fig)
+    if not quiet:
+        print(f"comparison figure written to {out}")
+    for d in dirs:
+        plot_run(d, quiet)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("run_dir", nargs="?", help="a run directory (trajectory.csv, summary.json)")
+    p.add_argument("--compare", nargs="+", metavar="DIR", help="run directories to compare")
+    p.add_argument("--out", help="output directory for the comparison figure")
+    p.add_argument("--quiet", action="store_true")
+    a = p.parse_args()
+    if a.compare:
+        plot_compare(a.compare, a.out or os.path.dirname(os.path.normpath(a.compare[0])), a.quiet)
+    elif a.run_dir:
+        plot_run(a.run_dir, a.quiet)
+    else:
+        p.error("give RUN_DIR or --compare DIR...")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

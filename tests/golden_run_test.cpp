@@ -1,0 +1,79 @@
+// Golden runs: every configs/*.toml is run, and its summary figures must stay within stated tolerances of the
+// figures recorded in tests/golden/<name>.json. To record new goldens after an intended change:
+//   REDRES_UPDATE_GOLDEN=1 build/release/bin/redres_tests --gtest_filter='Golden*'
+// and review the diff.
+//
+// Tolerances: final theta 1e-6 rad; manipulability (initial, final, mean, min, max) 1e-6 relative; joint-velocity
+// norms 1e-6 rad/s absolute; position errors 10 % relative + 1e-8 m (they sit near the solver's tolerance); the
+// number of failed steps exactly.
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "redres/scenario.hpp"
+#include "test_util.hpp"
+
+namespace redres {
+namespace {
+
+std::vector<std::string> configs() {
+  std::vector<std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(source_path("configs"))) {
+    if (e.path().extension() == ".toml") out.push_back(e.path().stem().string());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+class Golden : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Golden, SummaryStaysWithinTolerances) {
+  const std::string name = GetParam();
+  Scenario s = load_scenario(source_path("configs/" + name + ".toml"));
+  const RunResult run = simulate(s);
+  const nlohmann::json got = nlohmann::json::parse(summary_json(s, run));
+  const std::filesystem::path file = source_path("tests/golden/" + name + ".json");
+  if (std::getenv("REDRES_UPDATE_GOLDEN") != nullptr) {
+    std::filesystem::create_directories(file.parent_path());
+    nlohmann::json keep = got;
+    keep.erase("wall_time_s");
+    keep.erase("source");
+    std::ofstream(file) << keep.dump(2) << "\n";
+    GTEST_SKIP() << "recorded " << file;
+  }
+  std::ifstream in(file);
+  ASSERT_TRUE(in) << "no golden file " << file << "; record it with REDRES_UPDATE_GOLDEN=1";
+  const nlohmann::json want = nlohmann::json::parse(in);
+
+  EXPECT_EQ(got["steps"], want["steps"]);
+  EXPECT_EQ(got["solver"]["failures"], want["solver"]["failures"]);
+  EXPECT_EQ(got["solver"]["engine"], want["solver"]["engine"]);
+  for (const char* k : {"initial", "final", "mean", "min", "max"}) {
+    const double w = want["manipulability"][k];
+    EXPECT_NEAR(got["manipulability"][k].get<double>(), w, 1e-6 * std::abs(w)) << "manipulability." << k;
+  }
+  for (const char* k : {"initial_joint_velocity_norm", "final_joint_velocity_norm"}) {
+    EXPECT_NEAR(got[k].get<double>(), want[k].get<double>(), 1e-6) << k;
+  }
+  for (const char* k : {"max_position_error", "final_position_error"}) {
+    const double w = want[k];
+    EXPECT_NEAR(got[k].get<double>(), w, 0.1 * w + 1e-8) << k;
+  }
+  EXPECT_LE(got["max_joint_angle_violation"].get<double>(), 0.0);
+  EXPECT_LE(got["max_joint_velocity_violation"].get<double>(), 0.0);
+  ASSERT_EQ(got["final_theta"].size(), want["final_theta"].size());
+  for (std::size_t j = 0; j < want["final_theta"].size(); ++j) {
+    EXPECT_NEAR(got["final_theta"][j].get<double>(), want["final_theta"][j].get<double>(), 1e-6) << "joint " << j + 1;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Configs, Golden, ::testing::ValuesIn(configs()),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+}  // namespace
+}  // namespace redres

@@ -30,7 +30,12 @@ void apply_override(toml::table& root, const std::string& text) {
   try {
     holder = toml::parse("v = " + value, "--set " + key);
   } catch (const toml::parse_error&) {
-    holder.insert("v", value);
+    std::string quoted = "\"";
+    for (char ch : value) {
+      if (ch == '"' || ch == '\\') quoted += '\\';
+      quoted += ch;
+    }
+    holder = toml::parse("v = " + quoted + "\"", "--set " + key);
   }
   toml::node& v = *holder.get("v");
   std::vector<std::string> parts;
@@ -117,7 +122,7 @@ Eigen::VectorXd read_theta0(const TableReader& r, const RobotModel& robot) {
 int Scenario::steps() const { return static_cast<int>(std::lround(duration / tau)); }
 
 Scenario load_scenario(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
-  auto parsed = std::make_shared<TomlFile>(*parse_toml_file(file));
+  const std::shared_ptr<TomlFile> parsed = parse_toml_file(file);
   for (const auto& o : overrides) apply_override(parsed->root, o);
   const std::shared_ptr<const TomlFile> doc = parsed;
   const TableReader r = TableReader::root(doc, "scenario");

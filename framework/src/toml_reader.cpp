@@ -26,7 +26,7 @@ std::string quoted_list(const std::vector<std::string>& names) {
   return out;
 }
 
-std::shared_ptr<const TomlFile> parse(std::string_view text, const std::filesystem::path& path) {
+std::shared_ptr<TomlFile> parse(std::string_view text, const std::filesystem::path& path) {
   auto file = std::make_shared<TomlFile>();
   file->path = path;
   try {
@@ -41,7 +41,7 @@ std::shared_ptr<const TomlFile> parse(std::string_view text, const std::filesyst
 
 }  // namespace
 
-std::shared_ptr<const TomlFile> parse_toml_file(const std::filesystem::path& path) {
+std::shared_ptr<TomlFile> parse_toml_file(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError({path.string(), 0, 0}, "cannot open file (does it exist and is it readable?)");
   std::stringstream buffer;
@@ -49,7 +49,7 @@ std::shared_ptr<const TomlFile> parse_toml_file(const std::filesystem::path& pat
   return parse(buffer.str(), path);
 }
 
-std::shared_ptr<const TomlFile> parse_toml_string(std::string_view text, const std::string& name) {
+std::shared_ptr<TomlFile> parse_toml_string(std::string_view text, const std::string& name) {
   return parse(text, name);
 }
 

@@ -26,11 +26,12 @@ struct TomlFile {
   toml::table root;            //!< the parsed document
 };
 
-/// Parses a TOML file; a syntax error or an unreadable file is a ConfigError at the offending position.
-[[nodiscard]] std::shared_ptr<const TomlFile> parse_toml_file(const std::filesystem::path& path);
+/// Parses a TOML file; a syntax error or an unreadable file is a ConfigError at the offending position. (Edit the
+/// tree in place if needed: copying toml++ nodes drops their source positions.)
+[[nodiscard]] std::shared_ptr<TomlFile> parse_toml_file(const std::filesystem::path& path);
 
 /// Parses TOML text; `name` stands in for the file name in messages.
-[[nodiscard]] std::shared_ptr<const TomlFile> parse_toml_string(std::string_view text, const std::string& name);
+[[nodiscard]] std::shared_ptr<TomlFile> parse_toml_string(std::string_view text, const std::string& name);
 
 /// "file:line:col" of a node in `file`.
 [[nodiscard]] SourceLocation location_of(const TomlFile& file, const toml::node& node);

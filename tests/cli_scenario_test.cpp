@@ -1,0 +1,155 @@
+// The scenario commands of the CLI: run, validate, compare, --set, exit codes, and the output formats of
+// DESIGN section 6.
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_util.hpp"
+
+namespace redres {
+namespace {
+
+struct Cli {
+  int code = -1;
+  std::string out;
+};
+
+// Runs the CLI from the source tree with stderr merged into the captured output.
+Cli redres(const std::string& args) {
+  const std::string cmd = "cd '" + std::string(REDRES_SOURCE_DIR) + "' && '" + REDRES_CLI + "' " + args + " 2>&1";
+  Cli r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, p) != nullptr) r.out += buf;
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::filesystem::path scratch(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("redres_cli_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+std::string first_line(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+TEST(CliScenario, RunWritesTheTrajectoryAndSummaryOfDesignSection6) {
+  const auto dir = scratch("run");
+  const Cli r = redres("run configs/paper_r_mvn.toml --out '" + dir.string() + "' --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::string expected = "t";
+  for (const char* prefix : {"theta_", "theta_dot_", "lo_", "hi_"}) {
+    for (int j = 1; j <= 6; ++j) expected += "," + std::string(prefix) + std::to_string(j);
+  }
+  expected += ",rd_x,rd_y,r_x,r_y,position_error,manipulability,solver_iterations,solver_residual";
+  EXPECT_EQ(first_line(dir / "trajectory.csv").rfind(expected, 0), 0u) << first_line(dir / "trajectory.csv");
+  std::ifstream js(dir / "summary.json");
+  const nlohmann::json s = nlohmann::json::parse(js);
+  for (const char* k : {"steps", "tau", "duration", "max_position_error", "final_position_error",
+                        "initial_joint_velocity_norm", "final_joint_velocity_norm", "manipulability",
+                        "max_joint_angle_violation", "max_joint_velocity_violation", "final_theta", "solver",
+                        "wall_time_s"}) {
+    EXPECT_TRUE(s.contains(k)) << k;
+  }
+  for (const char* k : {"initial", "final", "min", "mean", "max"}) EXPECT_TRUE(s["manipulability"].contains(k)) << k;
+  for (const char* k : {"engine", "mean_iterations", "max_iterations", "max_residual", "failures"}) {
+    EXPECT_TRUE(s["solver"].contains(k)) << k;
+  }
+  EXPECT_EQ(s["steps"], 4000);
+  EXPECT_EQ(s["final_theta"].size(), 6u);
+  // One line per step, t = 0 .. T.
+  std::ifstream csv(dir / "trajectory.csv");
+  std::size_t lines = 0;
+  for (std::string l; std::getline(csv, l);) ++lines;
+  EXPECT_EQ(lines, 4002u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliScenario, SetOverridesValuesAndValidateChecksWithoutRunning) {
+  const Cli ok = redres("validate configs/paper_r_tvcmm.toml --set solver.engine=newton --set objectives.1.p=1.5");
+  ASSERT_EQ(ok.code, 0) << ok.out;
+  EXPECT_NE(ok.out.find("engine newton"), std::string::npos) << ok.out;
+  const Cli bad_engine = redres("validate configs/paper_r_tvcmm.toml --set solver.engine=simplex");
+  EXPECT_EQ(bad_engine.code, 2);
+  EXPECT_NE(bad_engine.out.find("--set solver.engine:1:"), std::string::npos) << bad_engine.out;
+  EXPECT_NE(bad_engine.out.find("expected one of 'newton', 'nlopt', 'projection'"), std::string::npos)
+      << bad_engine.out;
+  const Cli bad_index = redres("validate configs/paper_r_tvcmm.toml --set objectives.7.p=1");
+  EXPECT_EQ(bad_index.code, 2);
+  EXPECT_NE(bad_index.out.find("out of range"), std::string::npos) << bad_index.out;
+}
+
+TEST(CliScenario, BadScenarioFilesReportFileLineColumn) {
+  const auto dir = scratch("bad");
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return (dir / name).string();
+  };
+  const std::string robot = source_path("robots/paper_pushrod_6dof.toml").string();
+  const std::string base = "robot = \"" + robot + "\"\nduration = 4.0\nstep = 0.01\n[path]\ntype = \"letter_r\"\n"
+                           "[[objectives]]\ntype = \"min_velocity_norm\"\n";
+  const std::string typo = write("typo.toml", base + "[[constraints]]\ntype = \"task_tracking\"\ngian = 8.0\n");
+  Cli r = redres("validate '" + typo + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.out.rfind(typo + ":10:1: unknown key 'gian'", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("gain"), std::string::npos) << r.out;  // the known keys are listed
+  const std::string step = write("step.toml", "robot = \"" + robot + "\"\nduration = 4.0\nstep = 0.03\n");
+  r = redres("validate '" + step + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.out.rfind(step + ":3:8:", 0), 0u) << r.out;
+  const std::string theta = write("theta.toml", "theta0 = [0, 0, 0, 0, 0, 0]\n" + base);
+  r = redres("validate '" + theta + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("joint 'joint2' = 0 is outside its limits"), std::string::npos) << r.out;
+  r = redres("run '" + (dir / "missing.toml").string() + "' --out '" + (dir / "o").string() + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("cannot open file"), std::string::npos) << r.out;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliScenario, FailedStepsGiveExitCodeOne) {
+  const auto dir = scratch("fail");
+  // The R in 0.5 s asks for more than the push-rod joints can give.
+  const Cli r = redres("run configs/paper_r_tvcmm.toml --out '" + dir.string() +
+                       "' --quiet --set duration=0.5 --set step=0.01");
+  EXPECT_EQ(r.code, 1) << r.out;
+  std::ifstream js(dir / "summary.json");
+  const nlohmann::json s = nlohmann::json::parse(js);
+  EXPECT_GT(s["solver"]["failures"].get<int>(), 0);
+  EXPECT_NE(s["solver"]["first_failure"].get<std::string>().find("infeasible"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliScenario, CompareWritesATableForEveryScenario) {
+  const auto dir = scratch("compare");
+  const Cli r = redres("compare configs/paper_r_mvn.toml configs/planar_4link_circle.toml --out '" + dir.string() +
+                       "' --quiet --no-plots");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream md(dir / "comparison.md");
+  std::stringstream text;
+  text << md.rdbuf();
+  EXPECT_NE(text.str().find("| paper_r_mvn |"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("| planar_4link_circle |"), std::string::npos) << text.str();
+  EXPECT_TRUE(std::filesystem::exists(dir / "comparison.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "paper_r_mvn" / "trajectory.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "planar_4link_circle" / "summary.json"));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace redres

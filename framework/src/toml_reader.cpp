@@ -226,10 +226,10 @@ std::optional<TableReader> TableReader::optional_table(std::string_view key) con
 std::vector<TableReader> TableReader::tables(std::string_view key) const {
   const toml::node& n = need(key);
   const auto* arr = n.as_array();
+  if (arr != nullptr && arr->empty()) fail(key, "expected at least one [[" + std::string(key) + "]] entry, got none");
   if (arr == nullptr || !arr->is_array_of_tables()) {
     fail(key, "expected an array of tables ([[" + std::string(key) + "]]), got " + describe_type(n));
   }
-  if (arr->empty()) fail(key, "expected at least one [[" + std::string(key) + "]] entry, got none");
   std::vector<TableReader> out;
   std::size_t i = 0;
   for (const auto& el : *arr) {

@@ -2,6 +2,7 @@
 /// TOML keys: `lower` (rad/s or m/s, < 0, required), `upper` (> 0, required).
 
 #include <sstream>
+#include <string>
 
 #include "redres/velocity_limit.hpp"
 
@@ -32,8 +33,8 @@ const bool kRegistered = velocity_limit_registry().add({
     [](const TableReader& r) -> std::unique_ptr<VelocityLimitLaw> {
       const double lower = r.number("lower");
       const double upper = r.number("upper");
-      if (!(lower < 0.0)) r.fail("lower", "expected a lower velocity limit < 0");
-      if (!(upper > 0.0)) r.fail("upper", "expected an upper velocity limit > 0");
+      if (!(lower < 0.0)) r.fail("lower", "expected a lower velocity limit < 0, got " + std::to_string(lower));
+      if (!(upper > 0.0)) r.fail("upper", "expected an upper velocity limit > 0, got " + std::to_string(upper));
       return std::make_unique<ConstantLaw>(lower, upper);
     },
 });

@@ -1,0 +1,131 @@
+// A corpus of bad robot files (tests/data/robot_corpus): each must be rejected with a ConfigError that points at
+// the right file, line and column and says what was expected. Also: every robot in robots/ loads, and laws given
+// as formulas and CSV tables load and evaluate as written.
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "redres/kinematics.hpp"
+#include "test_util.hpp"
+
+namespace redres {
+namespace {
+
+struct Bad {
+  const char* file;
+  const char* where;  // "line:col" expected after the file name ("" for a file-level error)
+  std::vector<const char*> says;
+};
+
+const std::vector<Bad>& corpus() {
+  static const std::vector<Bad> c = {
+      {"unknown_top_key.toml", "3:1", {"unknown key 'colour'", "known keys: end_effector, home, joints, kind"}},
+      {"unknown_joint_key.toml", "6:1", {"unknown key 'mass' in joint 'j1'", "length, limits, name"}},
+      {"unknown_law_key.toml", "14:1", {"unknown key 'sigma'", "known keys: a, b, s, sigma_max, sigma_min, type"}},
+      {"wrong_type_number.toml", "5:10", {"key 'length': expected a number, got a string"}},
+      {"wrong_type_string.toml", "1:8", {"key 'name': expected a string, got an integer"}},
+      {"missing_name.toml", "1:1", {"missing required key 'name'"}},
+      {"missing_kind.toml", "1:1", {"missing required key 'kind'"}},
+      {"missing_joints.toml", "1:1", {"missing required key 'joints'"}},
+      {"missing_length.toml", "3:1", {"joint 'j1'", "missing required key 'length'"}},
+      {"missing_limits.toml", "3:1", {"joint 'j1'", "missing required key 'limits'"}},
+      {"missing_velocity_limit.toml", "3:1", {"missing required key 'velocity_limit'"}},
+      {"missing_law_parameter.toml", "7:1", {"joint 'j1' velocity_limit", "missing required key 'b'"}},
+      {"limits_reversed.toml", "6:10", {"key 'limits'", "lower < upper", "got lower 1 >= upper -1"}},
+      {"limits_equal.toml", "6:10", {"key 'limits'", "got lower 0.5 >= upper 0.5"}},
+      {"zero_length.toml", "5:10", {"key 'length'", "link length > 0 m, got 0"}},
+      {"negative_length.toml", "5:10", {"key 'length'", "got -0.2"}},
+      {"nan_value.toml", "5:10", {"key 'length': expected a finite number, got nan"}},
+      {"inf_limit.toml", "6:11", {"key 'limits': expected a finite number, got -inf"}},
+      {"empty_chain.toml", "3:10", {"expected at least one [[joints]] entry, got none"}},
+      {"unknown_kind.toml", "2:8", {"expected one of 'planar', 'spatial', got 'cylindrical'"}},
+      {"unknown_joint_type.toml", "6:8", {"expected one of 'revolute', 'prismatic', got 'spherical'"}},
+      {"prismatic_in_planar.toml", "5:8", {"expected one of 'revolute', got 'prismatic'"}},
+      {"unknown_law.toml", "7:27", {"unknown velocity-limit law type 'sinusoidal'", "constant, expression, push_rod, table"}},
+      {"constant_lower_positive.toml", "7:47", {"key 'lower': expected a lower velocity limit < 0"}},
+      {"push_rod_reaches_cos_zero.toml", "7:1",
+       {"joint 'j2'", "'push_rod' is invalid at theta = 1.570796327 rad", "cos(theta) = 0"}},
+      {"expression_syntax.toml", "9:9", {"key 'lower'", "is not a valid formula"}},
+      {"expression_sign.toml", "7:1", {"joint 'j1'", "invalid at theta = 0.5 rad", "expected lower < 0 < upper"}},
+      {"table_not_covering.toml", "7:1", {"invalid at theta = -1 rad", "outside the table"}},
+      {"table_not_increasing.toml", "9:9", {"expected strictly increasing theta"}},
+      {"duplicate_joint.toml", "9:8", {"duplicate joint name 'j1'"}},
+      {"home_wrong_length.toml", "3:8", {"key 'home': expected an array of 2 numbers, got 3"}},
+      {"home_outside.toml", "3:8", {"joint 'j2' within its limits [-1, 1], got 1.5"}},
+      {"syntax_error.toml", "3:17", {"TOML syntax error"}},
+      {"spatial_without_convention.toml", "1:1", {"missing required key 'convention'"}},
+      {"end_effector_wrong_size.toml", "4:12", {"key 'position': expected an array of 2 numbers, got 3"}},
+  };
+  return c;
+}
+
+TEST(RobotCorpus, EveryBadFileIsRejectedAtItsLineWithWhatWasExpected) {
+  for (const Bad& b : corpus()) {
+    SCOPED_TRACE(b.file);
+    const std::string path = data_path(std::string("robot_corpus/") + b.file).string();
+    try {
+      (void)load_robot(path);
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(path + ":" + b.where + ": ", 0), 0u) << what;
+      for (const char* s : b.says) EXPECT_NE(what.find(s), std::string::npos) << "missing '" << s << "' in: " << what;
+    }
+  }
+}
+
+// A CSV table's own errors point into the CSV file, not the robot file.
+TEST(RobotCorpus, CsvTableErrorsPointIntoTheCsvFile) {
+  const std::string csv = data_path("robot_corpus/bad_table.csv").string();
+  try {
+    (void)load_robot(data_path("robot_corpus/table_bad_csv.toml"));
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(csv + ":3:10: column 'upper': expected a finite number, got 'oops'", 0), 0u)
+        << e.what();
+  }
+}
+
+TEST(RobotFiles, EveryShippedRobotLoads) {
+  int count = 0;
+  for (const auto& e : std::filesystem::directory_iterator(source_path("robots"))) {
+    if (e.path().extension() != ".toml") continue;
+    SCOPED_TRACE(e.path().string());
+    const RobotModel model = load_robot(e.path());
+    EXPECT_GE(model.dof(), 3);
+    KinematicsData k(model);
+    compute_kinematics(model, model.home(), k, KinematicsLevel::kAll);
+    EXPECT_GT(k.w, 0.0);  // the home configurations are not singular
+    ++count;
+  }
+  EXPECT_GE(count, 5);
+}
+
+// The Panda's published "ready" pose puts the flange at about (0.307, 0, 0.590) m.
+TEST(RobotFiles, PandaFlangeAtTheReadyPose) {
+  const RobotModel panda = load_robot(source_path("robots/franka_panda.toml"));
+  KinematicsData k(panda);
+  compute_kinematics(panda, panda.home(), k, KinematicsLevel::kPosition);
+  EXPECT_NEAR(k.f(0), 0.3069, 1e-3);
+  EXPECT_NEAR(k.f(1), 0.0, 1e-9);
+  EXPECT_NEAR(k.f(2), 0.5903, 1e-3);
+}
+
+TEST(RobotFiles, FormulaAndTableLawsEvaluateAsWritten) {
+  const RobotModel model = load_robot(data_path("robot_corpus/good_laws.toml"));
+  Eigen::VectorXd lo(2), hi(2);
+  for (double th : {-1.0, -0.3, 0.0, 0.4, 1.0}) {
+    model.velocity_limits(Eigen::Vector2d(th, th), lo, hi);
+    EXPECT_NEAR(lo(0), -1.0 - 0.5 * th * th, 1e-14);
+    EXPECT_NEAR(hi(0), 1.5 + 0.5 * std::cos(th), 1e-14);
+    // good_table.csv: theta -1, 0, 1 -> lower -0.5, -1.0, -0.5 and upper 0.5, 2.0, 1.0, linear in between.
+    const double lo_tab = th <= 0 ? -0.5 + (th + 1.0) * (-0.5) : -1.0 + th * 0.5;
+    const double hi_tab = th <= 0 ? 0.5 + (th + 1.0) * 1.5 : 2.0 - th;
+    EXPECT_NEAR(lo(1), lo_tab, 1e-14) << th;
+    EXPECT_NEAR(hi(1), hi_tab, 1e-14) << th;
+  }
+}
+
+}  // namespace
+}  // namespace redres

@@ -70,6 +70,27 @@ struct State {
   }
 };
 
+// Builds the plugin from its defaults, checks its name and that its configuration survives a round trip and
+// writes only documented keys.
+template <class Entry, class Make>
+auto build_and_round_trip(const Entry& entry, const RobotModel& robot, Make make) {
+  const auto file = parse_toml_string(to_text(defaults(entry.type)), "<defaults>");
+  auto p = make(TableReader::root(file), robot);
+  EXPECT_EQ(p->type(), entry.type);
+  EXPECT_EQ(p->name(), entry.type);
+  const toml::table config = p->config();
+  const auto again = round_trip(config, robot, make);
+  EXPECT_EQ(to_text(again->config()), to_text(config));
+  for (const auto& [k, v] : config) {
+    const std::string key(k.str());
+    if (key == "type" || key == "name" || key == "weight" || key == "active") continue;
+    bool documented = false;
+    for (const auto& spec : entry.keys) documented = documented || spec.name == key;
+    EXPECT_TRUE(documented) << "key '" << key << "' is written but not listed";
+  }
+  return p;
+}
+
 TEST(PluginConformance, EveryObjective) {
   ASSERT_GE(objective_registry().entries().size(), 3u);
   std::mt19937 rng(5);
@@ -77,23 +98,7 @@ TEST(PluginConformance, EveryObjective) {
   for (const auto& robot : robots()) {
     for (const auto* entry : objective_registry().entries()) {
       SCOPED_TRACE(entry->type + " on " + robot->name());
-      const auto file = parse_toml_string(to_text(defaults(entry->type)), "<defaults>");
-      std::unique_ptr<Objective> p;
-      ASSERT_NO_THROW(p = make_objective(TableReader::root(file), *robot));
-      EXPECT_EQ(p->type(), entry->type);
-      EXPECT_EQ(p->name(), entry->type);
-      // Round trip: config -> TOML text -> plugin -> config is the same table.
-      const toml::table config = p->config();
-      const auto again = round_trip(config, *robot, make_objective);
-      EXPECT_EQ(to_text(again->config()), to_text(config));
-      // Every key the plugin writes is one it documents.
-      for (const auto& [k, v] : config) {
-        const std::string key(k.str());
-        if (key == "type" || key == "name" || key == "weight" || key == "active") continue;
-        bool documented = false;
-        for (const auto& spec : entry->keys) documented = documented || spec.name == key;
-        EXPECT_TRUE(documented) << "key '" << key << "' is written but not listed";
-      }
+      const std::unique_ptr<Objective> p = build_and_round_trip(*entry, *robot, make_objective);
       // Contributions on random states.
       QpProblem qp;
       qp.resize(robot->dof(), 0, 0);
@@ -139,20 +144,7 @@ TEST(PluginConformance, EveryConstraint) {
   for (const auto& robot : robots()) {
     for (const auto* entry : constraint_registry().entries()) {
       SCOPED_TRACE(entry->type + " on " + robot->name());
-      const auto file = parse_toml_string(to_text(defaults(entry->type)), "<defaults>");
-      std::unique_ptr<Constraint> p;
-      ASSERT_NO_THROW(p = make_constraint(TableReader::root(file), *robot));
-      EXPECT_EQ(p->type(), entry->type);
-      const toml::table config = p->config();
-      const auto again = round_trip(config, *robot, make_constraint);
-      EXPECT_EQ(to_text(again->config()), to_text(config));
-      for (const auto& [k, v] : config) {
-        const std::string key(k.str());
-        if (key == "type" || key == "name" || key == "weight" || key == "active") continue;
-        bool documented = false;
-        for (const auto& spec : entry->keys) documented = documented || spec.name == key;
-        EXPECT_TRUE(documented) << "key '" << key << "' is written but not listed";
-      }
+      const std::unique_ptr<Constraint> p = build_and_round_trip(*entry, *robot, make_constraint);
       const int me = p->equality_rows(*robot), mi = p->inequality_rows(*robot);
       ASSERT_GE(me, 0);
       ASSERT_GE(mi, 0);

@@ -64,6 +64,16 @@ Eigen::Vector3d PathSegment::end() const {
   return p;
 }
 
+PathGeometry strokes_from(std::vector<PathSegment> segments, bool stroke_each) {
+  PathGeometry g;
+  if (stroke_each) {
+    for (auto& seg : segments) g.strokes.push_back({seg});
+  } else {
+    g.strokes.push_back(std::move(segments));
+  }
+  return g;
+}
+
 void timing(TimingLaw law, double u, double& sigma, double& dsigma) {
   u = std::clamp(u, 0.0, 1.0);
   switch (law) {

@@ -25,7 +25,6 @@ const bool kRegistered = path_registry().add({
       (void)r.has("segments");
       const toml::array* arr = node != nullptr ? node->as_array() : nullptr;
       if (arr == nullptr || arr->empty()) r.fail("segments", "expected a non-empty array of inline tables");
-      auto g = std::make_unique<PathGeometry>();
       std::vector<PathSegment> all;
       Eigen::Vector3d p = Eigen::Vector3d::Zero();
       int k = 0;
@@ -57,12 +56,7 @@ const bool kRegistered = path_registry().add({
         }
         s.finish();
       }
-      if (stop) {
-        for (const auto& seg : all) g->strokes.push_back({seg});
-      } else {
-        g->strokes.push_back(all);
-      }
-      return g;
+      return std::make_unique<PathGeometry>(strokes_from(std::move(all), stop));
     },
 });
 

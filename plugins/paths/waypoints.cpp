@@ -21,7 +21,6 @@ const bool kRegistered = path_registry().add({
       const std::vector<double>& x = csv.column("x");
       const std::vector<double>& y = csv.column("y");
       if (x.size() < 2) r.fail("file", "expected at least 2 waypoints in " + csv.path);
-      auto g = std::make_unique<PathGeometry>();
       std::vector<PathSegment> all;
       for (std::size_t k = 1; k < x.size(); ++k) {
         const double z0 = ctx.dim == 3 ? csv.column("z")[k - 1] : 0.0;
@@ -29,12 +28,7 @@ const bool kRegistered = path_registry().add({
         const PathSegment s = PathSegment::line({x[k - 1], y[k - 1], z0}, {x[k], y[k], z1});
         if (s.length > 0.0) all.push_back(s);
       }
-      if (stop) {
-        for (const auto& seg : all) g->strokes.push_back({seg});
-      } else {
-        g->strokes.push_back(all);
-      }
-      return g;
+      return std::make_unique<PathGeometry>(strokes_from(std::move(all), stop));
     },
 });
 

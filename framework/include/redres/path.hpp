@@ -60,6 +60,10 @@ struct PathGeometry {
   std::vector<std::vector<PathSegment>> strokes;  //!< each stroke is drawn from rest to rest (per_stroke timing)
 };
 
+/// Geometry from consecutive segments: one stroke, or (`stroke_each`) one stroke per segment, each drawn from rest
+/// to rest.
+[[nodiscard]] PathGeometry strokes_from(std::vector<PathSegment> segments, bool stroke_each);
+
 /// Timing law sigma(u).
 enum class TimingLaw { kCycloidal, kSin2, kQuintic };
 /// Where the timing law applies.

@@ -103,6 +103,20 @@ INSTANTIATE_TEST_SUITE_P(
                       std::make_pair(std::string("type = \"circle\"\nnormal = [1.0, 1.0, 0.0]\n"), 3),
                       std::make_pair(std::string("type = \"helix\"\n"), 3)));
 
+TEST(Waypoints, CsvPointsAreVisitedInOrderRelativeToTheScenarioFile) {
+  const std::string csv = data_path("paths/zigzag.csv").string();
+  const auto path = make("type = \"waypoints\"\nfile = \"" + csv + "\"\nstop_at_points = true\n", 2, 3.0,
+                         Eigen::Vector3d(1.0, 2.0, 0.0));
+  const double l1 = std::hypot(0.02, 0.01), l2 = std::hypot(0.02, 0.01), l3 = std::hypot(0.02, 0.02);
+  EXPECT_NEAR(path->length(), l1 + l2 + l3, 1e-15);
+  Eigen::VectorXd r(2), v(2);
+  path->evaluate(3.0 * l1 / path->length(), r, v);  // end of the first stroke
+  EXPECT_NEAR((r - Eigen::Vector2d(1.02, 2.01)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(v.norm(), 0.0, 1e-12);
+  path->evaluate(3.0, r, v);
+  EXPECT_NEAR((r - Eigen::Vector2d(1.06, 1.98)).norm(), 0.0, 1e-12);
+}
+
 TEST(PathConfig, BadKeysAreReportedWithTheirLocation) {
   try {
     (void)make("type = \"letter_r\"\nheigth = 0.1\n");

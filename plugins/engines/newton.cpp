@@ -27,6 +27,9 @@
 namespace redres {
 namespace {
 
+// P_[lo, hi](v) for lo <= hi, as min(max(v, lo), hi): the same value as std::clamp, without branches.
+inline double box(double v, double lo, double hi) { return std::min(std::max(v, lo), hi); }
+
 constexpr int kMaxNewtonIterations = 100;
 
 class Newton final : public LviEngine {
@@ -69,7 +72,7 @@ class Newton final : public LviEngine {
       double jty = 0.0;
       for (int r = 0; r < me; ++r) jty += Ji[r] * y[r];
       const double vi = (jty - zeta[i]) * inv_w_(i);
-      const double xi = std::clamp(vi, lo[i], hi[i]);
+      const double xi = box(vi, lo[i], hi[i]);
       v_(i) = vi;
       x_(i) = xi;
       free_[static_cast<std::size_t>(i)] = (vi > lo[i] && vi < hi[i]) ? 1 : 0;
@@ -135,7 +138,7 @@ class Newton final : public LviEngine {
   double slope_at(const QpProblem& qp, double s) const {
     double out = delta_.dot(qp.d);
     for (int i = 0; i < qp.n(); ++i) {
-      out -= jtd_(i) * std::clamp(v_(i) + s * dv_(i), qp.lo(i), qp.hi(i));
+      out -= jtd_(i) * box(v_(i) + s * dv_(i), qp.lo(i), qp.hi(i));
     }
     return out;
   }

@@ -21,6 +21,9 @@
 namespace redres {
 namespace {
 
+// P_[lo, hi](v) for lo <= hi, as min(max(v, lo), hi): the same value as std::clamp, without branches.
+inline double box(double v, double lo, double hi) { return std::min(std::max(v, lo), hi); }
+
 class Projection final : public LviEngine {
  public:
   explicit Projection(const SolverSettings& s) { set_settings(s); }
@@ -138,16 +141,16 @@ class Projection final : public LviEngine {
       // e = u - P_Omega(u - r).
       double e2 = 0.0, e2_odd = 0.0;
       for (int i = 0; i < n; ++i) {
-        ex[i] = x[i] - std::clamp(x[i] - rx[i], lo[i], hi[i]);
+        ex[i] = x[i] - box(x[i] - rx[i], lo[i], hi[i]);
         ((i & 1) ? e2_odd : e2) += ex[i] * ex[i];
       }
       e2 += e2_odd;
       for (int r = 0; r < me; ++r) {
-        ey[r] = y[r] - std::clamp(y[r] - ry[r], -varpi, varpi);
+        ey[r] = y[r] - box(y[r] - ry[r], -varpi, varpi);
         e2 += ey[r] * ey[r];
       }
       for (int r = 0; r < mi; ++r) {
-        ez[r] = z[r] - std::clamp(z[r] - rz[r], 0.0, varpi);
+        ez[r] = z[r] - box(z[r] - rz[r], 0.0, varpi);
         e2 += ez[r] * ez[r];
       }
       out.e2 = e2;

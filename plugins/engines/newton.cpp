@@ -44,6 +44,7 @@ class Newton final : public LviEngine {
     v_.setZero(n);
     jtd_.setZero(n);
     inv_w_.setZero(n);
+    w_diag_.setZero(n);
     dv_.setZero(n);
     breaks_.assign(2 * static_cast<std::size_t>(n), 0.0);
     y_.setZero(m_e);
@@ -229,7 +230,11 @@ class Newton final : public LviEngine {
     double d_max = 0.0;
     full_scale_ = 0.0;
     for (int i = 0; i < n; ++i) {
-      inv_w_(i) = 1.0 / qp.W(i, i);
+      // W rarely changes between steps (W = I in the paper): reuse 1 / W_ii when it has not.
+      if (w_diag_(i) != qp.W(i, i)) {
+        w_diag_(i) = qp.W(i, i);
+        inv_w_(i) = 1.0 / w_diag_(i);
+      }
       for (int r = 0; r < me; ++r) full_scale_ = std::max(full_scale_, qp.J(r, i) * qp.J(r, i) * inv_w_(i));
     }
     for (int r = 0; r < me; ++r) d_max = std::max(d_max, std::abs(qp.d(r)));
@@ -288,7 +293,7 @@ class Newton final : public LviEngine {
   }
 
   double full_scale_ = 0.0;
-  Eigen::VectorXd v_, x_, y_, F_, delta_, diag_, jtd_, dv_, inv_w_;
+  Eigen::VectorXd v_, x_, y_, F_, delta_, diag_, jtd_, dv_, inv_w_, w_diag_;
   std::vector<char> free_;
   std::vector<double> breaks_;
   Eigen::MatrixXd G_;

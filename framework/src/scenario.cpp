@@ -292,27 +292,40 @@ std::string summary_json(const Scenario& s, const RunResult& run) {
   const std::size_t w = run.columns.size();
   const auto val = [&](std::size_t r, std::size_t c) { return run.rows[r * w + c]; };
 
+  // Column indices, looked up once.
+  const std::size_t c_err = col("position_error"), c_w = col("manipulability"), c_res = col("solver_residual"),
+                    c_it = col("solver_iterations");
+  std::vector<std::size_t> c_th, c_thd, c_vlo, c_vhi, c_lo, c_hi;
+  for (int j = 1; j <= n; ++j) {
+    const std::string J = std::to_string(j);
+    c_th.push_back(col("theta_" + J));
+    c_thd.push_back(col("theta_dot_" + J));
+    c_vlo.push_back(col("vel_lo_" + J));
+    c_vhi.push_back(col("vel_hi_" + J));
+    c_lo.push_back(col("lo_" + J));
+    c_hi.push_back(col("hi_" + J));
+  }
   double max_err = 0.0, w_min = 1e300, w_max = -1e300, w_sum = 0.0, angle_viol = 0.0, vel_viol = 0.0;
   double safety_entry = 0.0, max_res = 0.0, it_sum = 0.0, it_max = 0.0;
   long active_steps = 0;
   for (std::size_t r = 0; r < rows; ++r) {
-    max_err = std::max(max_err, val(r, col("position_error")));
-    const double wv = val(r, col("manipulability"));
+    max_err = std::max(max_err, val(r, c_err));
+    const double wv = val(r, c_w);
     w_min = std::min(w_min, wv);
     w_max = std::max(w_max, wv);
     w_sum += wv;
-    max_res = std::max(max_res, val(r, col("solver_residual")));
-    it_sum += val(r, col("solver_iterations"));
-    it_max = std::max(it_max, val(r, col("solver_iterations")));
+    max_res = std::max(max_res, val(r, c_res));
+    it_sum += val(r, c_it);
+    it_max = std::max(it_max, val(r, c_it));
     bool active = false;
     for (int j = 0; j < n; ++j) {
-      const std::string J = std::to_string(j + 1);
-      const double th = val(r, col("theta_" + J)), thd = val(r, col("theta_dot_" + J));
+      const auto k = static_cast<std::size_t>(j);
+      const double th = val(r, c_th[k]), thd = val(r, c_thd[k]);
       const double lo = robot.lower_limits()(j), hi = robot.upper_limits()(j);
       angle_viol = std::max({angle_viol, th - hi, lo - th});
       safety_entry = std::max({safety_entry, th - (hi - s.safety_margin(j)), (lo + s.safety_margin(j)) - th});
-      vel_viol = std::max({vel_viol, thd - val(r, col("vel_hi_" + J)), val(r, col("vel_lo_" + J)) - thd});
-      const double blo = val(r, col("lo_" + J)), bhi = val(r, col("hi_" + J));
+      vel_viol = std::max({vel_viol, thd - val(r, c_vhi[k]), val(r, c_vlo[k]) - thd});
+      const double blo = val(r, c_lo[k]), bhi = val(r, c_hi[k]);
       active = active || std::abs(thd - blo) <= 1e-9 * (1.0 + std::abs(blo)) ||
                std::abs(thd - bhi) <= 1e-9 * (1.0 + std::abs(bhi));
     }
@@ -320,13 +333,13 @@ std::string summary_json(const Scenario& s, const RunResult& run) {
   }
   const auto joint_velocity_norm = [&](std::size_t r) {
     double sq = 0.0;
-    for (int j = 1; j <= n; ++j) sq += std::pow(val(r, col("theta_dot_" + std::to_string(j))), 2);
+    for (std::size_t k = 0; k < c_thd.size(); ++k) sq += std::pow(val(r, c_thd[k]), 2);
     return std::sqrt(sq);
   };
   std::vector<double> final_theta, lengths, lower, upper, margin;
   std::vector<std::string> names;
   for (int j = 0; j < n; ++j) {
-    final_theta.push_back(val(rows - 1, col("theta_" + std::to_string(j + 1))));
+    final_theta.push_back(val(rows - 1, c_th[static_cast<std::size_t>(j)]));
     names.push_back(robot.joint(j).name);
     lower.push_back(robot.lower_limits()(j));
     upper.push_back(robot.upper_limits()(j));
@@ -342,12 +355,12 @@ std::string summary_json(const Scenario& s, const RunResult& run) {
       {"integrator", s.integrator == Integrator::kEuler ? "euler" : "heun"},
       {"path", s.path->description()},
       {"max_position_error", max_err},
-      {"final_position_error", val(rows - 1, col("position_error"))},
+      {"final_position_error", val(rows - 1, c_err)},
       {"initial_joint_velocity_norm", joint_velocity_norm(0)},
       {"final_joint_velocity_norm", joint_velocity_norm(rows - 1)},
       {"manipulability",
-       {{"initial", val(0, col("manipulability"))},
-        {"final", val(rows - 1, col("manipulability"))},
+       {{"initial", val(0, c_w)},
+        {"final", val(rows - 1, c_w)},
         {"min", w_min},
         {"mean", w_sum / static_cast<double>(rows)},
         {"max", w_max}}},

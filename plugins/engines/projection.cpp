@@ -18,6 +18,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "redres/lvi.hpp"
 
 namespace redres {
@@ -48,7 +52,11 @@ class Projection final : public LviEngine {
     // same order, so the iterates are identical.
     Outcome out;
     if (qp.w_diagonal && qp.m_in() == 0 && qp.m_eq() == 2 && qp.n() == 6) {
+#if defined(__SSE2__)
+      out = iterate_6x2_sse2(qp);  // the paper's case: two joints per SSE2 register
+#else
       out = iterate<true, false, 2, 6>(qp);  // the paper's case: every loop unrolls
+#endif
     } else if (qp.w_diagonal && qp.m_in() == 0 && qp.m_eq() == 2) {
       out = iterate<true, false, 2>(qp);
     } else if (qp.w_diagonal) {
@@ -76,6 +84,95 @@ class Projection final : public LviEngine {
     double e2 = 0.0;
     bool broke_down = false;
   };
+
+#if defined(__SSE2__)
+  // The paper's case (diagonal W, 6 joints, 2 rows, no inequality rows) with the even and odd joints in the two
+  // lanes of an SSE2 register. The lanes are exactly the even/odd partial sums of iterate<>, and every operation
+  // is the same IEEE operation in the same order (max/min with the operand order of std::max/std::min), so the
+  // iterates are bit-identical to the scalar variants.
+  Outcome iterate_6x2_sse2(const QpProblem& qp) {
+    const double varpi = settings().varpi;
+    const double tol2 = settings().tolerance * settings().tolerance;
+    const int max_iterations = settings().max_iterations;
+    const double* J = qp.J.data();  // column-major 2 x 6
+    __m128d j0[3], j1[3], w[3], zeta[3], lo[3], hi[3], x[3];
+    for (int p = 0; p < 3; ++p) {
+      const __m128d ce = _mm_loadu_pd(J + 4 * p);      // (J_0,2p,   J_1,2p)
+      const __m128d co = _mm_loadu_pd(J + 4 * p + 2);  // (J_0,2p+1, J_1,2p+1)
+      j0[p] = _mm_unpacklo_pd(ce, co);
+      j1[p] = _mm_unpackhi_pd(ce, co);
+      w[p] = _mm_set_pd(qp.W(2 * p + 1, 2 * p + 1), qp.W(2 * p, 2 * p));
+      zeta[p] = _mm_loadu_pd(qp.zeta.data() + 2 * p);
+      lo[p] = _mm_loadu_pd(qp.lo.data() + 2 * p);
+      hi[p] = _mm_loadu_pd(qp.hi.data() + 2 * p);
+      x[p] = _mm_loadu_pd(ux_.data() + 2 * p);
+    }
+    const double d0 = qp.d(0), d1 = qp.d(1);
+    double y0 = uy_(0), y1 = uy_(1);
+    const __m128d zero = _mm_setzero_pd();
+    Outcome out;
+    int k = 0;
+    for (;; ++k) {
+      // r = M u + g.
+      const __m128d vy0 = _mm_set1_pd(y0), vy1 = _mm_set1_pd(y1);
+      __m128d ry0 = _mm_set_pd(0.0, -d0), ry1 = _mm_set_pd(0.0, -d1);
+      __m128d rx[3];
+      for (int p = 0; p < 3; ++p) {
+        const __m128d wx = _mm_mul_pd(w[p], x[p]);
+        const __m128d jty = _mm_add_pd(_mm_add_pd(zero, _mm_mul_pd(j0[p], vy0)), _mm_mul_pd(j1[p], vy1));
+        ry0 = _mm_add_pd(ry0, _mm_mul_pd(j0[p], x[p]));
+        ry1 = _mm_add_pd(ry1, _mm_mul_pd(j1[p], x[p]));
+        rx[p] = _mm_add_pd(_mm_add_pd(_mm_sub_pd(wx, jty), zero), zeta[p]);
+      }
+      const double r0 = _mm_cvtsd_f64(ry0) + _mm_cvtsd_f64(_mm_unpackhi_pd(ry0, ry0));
+      const double r1 = _mm_cvtsd_f64(ry1) + _mm_cvtsd_f64(_mm_unpackhi_pd(ry1, ry1));
+      // e = u - P_Omega(u - r).
+      __m128d ex[3], e2v = zero;
+      for (int p = 0; p < 3; ++p) {
+        const __m128d v = _mm_sub_pd(x[p], rx[p]);
+        ex[p] = _mm_sub_pd(x[p], _mm_min_pd(hi[p], _mm_max_pd(lo[p], v)));
+        e2v = _mm_add_pd(e2v, _mm_mul_pd(ex[p], ex[p]));
+      }
+      double e2 = _mm_cvtsd_f64(e2v) + _mm_cvtsd_f64(_mm_unpackhi_pd(e2v, e2v));
+      const double ey0 = y0 - box(y0 - r0, -varpi, varpi);
+      e2 += ey0 * ey0;
+      const double ey1 = y1 - box(y1 - r1, -varpi, varpi);
+      e2 += ey1 * ey1;
+      out.e2 = e2;
+      if (e2 <= tol2 || k >= max_iterations) break;
+      // phi = (M' + I) e.
+      const __m128d vey0 = _mm_set1_pd(ey0), vey1 = _mm_set1_pd(ey1);
+      __m128d py0 = _mm_set_pd(0.0, ey0), py1 = _mm_set_pd(0.0, ey1), p2v = zero, px[3];
+      for (int p = 0; p < 3; ++p) {
+        const __m128d we = _mm_mul_pd(w[p], ex[p]);
+        const __m128d jte = _mm_add_pd(_mm_add_pd(zero, _mm_mul_pd(j0[p], vey0)), _mm_mul_pd(j1[p], vey1));
+        py0 = _mm_sub_pd(py0, _mm_mul_pd(j0[p], ex[p]));
+        py1 = _mm_sub_pd(py1, _mm_mul_pd(j1[p], ex[p]));
+        px[p] = _mm_add_pd(_mm_sub_pd(_mm_add_pd(we, jte), zero), ex[p]);
+        p2v = _mm_add_pd(p2v, _mm_mul_pd(px[p], px[p]));
+      }
+      double p2 = _mm_cvtsd_f64(p2v) + _mm_cvtsd_f64(_mm_unpackhi_pd(p2v, p2v));
+      const double q0 = _mm_cvtsd_f64(py0) + _mm_cvtsd_f64(_mm_unpackhi_pd(py0, py0));
+      p2 += q0 * q0;
+      const double q1 = _mm_cvtsd_f64(py1) + _mm_cvtsd_f64(_mm_unpackhi_pd(py1, py1));
+      p2 += q1 * q1;
+      if (!(p2 > 0.0) || !std::isfinite(p2)) {
+        out.broke_down = true;
+        break;
+      }
+      const double step = e2 / p2;
+      const __m128d vstep = _mm_set1_pd(step);
+      for (int p = 0; p < 3; ++p) x[p] = _mm_sub_pd(x[p], _mm_mul_pd(vstep, px[p]));
+      y0 -= step * q0;
+      y1 -= step * q1;
+    }
+    for (int p = 0; p < 3; ++p) _mm_storeu_pd(ux_.data() + 2 * p, x[p]);
+    uy_(0) = y0;
+    uy_(1) = y1;
+    out.iterations = k;
+    return out;
+  }
+#endif
 
   template <bool kDiagonal, bool kInequalities, int kRows = 0, int kCols = 0>
   Outcome iterate(const QpProblem& qp) {

@@ -117,8 +117,10 @@ void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
   info.iterations = 0;
   info.engine = name();
 
-  const BoundConflict conflict = find_bound_conflict(qp);
-  if (conflict.joint >= 0) {
+  bool conflicting = false;
+  for (int i = 0; i < n_; ++i) conflicting = conflicting || qp.lo(i) > qp.hi(i);
+  if (conflicting) {
+    const BoundConflict conflict = find_bound_conflict(qp);
     info.status = SolverStatus::kInfeasible;
     info.residual = std::numeric_limits<double>::infinity();
     info.diagnosis = "bounds conflict at " + describe(conflict, qp.variable_names);

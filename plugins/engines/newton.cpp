@@ -43,6 +43,9 @@ class Newton final : public LviEngine {
     free_.assign(static_cast<std::size_t>(n), 0);
     v_.setZero(n);
     jtd_.setZero(n);
+    x1_.setZero(n);
+    v1_.setZero(n);
+    F1_.setZero(m_e);
     inv_w_.setZero(n);
     w_diag_.setZero(n);
     dv_.setZero(n);
@@ -167,10 +170,28 @@ class Newton final : public LviEngine {
       same_status = same_status && s0 == s1;
     }
     const double g0 = -F_.dot(delta_);
+    full_step_ready_ = false;
     if (!(g0 > 0.0)) return 0.0;
     if (same_status) {
-      const double g1 = slope_at(qp, 1.0);
-      if (g1 <= 0.0) return g0 / (g0 - g1);
+      // x, v and F at s = 1, kept so that a full step needs no re-evaluation.
+      for (int r = 0; r < me; ++r) F1_(r) = -qp.d(r);
+      for (int i = 0; i < n; ++i) {
+        const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
+        v1_(i) = v_(i) + dv_(i);
+        x1_(i) = box(v1_(i), qp.lo(i), qp.hi(i));
+        for (int r = 0; r < me; ++r) F1_(r) += Ji[r] * x1_(i);
+      }
+      double g1 = 0.0;
+      for (int r = 0; r < me; ++r) g1 -= delta_(r) * F1_(r);
+      if (g1 <= 0.0) {
+        const double step = g0 / (g0 - g1);
+        // The root of the linear piece is s = 1 up to the regularisation and rounding: take the full step.
+        if (std::abs(step - 1.0) <= 1e-9) {
+          full_step_ready_ = true;
+          return 1.0;
+        }
+        return step;
+      }
     }
     int count = 0;
     for (int i = 0; i < n; ++i) {
@@ -266,7 +287,15 @@ class Newton final : public LviEngine {
         y_(r) += step * delta_(r);
         outside = outside || std::abs(y_(r)) > varpi;
       }
-      f2 = evaluate<kRows>(qp);
+      if (full_step_ready_) {
+        // Same free set as before the step: x, v and F at the new y were computed by exact_step.
+        x_.swap(x1_);
+        v_.swap(v1_);
+        F_.swap(F1_);
+        f2 = F_.squaredNorm();
+      } else {
+        f2 = evaluate<kRows>(qp);
+      }
       if (outside) {
         // The duals left the LVI's box: J x = d cannot be met inside the bounds.
         y_ = y_.cwiseMax(-varpi).cwiseMin(varpi);
@@ -293,7 +322,8 @@ class Newton final : public LviEngine {
   }
 
   double full_scale_ = 0.0;
-  Eigen::VectorXd v_, x_, y_, F_, delta_, diag_, jtd_, dv_, inv_w_, w_diag_;
+  Eigen::VectorXd v_, x_, y_, F_, delta_, diag_, jtd_, dv_, inv_w_, w_diag_, x1_, v1_, F1_;
+  bool full_step_ready_ = false;
   std::vector<char> free_;
   std::vector<double> breaks_;
   Eigen::MatrixXd G_;

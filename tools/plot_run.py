@@ -106,44 +106,47 @@ def fig_task(run_dir, data, summary, n, name):
     plt.close(fig)
 
 
-def grid(n):
+def joint_panels(run_dir, n, name, title, filename, ylabel, draw):
+    """One panel per joint; draw(ax, j) plots joint j (1-based) and returns the panel title."""
     cols = 3 if n > 4 else 2
     rows = (n + cols - 1) // cols
-    return rows, cols
-
-
-def fig_angles(run_dir, data, summary, n, name):
-    rows, cols = grid(n)
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3 * rows), squeeze=False)
-    lo, hi = summary["robot"]["lower_limits"], summary["robot"]["upper_limits"]
-    margin = summary["robot"]["safety_margin"]
-    t = data["t"]
-    for j in range(n):
-        ax = axes[j // cols][j % cols]
-        ax.plot(t, data[f"theta_{j + 1}"], "b", label=rf"$\theta_{j + 1}$")
-        ax.axhline(hi[j], color="r", lw=1, label=r"$\theta^\pm$")
-        ax.axhline(lo[j], color="r", lw=1)
-        if margin[j] > 0:
-            ax.axhspan(hi[j] - margin[j], hi[j], color="r", alpha=0.15, label="safety region")
-            ax.axhspan(lo[j], lo[j] + margin[j], color="r", alpha=0.15)
-        ax.set_title(f"({chr(97 + j)}) " + rf"$\theta_{j + 1}$ and limits", fontsize=9)
+    for j in range(1, n + 1):
+        ax = axes[(j - 1) // cols][(j - 1) % cols]
+        ax.set_title(f"({chr(96 + j)}) " + draw(ax, j), fontsize=9)
         ax.set_xlabel("t (s)")
-        ax.set_ylabel("rad")
+        ax.set_ylabel(ylabel)
         ax.legend(fontsize=6)
     for k in range(n, rows * cols):
         axes[k // cols][k % cols].axis("off")
-    fig.suptitle(f"{name}: joint angles, limits and safety regions")
+    fig.suptitle(f"{name}: {title}")
     fig.tight_layout()
-    fig.savefig(os.path.join(run_dir, "fig6_joint_angles.png"), dpi=110)
+    fig.savefig(os.path.join(run_dir, filename), dpi=110)
     plt.close(fig)
 
 
-def fig_velocities(run_dir, data, n, name):
-    rows, cols = grid(n)
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3 * rows), squeeze=False)
+def fig_angles(run_dir, data, summary, n, name):
+    lo, hi = summary["robot"]["lower_limits"], summary["robot"]["upper_limits"]
+    margin = summary["robot"]["safety_margin"]
     t = data["t"]
-    for j in range(1, n + 1):
-        ax = axes[(j - 1) // cols][(j - 1) % cols]
+
+    def draw(ax, j):
+        k = j - 1
+        ax.plot(t, data[f"theta_{j}"], "b", label=rf"$\theta_{j}$")
+        ax.axhline(hi[k], color="r", lw=1, label=r"$\theta^\pm$")
+        ax.axhline(lo[k], color="r", lw=1)
+        if margin[k] > 0:
+            ax.axhspan(hi[k] - margin[k], hi[k], color="r", alpha=0.15, label="safety region")
+            ax.axhspan(lo[k], lo[k] + margin[k], color="r", alpha=0.15)
+        return rf"$\theta_{j}$ and limits"
+
+    joint_panels(run_dir, n, name, "joint angles, limits and safety regions", "fig6_joint_angles.png", "rad", draw)
+
+
+def fig_velocities(run_dir, data, n, name):
+    t = data["t"]
+
+    def draw(ax, j):
         ax.plot(t, data[f"theta_dot_{j}"], "b", label=rf"$\dot\theta_{j}$")
         ax.plot(t, data[f"vel_hi_{j}"], "r", lw=1, label="velocity limits")
         ax.plot(t, data[f"vel_lo_{j}"], "r", lw=1)
@@ -151,16 +154,10 @@ def fig_velocities(run_dir, data, n, name):
         ax.plot(t, data[f"lo_{j}"], "g--", lw=1)
         span = max(np.abs(data[f"vel_hi_{j}"]).max(), np.abs(data[f"vel_lo_{j}"]).max())
         ax.set_ylim(-1.1 * span, 1.1 * span)
-        ax.set_title(f"({chr(96 + j)}) " + rf"$\dot\theta_{j}$, limits and bounds", fontsize=9)
-        ax.set_xlabel("t (s)")
-        ax.set_ylabel("rad/s")
-        ax.legend(fontsize=6)
-    for k in range(n, rows * cols):
-        axes[k // cols][k % cols].axis("off")
-    fig.suptitle(f"{name}: joint velocities, velocity limits and merged bounds")
-    fig.tight_layout()
-    fig.savefig(os.path.join(run_dir, "fig7_joint_velocities.png"), dpi=110)
-    plt.close(fig)
+        return rf"$\dot\theta_{j}$, limits and bounds"
+
+    joint_panels(run_dir, n, name, "joint velocities, velocity limits and merged bounds", "fig7_joint_velocities.png",
+                 "rad/s", draw)
 
 
 def fig_error(run_dir, data, name):

@@ -79,7 +79,7 @@ class Newton final : public LviEngine {
       const double xi = box(vi, lo[i], hi[i]);
       v_(i) = vi;
       x_(i) = xi;
-      free_[static_cast<std::size_t>(i)] = (vi > lo[i] && vi < hi[i]) ? 1 : 0;
+      free_[static_cast<std::size_t>(i)] = static_cast<char>(static_cast<int>(vi > lo[i]) & static_cast<int>(vi < hi[i]));
       for (int r = 0; r < me; ++r) F[r] += Ji[r] * xi;
     }
     double f2 = 0.0;
@@ -96,9 +96,9 @@ class Newton final : public LviEngine {
     G_.setZero();
     const double full_scale = full_scale_;
     for (int i = 0; i < n; ++i) {
-      if (!free_[static_cast<std::size_t>(i)]) continue;
       const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
-      const double inv_w = inv_w_(i);
+      // Clamped joints add zero; no branch on the free set.
+      const double inv_w = free_[static_cast<std::size_t>(i)] ? inv_w_(i) : 0.0;
       for (int c = 0; c < me; ++c) {
         for (int r = c; r < me; ++r) G_(r, c) += Ji[r] * Ji[c] * inv_w;
       }
@@ -108,6 +108,19 @@ class Newton final : public LviEngine {
     for (int r = 0; r < me; ++r) {
       G_(r, r) += reg;
       diag_(r) = G_(r, r);
+    }
+    if constexpr (kRows == 2) {
+      // Two rows: the same pivots as the Cholesky below (a, then the Schur complement det / a), solved in closed
+      // form with one division instead of two square roots and four divisions.
+      const double a = G_(0, 0), b = G_(1, 0), c = G_(1, 1);
+      const double det = a * c - b * b;
+      if (check && !(a > 1e-8 * diag_(0) + 1e-10 * full_scale)) return false;
+      if (check && !(det > (1e-8 * diag_(1) + 1e-10 * full_scale) * a)) return false;
+      if (!(a > 0.0) || !(det > 0.0)) return false;
+      const double inv = 1.0 / det;
+      delta_(0) = (-F_(0) * c + F_(1) * b) * inv;
+      delta_(1) = (-F_(1) * a + F_(0) * b) * inv;
+      return true;
     }
     // Cholesky G = L L' (lower triangle of G_).
     for (int c = 0; c < me; ++c) {
@@ -165,9 +178,10 @@ class Newton final : public LviEngine {
       jtd_(i) = jtd;
       dv_(i) = jtd * inv_w_(i);
       const double v1 = v_(i) + dv_(i);
-      const int s0 = v_(i) <= qp.lo(i) ? -1 : (v_(i) >= qp.hi(i) ? 1 : 0);
-      const int s1 = v1 <= qp.lo(i) ? -1 : (v1 >= qp.hi(i) ? 1 : 0);
-      same_status = same_status && s0 == s1;
+      // Status -1 (at lo), 0 (free), +1 (at hi), computed without branches (the pattern varies by problem).
+      const int s0 = static_cast<int>(v_(i) >= qp.hi(i)) - static_cast<int>(v_(i) <= qp.lo(i));
+      const int s1 = static_cast<int>(v1 >= qp.hi(i)) - static_cast<int>(v1 <= qp.lo(i));
+      same_status &= s0 == s1;
     }
     const double g0 = -F_.dot(delta_);
     full_step_ready_ = false;

@@ -197,14 +197,15 @@ class Newton final : public LviEngine {
       }
       double g1 = 0.0;
       for (int r = 0; r < me; ++r) g1 -= delta_(r) * F1_(r);
-      if (g1 <= 0.0) {
+      if (g1 < g0) {
+        // phi' is linear on [0, 1]; its root g0 / (g0 - g1) is s = 1 up to the regularisation and rounding (g1 is
+        // then tiny, of either sign): take the full step.
         const double step = g0 / (g0 - g1);
-        // The root of the linear piece is s = 1 up to the regularisation and rounding: take the full step.
         if (std::abs(step - 1.0) <= 1e-9) {
           full_step_ready_ = true;
           return 1.0;
         }
-        return step;
+        if (g1 <= 0.0) return step;  // the root lies inside [0, 1]
       }
     }
     int count = 0;

@@ -118,7 +118,7 @@ void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
   info.engine = name();
 
   bool conflicting = false;
-  for (int i = 0; i < n_; ++i) conflicting = conflicting || qp.lo(i) > qp.hi(i);
+  for (int i = 0; i < n_; ++i) conflicting |= qp.lo(i) > qp.hi(i);  // no early exit: the usual case is none
   if (conflicting) {
     const BoundConflict conflict = find_bound_conflict(qp);
     info.status = SolverStatus::kInfeasible;
@@ -135,8 +135,9 @@ void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
 
   // Duals at the +-varpi cap mean the LVI met its box only because the rows were given up: infeasible.
   const double cap = settings_.varpi * (1.0 - 1e-9);
-  const bool capped = (m_e_ > 0 && result.y.cwiseAbs().maxCoeff() >= cap) ||
-                      (m_i_ > 0 && result.z.maxCoeff() >= cap);
+  bool capped = false;
+  for (int r = 0; r < m_e_; ++r) capped |= std::abs(result.y(r)) >= cap;
+  for (int r = 0; r < m_i_; ++r) capped |= result.z(r) >= cap;
   if (info.status != SolverStatus::kSolved || capped) {
     bool infeasible = false;
     const std::string rows = diagnose_rows(qp, settings_.tolerance, &infeasible);

@@ -55,97 +55,149 @@ class Newton final : public LviEngine {
     delta_.setZero(m_e);
     diag_.setZero(m_e);
     G_.setZero(m_e, m_e);
+    L_.setZero(m_e, m_e);
     fallback_ = make_engine("projection", settings());
     fallback_result_.x.resize(0);
     fallback_->setup(n, m_e, m_i, fallback_result_);
   }
 
-  // x(y), v(y), the free set and F(y) = J x(y) - d; returns |F|^2.
+  // Number of rows: fixed at compile time for planar position tasks (kRows = 2), else m_e.
+  template <int kRows>
+  static int rows(const QpProblem& qp) {
+    return kRows > 0 ? kRows : qp.m_eq();
+  }
+
+  // x(y), v(y), the free set, F(y) = J x(y) - d, G = J D W^-1 J' over the free joints (lower triangle, in G_) and
+  // full_scale_ = the largest diagonal entry of J W^-1 J' (all joints), in one pass over the joints; returns |F|^2.
   template <int kRows>
   double evaluate(const QpProblem& qp) {
-    const int n = qp.n(), me = kRows > 0 ? kRows : qp.m_eq();
+    const int n = qp.n(), me = rows<kRows>(qp);
     const double* __restrict J = qp.J.data();
     const double* __restrict zeta = qp.zeta.data();
     const double* __restrict lo = qp.lo.data();
     const double* __restrict hi = qp.hi.data();
+    const double* __restrict inv_w = inv_w_.data();
     const double* __restrict y = y_.data();
+    double* __restrict v = v_.data();
+    double* __restrict x = x_.data();
+    char* __restrict free_mask = free_.data();
     double* __restrict F = F_.data();
+    double* __restrict G = G_.data();
+    if constexpr (kRows == 2) {
+      // The same sums as the general loops below, kept in registers.
+      const double y0 = y[0], y1 = y[1];
+      double f0 = -qp.d(0), f1 = -qp.d(1), g00 = 0.0, g10 = 0.0, g11 = 0.0, s0 = 0.0, s1 = 0.0;
+      for (int i = 0; i < n; ++i) {
+        const double j0 = J[2 * i], j1 = J[2 * i + 1], iw = inv_w[i];
+        const double vi = (j0 * y0 + j1 * y1 - zeta[i]) * iw;
+        const double xi = box(vi, lo[i], hi[i]);
+        const bool is_free = (vi > lo[i]) & (vi < hi[i]);
+        v[i] = vi;
+        x[i] = xi;
+        free_mask[i] = static_cast<char>(is_free);
+        f0 += j0 * xi;
+        f1 += j1 * xi;
+        // Clamped joints add zero; no branch on the free set.
+        const double fw = is_free ? iw : 0.0;
+        g00 += j0 * j0 * fw;
+        g10 += j1 * j0 * fw;
+        g11 += j1 * j1 * fw;
+        s0 += j0 * j0 * iw;
+        s1 += j1 * j1 * iw;
+      }
+      F[0] = f0;
+      F[1] = f1;
+      G[0] = g00;
+      G[1] = g10;
+      G[3] = g11;
+      full_scale_ = std::max(s0, s1);
+      return f0 * f0 + f1 * f1;
+    }
     for (int r = 0; r < me; ++r) F[r] = -qp.d(r);
+    G_.setZero();
+    double* __restrict scale = diag_.data();
+    for (int r = 0; r < me; ++r) scale[r] = 0.0;
     for (int i = 0; i < n; ++i) {
       const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
+      const double iw = inv_w[i];
       double jty = 0.0;
       for (int r = 0; r < me; ++r) jty += Ji[r] * y[r];
-      const double vi = (jty - zeta[i]) * inv_w_(i);
+      const double vi = (jty - zeta[i]) * iw;
       const double xi = box(vi, lo[i], hi[i]);
-      v_(i) = vi;
-      x_(i) = xi;
-      free_[static_cast<std::size_t>(i)] = static_cast<char>(static_cast<int>(vi > lo[i]) & static_cast<int>(vi < hi[i]));
-      for (int r = 0; r < me; ++r) F[r] += Ji[r] * xi;
+      const bool is_free = (vi > lo[i]) & (vi < hi[i]);
+      v[i] = vi;
+      x[i] = xi;
+      free_mask[i] = static_cast<char>(is_free);
+      const double fw = is_free ? iw : 0.0;
+      for (int r = 0; r < me; ++r) {
+        F[r] += Ji[r] * xi;
+        scale[r] += Ji[r] * Ji[r] * iw;
+      }
+      for (int c = 0; c < me; ++c) {
+        for (int r = c; r < me; ++r) G[r + c * me] += Ji[r] * Ji[c] * fw;
+      }
     }
+    full_scale_ = 0.0;
     double f2 = 0.0;
-    for (int r = 0; r < me; ++r) f2 += F[r] * F[r];
+    for (int r = 0; r < me; ++r) {
+      full_scale_ = std::max(full_scale_, scale[r]);
+      f2 += F[r] * F[r];
+    }
     return f2;
   }
 
-  // Solves (G + (reg + prox) I) delta = -F by Cholesky, in place in G_, with G = J D W^-1 J' over the free
-  // joints. Without `prox`, false if a pivot is not clearly positive (the free joints do not span the rows).
+  // Solves (G + (reg + prox) I) delta = -F, with G from evaluate(). Without `prox`, false if a pivot is not clearly
+  // positive (the free joints do not span the rows).
   template <int kRows>
   bool solve_newton_system(const QpProblem& qp, double prox) {
-    const int n = qp.n(), me = kRows > 0 ? kRows : qp.m_eq();
-    const double* J = qp.J.data();
-    G_.setZero();
+    const int me = rows<kRows>(qp);
     const double full_scale = full_scale_;
-    for (int i = 0; i < n; ++i) {
-      const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
-      // Clamped joints add zero; no branch on the free set.
-      const double inv_w = free_[static_cast<std::size_t>(i)] ? inv_w_(i) : 0.0;
-      for (int c = 0; c < me; ++c) {
-        for (int r = c; r < me; ++r) G_(r, c) += Ji[r] * Ji[c] * inv_w;
-      }
-    }
     const double reg = 1e-13 * (1.0 + full_scale) + prox * full_scale;
     const bool check = prox == 0.0;
-    for (int r = 0; r < me; ++r) {
-      G_(r, r) += reg;
-      diag_(r) = G_(r, r);
-    }
+    // A pivot lost to cancellation (below 1e-8 of its diagonal entry) means the free joints (nearly) do not span
+    // the rows.
+    const auto pivot_ok = [&](double pivot, double diag) {
+      return (!check || pivot > 1e-8 * diag + 1e-10 * full_scale) && pivot > 0.0;
+    };
     if constexpr (kRows == 2) {
       // Two rows: the same pivots as the Cholesky below (a, then the Schur complement det / a), solved in closed
       // form with one division instead of two square roots and four divisions.
-      const double a = G_(0, 0), b = G_(1, 0), c = G_(1, 1);
+      const double a = G_(0, 0) + reg, b = G_(1, 0), c = G_(1, 1) + reg;
       const double det = a * c - b * b;
-      if (check && !(a > 1e-8 * diag_(0) + 1e-10 * full_scale)) return false;
-      if (check && !(det > (1e-8 * diag_(1) + 1e-10 * full_scale) * a)) return false;
+      if (check && !(a > 1e-8 * a + 1e-10 * full_scale)) return false;
+      if (check && !(det > (1e-8 * c + 1e-10 * full_scale) * a)) return false;
       if (!(a > 0.0) || !(det > 0.0)) return false;
       const double inv = 1.0 / det;
       delta_(0) = (-F_(0) * c + F_(1) * b) * inv;
       delta_(1) = (-F_(1) * a + F_(0) * b) * inv;
       return true;
     }
-    // Cholesky G = L L' (lower triangle of G_).
+    // Cholesky L L' = G + reg I in L_ (lower triangle); G_ is kept for a regularised retry.
     for (int c = 0; c < me; ++c) {
-      double diag = G_(c, c);
-      for (int k = 0; k < c; ++k) diag -= G_(c, k) * G_(c, k);
-      // A pivot lost to cancellation means the free joints (nearly) do not span the rows.
-      if (check && !(diag > 1e-8 * diag_(c) + 1e-10 * full_scale)) return false;
-      if (!(diag > 0.0)) return false;
+      for (int r = c; r < me; ++r) L_(r, c) = G_(r, c) + (r == c ? reg : 0.0);
+    }
+    for (int c = 0; c < me; ++c) {
+      const double diag_entry = L_(c, c);
+      double diag = diag_entry;
+      for (int k = 0; k < c; ++k) diag -= L_(c, k) * L_(c, k);
+      if (!pivot_ok(diag, diag_entry)) return false;
       const double l = std::sqrt(diag);
-      G_(c, c) = l;
+      L_(c, c) = l;
       for (int r = c + 1; r < me; ++r) {
-        double s = G_(r, c);
-        for (int k = 0; k < c; ++k) s -= G_(r, k) * G_(c, k);
-        G_(r, c) = s / l;
+        double t = L_(r, c);
+        for (int k = 0; k < c; ++k) t -= L_(r, k) * L_(c, k);
+        L_(r, c) = t / l;
       }
     }
     for (int r = 0; r < me; ++r) {  // L w = -F
-      double s = -F_(r);
-      for (int k = 0; k < r; ++k) s -= G_(r, k) * delta_(k);
-      delta_(r) = s / G_(r, r);
+      double t = -F_(r);
+      for (int k = 0; k < r; ++k) t -= L_(r, k) * delta_(k);
+      delta_(r) = t / L_(r, r);
     }
     for (int r = me - 1; r >= 0; --r) {  // L' delta = w
-      double s = delta_(r);
-      for (int k = r + 1; k < me; ++k) s -= G_(k, r) * delta_(k);
-      delta_(r) = s / G_(r, r);
+      double t = delta_(r);
+      for (int k = r + 1; k < me; ++k) t -= L_(k, r) * delta_(k);
+      delta_(r) = t / L_(r, r);
     }
     return true;
   }
@@ -165,48 +217,57 @@ class Newton final : public LviEngine {
   // unbounded, which proves that J x = d cannot be met inside the bounds.
   template <int kRows>
   double exact_step(const QpProblem& qp) {
-    const int n = qp.n(), me = kRows > 0 ? kRows : qp.m_eq();
-    const double* J = qp.J.data();
+    const int n = qp.n(), me = rows<kRows>(qp);
+    const double* __restrict J = qp.J.data();
+    const double* __restrict lo = qp.lo.data();
+    const double* __restrict hi = qp.hi.data();
+    const double* __restrict inv_w = inv_w_.data();
+    const double* __restrict delta = delta_.data();
+    const double* __restrict v = v_.data();
+    double* __restrict jtd_out = jtd_.data();
+    double* __restrict dv = dv_.data();
+    double* __restrict v1 = v1_.data();
+    double* __restrict x1 = x1_.data();
+    double* __restrict F1 = F1_.data();
     // The usual case: no joint changes status between s = 0 and the full Newton step s = 1 (v is linear in s,
     // so equal status at both ends means no crossing); phi' is then linear on [0, 1] and its root is at s = 1 up
-    // to rounding. Checked without divisions or sorting.
+    // to rounding. Checked without divisions or sorting, in the same pass that computes x, v and F at s = 1, so
+    // that a full step needs no re-evaluation.
     bool same_status = true;
+    for (int r = 0; r < me; ++r) F1[r] = -qp.d(r);
     for (int i = 0; i < n; ++i) {
       const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
       double jtd = 0.0;
-      for (int r = 0; r < me; ++r) jtd += Ji[r] * delta_(r);
-      jtd_(i) = jtd;
-      dv_(i) = jtd * inv_w_(i);
-      const double v1 = v_(i) + dv_(i);
+      for (int r = 0; r < me; ++r) jtd += Ji[r] * delta[r];
+      jtd_out[i] = jtd;
+      const double dvi = jtd * inv_w[i];
+      const double v0i = v[i], v1i = v0i + dvi;
+      dv[i] = dvi;
+      v1[i] = v1i;
+      const double x1i = box(v1i, lo[i], hi[i]);
+      x1[i] = x1i;
+      for (int r = 0; r < me; ++r) F1[r] += Ji[r] * x1i;
       // Status -1 (at lo), 0 (free), +1 (at hi), computed without branches (the pattern varies by problem).
-      const int s0 = static_cast<int>(v_(i) >= qp.hi(i)) - static_cast<int>(v_(i) <= qp.lo(i));
-      const int s1 = static_cast<int>(v1 >= qp.hi(i)) - static_cast<int>(v1 <= qp.lo(i));
+      const int s0 = static_cast<int>(v0i >= hi[i]) - static_cast<int>(v0i <= lo[i]);
+      const int s1 = static_cast<int>(v1i >= hi[i]) - static_cast<int>(v1i <= lo[i]);
       same_status &= s0 == s1;
     }
-    const double g0 = -F_.dot(delta_);
+    double g0 = 0.0, g1 = 0.0;
+    for (int r = 0; r < me; ++r) {
+      g0 -= delta[r] * F_(r);
+      g1 -= delta[r] * F1[r];
+    }
     full_step_ready_ = false;
     if (!(g0 > 0.0)) return 0.0;
-    if (same_status) {
-      // x, v and F at s = 1, kept so that a full step needs no re-evaluation.
-      for (int r = 0; r < me; ++r) F1_(r) = -qp.d(r);
-      for (int i = 0; i < n; ++i) {
-        const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
-        v1_(i) = v_(i) + dv_(i);
-        x1_(i) = box(v1_(i), qp.lo(i), qp.hi(i));
-        for (int r = 0; r < me; ++r) F1_(r) += Ji[r] * x1_(i);
+    if (same_status && g1 < g0) {
+      // phi' is linear on [0, 1]; its root g0 / (g0 - g1) is s = 1 up to the regularisation and rounding (g1 is
+      // then tiny, of either sign): take the full step.
+      const double step = g0 / (g0 - g1);
+      if (std::abs(step - 1.0) <= 1e-9) {
+        full_step_ready_ = true;
+        return 1.0;
       }
-      double g1 = 0.0;
-      for (int r = 0; r < me; ++r) g1 -= delta_(r) * F1_(r);
-      if (g1 < g0) {
-        // phi' is linear on [0, 1]; its root g0 / (g0 - g1) is s = 1 up to the regularisation and rounding (g1 is
-        // then tiny, of either sign): take the full step.
-        const double step = g0 / (g0 - g1);
-        if (std::abs(step - 1.0) <= 1e-9) {
-          full_step_ready_ = true;
-          return 1.0;
-        }
-        if (g1 <= 0.0) return step;  // the root lies inside [0, 1]
-      }
+      if (g1 <= 0.0) return step;  // the root lies inside [0, 1]
     }
     int count = 0;
     for (int i = 0; i < n; ++i) {
@@ -223,12 +284,12 @@ class Newton final : public LviEngine {
       // Beyond the last breakpoint phi' is linear for ever; probe it one unit further.
       const double s1 = k < count ? breaks_[static_cast<std::size_t>(k)] : s0 + std::max(1.0, s0);
       if (s1 <= s0) continue;
-      const double g1 = slope_at(qp, s1);
-      if (g1 <= 0.0) return s0 + (s1 - s0) * g_prev / (g_prev - g1);  // root of the linear piece
-      if (k == count && !(g1 < g_prev * (1.0 - 1e-12))) return std::numeric_limits<double>::infinity();
-      if (k == count) return s1 + (s1 - s0) * g1 / (g_prev - g1);
+      const double g_next = slope_at(qp, s1);
+      if (g_next <= 0.0) return s0 + (s1 - s0) * g_prev / (g_prev - g_next);  // root of the linear piece
+      if (k == count && !(g_next < g_prev * (1.0 - 1e-12))) return std::numeric_limits<double>::infinity();
+      if (k == count) return s1 + (s1 - s0) * g_next / (g_prev - g_next);
       s0 = s1;
-      g_prev = g1;
+      g_prev = g_next;
     }
     return s0;
   }
@@ -246,7 +307,21 @@ class Newton final : public LviEngine {
 
   void do_solve(const QpProblem& qp, SolverResult& result) override {
     bool applicable = qp.w_diagonal && qp.m_in() == 0;
-    for (int i = 0; i < qp.n() && applicable; ++i) applicable = qp.W(i, i) > 0.0;
+    if (applicable) {
+      // W rarely changes between steps (W = I in the paper): reuse 1 / W_ii when it has not.
+      const int n = qp.n();
+      const double* __restrict W = qp.W.data();
+      double* __restrict w_diag = w_diag_.data();
+      double* __restrict inv_w = inv_w_.data();
+      for (int i = 0; i < n; ++i) {
+        const double w = W[static_cast<std::ptrdiff_t>(i) * (n + 1)];
+        applicable &= w > 0.0;
+        if (w != w_diag[i]) {
+          w_diag[i] = w;
+          inv_w[i] = 1.0 / w;
+        }
+      }
+    }
     if (!applicable) {
       run_fallback(qp, result);
       return;
@@ -262,17 +337,8 @@ class Newton final : public LviEngine {
   template <int kRows>
   void run(const QpProblem& qp, SolverResult& result) {
     SolverInfo& info = result.info;
-    const int n = qp.n(), me = kRows > 0 ? kRows : qp.m_eq();
+    const int me = rows<kRows>(qp);
     double d_max = 0.0;
-    full_scale_ = 0.0;
-    for (int i = 0; i < n; ++i) {
-      // W rarely changes between steps (W = I in the paper): reuse 1 / W_ii when it has not.
-      if (w_diag_(i) != qp.W(i, i)) {
-        w_diag_(i) = qp.W(i, i);
-        inv_w_(i) = 1.0 / w_diag_(i);
-      }
-      for (int r = 0; r < me; ++r) full_scale_ = std::max(full_scale_, qp.J(r, i) * qp.J(r, i) * inv_w_(i));
-    }
     for (int r = 0; r < me; ++r) d_max = std::max(d_max, std::abs(qp.d(r)));
     if (!warm()) y_.setZero();
     const double varpi = settings().varpi;
@@ -307,7 +373,8 @@ class Newton final : public LviEngine {
         x_.swap(x1_);
         v_.swap(v1_);
         F_.swap(F1_);
-        f2 = F_.squaredNorm();
+        f2 = 0.0;
+        for (int r = 0; r < me; ++r) f2 += F_(r) * F_(r);
       } else {
         f2 = evaluate<kRows>(qp);
       }
@@ -341,7 +408,7 @@ class Newton final : public LviEngine {
   bool full_step_ready_ = false;
   std::vector<char> free_;
   std::vector<double> breaks_;
-  Eigen::MatrixXd G_;
+  Eigen::MatrixXd G_, L_;
   std::unique_ptr<LviEngine> fallback_;
   SolverResult fallback_result_;
 };

@@ -5,6 +5,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <nlopt.h>
 #include <rapidcheck/gtest.h>
 
 #include "alloc_counter.hpp"
@@ -300,6 +301,73 @@ TEST(LviRealTime, ProjectionAndNewtonSolvesAllocateNothing) {
     EXPECT_EQ(r.info.status, SolverStatus::kSolved);
     EXPECT_EQ(count, 0) << name << " (scheme build + solve)";
   }
+}
+
+// NLopt's SLSQP mallocs its work array inside every nlopt_optimize() (it has no caller-provided workspace), so the
+// `nlopt` engine cannot be allocation-free; everything redres adds around it must be. The count per solve is
+// pinned to what a bare nlopt_optimize() of the same size allocates, measured here.
+double bare_objective(unsigned n, const double* x, double* grad, void* /*data*/) {
+  double f = 0.0;
+  for (unsigned i = 0; i < n; ++i) {
+    f += 0.5 * x[i] * x[i] + 0.1 * x[i];
+    if (grad != nullptr) grad[i] = x[i] + 0.1;
+  }
+  return f;
+}
+
+void bare_rows(unsigned m, double* result, unsigned n, const double* x, double* grad, void* /*data*/) {
+  for (unsigned r = 0; r < m; ++r) {
+    result[r] = x[r] + x[r + 1] - 0.1;
+    for (unsigned i = 0; grad != nullptr && i < n; ++i) grad[r * n + i] = (i == r || i == r + 1) ? 1.0 : 0.0;
+  }
+}
+
+TEST(LviRealTime, NloptEngineAllocatesOnlyWhatNloptDoes) {
+  if (!testing::allocation_counting_available()) {
+    GTEST_SKIP() << "AddressSanitizer owns malloc here; the release build runs this check";
+  }
+  long per_optimize = 0;
+  {
+    nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, 6);
+    ASSERT_NE(opt, nullptr);
+    const double tol[2] = {1e-13, 1e-13};
+    const double lo[6] = {-1, -1, -1, -1, -1, -1}, hi[6] = {1, 1, 1, 1, 1, 1};
+    nlopt_set_min_objective(opt, &bare_objective, nullptr);
+    nlopt_add_equality_mconstraint(opt, 2, &bare_rows, nullptr, tol);
+    nlopt_set_lower_bounds(opt, lo);
+    nlopt_set_upper_bounds(opt, hi);
+    nlopt_set_xtol_abs1(opt, 1e-14);
+    double x[6] = {0, 0, 0, 0, 0, 0};
+    double f = 0.0;
+    {
+      const testing::AllocationCounter counter;
+      ASSERT_GT(nlopt_optimize(opt, x, &f), 0);
+      per_optimize = counter.count();
+    }
+    nlopt_destroy(opt);
+  }
+  RecordProperty("nlopt_optimize_allocations", std::to_string(per_optimize));
+
+  auto step = testing::make_paper_step();
+  auto engine = make_engine("nlopt");
+  SolverResult r;
+  engine->setup(6, 2, 0, r);
+  Eigen::VectorXd theta = paper_theta0();
+  step->build(theta, 10.0, Eigen::Vector2d(0.004, -0.002), Eigen::Vector2d::Zero());
+  engine->solve(step->qp, r);  // warm-up
+  constexpr int kSolves = 20;
+  long count = 0;
+  {
+    const testing::AllocationCounter counter;
+    for (int k = 0; k < kSolves; ++k) {
+      step->build(theta, 10.0 + 0.01 * k, Eigen::Vector2d(0.004, -0.002), Eigen::Vector2d::Zero());
+      engine->solve(step->qp, r);
+      theta += 0.01 * r.x;
+    }
+    count = counter.count();
+  }
+  EXPECT_EQ(r.info.status, SolverStatus::kSolved) << r.info.diagnosis;
+  EXPECT_EQ(count, kSolves * per_optimize) << "allocations beyond NLopt's own " << per_optimize << " per solve";
 }
 
 }  // namespace

@@ -3,9 +3,10 @@
 /// over the joints strictly inside their bounds (and the active inequality rows, z >= 0), so that the residual
 /// ||e(u)|| can be reported like the other engines'. `iterations` counts objective evaluations.
 ///
-/// Allocation: the wrapper's buffers are sized at setup, but NLopt's SLSQP allocates its own work arrays inside
-/// every nlopt_optimize() call, and the dual estimate uses a QR factorisation; this engine is a cross-check, not
-/// for the real-time path. No engine-specific TOML keys.
+/// Allocation: everything redres does per solve uses buffers sized at setup (the dual estimate's QR included), but
+/// NLopt's SLSQP allocates its own work array inside every nlopt_optimize() call (one malloc, freed before it
+/// returns; NLopt has no caller-provided workspace). A test pins the count to NLopt's own. This engine is a
+/// cross-check, not for the real-time path. No engine-specific TOML keys.
 
 #include <cmath>
 
@@ -47,6 +48,12 @@ class NloptSlsqp final : public LviEngine {
     nlopt_set_ftol_abs(opt_, 1e-16);
     x_.setZero(n);
     have_x_ = false;
+    const int k = m_e + m_i;
+    B_.setZero(n, k);
+    rhs_.setZero(n);
+    sol_.setZero(k);
+    active_.assign(static_cast<std::size_t>(m_i), 0);
+    qr_ = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(n, k);
   }
 
   static double objective(unsigned /*n*/, const double* x, double* grad, void* data) {
@@ -102,9 +109,9 @@ class NloptSlsqp final : public LviEngine {
     SolverInfo& info = result.info;
     info.iterations = evaluations_;
     info.residual = lvi_residual(qp, result, settings().varpi);
-    const double feas =
-        std::max(qp.m_eq() > 0 ? (qp.J * result.x - qp.d).cwiseAbs().maxCoeff() : 0.0,
-                 qp.m_in() > 0 ? (qp.A * result.x - qp.b).maxCoeff() : 0.0);
+    double feas = 0.0;
+    for (int r = 0; r < qp.m_eq(); ++r) feas = std::max(feas, std::abs(qp.J.row(r).dot(result.x) - qp.d(r)));
+    for (int r = 0; r < qp.m_in(); ++r) feas = std::max(feas, qp.A.row(r).dot(result.x) - qp.b(r));
     if (code == NLOPT_MAXEVAL_REACHED) {
       info.status = SolverStatus::kMaxIterations;
     } else if (code > 0 && feas <= settings().tolerance && info.residual <= settings().tolerance) {
@@ -121,33 +128,42 @@ class NloptSlsqp final : public LviEngine {
   }
 
   // Least-squares duals from (W x + zeta - J' y + A' z)_F = 0 over the free joints F, with z on the active rows.
-  static void estimate_duals(const QpProblem& qp, SolverResult& result) {
+  // The matrix keeps its setup size: rows of clamped joints and columns of inactive rows are zero, which leaves the
+  // least-squares solution unchanged (column-pivoting QR gives the zero columns a zero coefficient).
+  void estimate_duals(const QpProblem& qp, SolverResult& result) {
     const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
-    std::vector<int> free, active;
-    for (int i = 0; i < n; ++i) {
-      if (result.x(i) > qp.lo(i) + 1e-10 && result.x(i) < qp.hi(i) - 1e-10) free.push_back(i);
-    }
-    for (int r = 0; r < mi; ++r) {
-      if (qp.A.row(r).dot(result.x) >= qp.b(r) - 1e-9) active.push_back(r);
-    }
     result.y.setZero();
     result.z.setZero();
-    const int cols = me + static_cast<int>(active.size());
-    if (free.empty() || cols == 0) return;
-    Eigen::MatrixXd B(static_cast<Eigen::Index>(free.size()), cols);
-    Eigen::VectorXd rhs(static_cast<Eigen::Index>(free.size()));
-    const Eigen::VectorXd g = qp.W * result.x + qp.zeta;
-    for (std::size_t k = 0; k < free.size(); ++k) {
-      const int i = free[k];
-      const auto row = static_cast<Eigen::Index>(k);
-      for (int r = 0; r < me; ++r) B(row, r) = qp.J(r, i);
-      for (std::size_t a = 0; a < active.size(); ++a) B(row, me + static_cast<Eigen::Index>(a)) = -qp.A(active[a], i);
-      rhs(row) = g(i);
+    if (me + mi == 0) return;
+    bool any_free = false;
+    for (int r = 0; r < mi; ++r) active_[static_cast<std::size_t>(r)] = qp.A.row(r).dot(result.x) >= qp.b(r) - 1e-9;
+    for (int i = 0; i < n; ++i) {
+      const bool is_free = result.x(i) > qp.lo(i) + 1e-10 && result.x(i) < qp.hi(i) - 1e-10;
+      any_free |= is_free;
+      const double keep = is_free ? 1.0 : 0.0;
+      for (int r = 0; r < me; ++r) B_(i, r) = keep * qp.J(r, i);
+      for (int r = 0; r < mi; ++r) B_(i, me + r) = active_[static_cast<std::size_t>(r)] ? -keep * qp.A(r, i) : 0.0;
+      rhs_(i) = keep * (qp.W.row(i).dot(result.x) + qp.zeta(i));
     }
-    const Eigen::VectorXd sol = B.colPivHouseholderQr().solve(rhs);
-    result.y = sol.head(me);
-    for (std::size_t a = 0; a < active.size(); ++a) {
-      result.z(active[a]) = std::max(0.0, sol(me + static_cast<Eigen::Index>(a)));
+    if (!any_free) return;
+    // sol = R^-1 Q' rhs on the numerical rank, in place (QR::solve() would allocate a temporary).
+    qr_.compute(B_);
+    const Eigen::Index rank = qr_.rank();
+    // Q' rhs = H_{p-1} ... H_0 rhs with H_k = I - tau_k v_k v_k', v_k = [1; essential part stored below R's diagonal].
+    const Eigen::MatrixXd& qr = qr_.matrixQR();
+    for (Eigen::Index k = 0; k < qr_.nonzeroPivots(); ++k) {
+      const Eigen::Index tail = n - k - 1;
+      const double vtr = rhs_(k) + qr.col(k).tail(tail).dot(rhs_.tail(tail));
+      const double scale = qr_.hCoeffs()(k) * vtr;
+      rhs_(k) -= scale;
+      rhs_.tail(tail) -= scale * qr.col(k).tail(tail);
+    }
+    qr.topLeftCorner(rank, rank).triangularView<Eigen::Upper>().solveInPlace(rhs_.head(rank));
+    sol_.setZero();
+    for (Eigen::Index k = 0; k < rank; ++k) sol_(qr_.colsPermutation().indices()(k)) = rhs_(k);
+    result.y = sol_.head(me);
+    for (int r = 0; r < mi; ++r) {
+      if (active_[static_cast<std::size_t>(r)]) result.z(r) = std::max(0.0, sol_(me + r));
     }
   }
 
@@ -157,11 +173,15 @@ class NloptSlsqp final : public LviEngine {
   std::vector<double> tol_eq_, tol_in_;
   Eigen::VectorXd x_;
   bool have_x_ = false;
+  Eigen::MatrixXd B_;  // dual estimate: n x (m_e + m_i)
+  Eigen::VectorXd rhs_, sol_;
+  std::vector<char> active_;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_;
 };
 
 const bool kRegistered = engine_registry().add({
     "nlopt",
-    "NLopt SLSQP on the QP (independent cross-check; allocates inside NLopt)",
+    "NLopt SLSQP on the QP (independent cross-check; NLopt allocates its work array per solve)",
     {},
     [](const TableReader& /*r*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
       return std::make_unique<NloptSlsqp>(s);

@@ -7,9 +7,10 @@
 /// exact line search on phi (phi is concave and piecewise quadratic along delta, so its maximiser is found by
 /// walking the breakpoints where a joint reaches a bound). Where the free joints do not span the rows (a
 /// degenerate solution), G is regularised by |F| I (Levenberg-Marquardt), which vanishes at the solution. Once
-/// the free set is right the step is exact, so warm-started steps take one or two iterations. At x(y), e_x(u) = 0 by construction and e_y(u) = F(y) while |y| < varpi, so
-/// ||e(u)||_2 = ||F(y)||_2 is the paper's stopping test; the engine reports `solved` only once
-/// ||F|| <= min(tolerance, 1e-12 (1 + |d|_inf)), i.e. after the exact step, so its KKT residual is tiny.
+/// the free set is right the step is exact, so warm-started steps take one or two iterations. At x(y), e_x(u) = 0
+/// by construction and e_y(u) = F(y) while |y| < varpi, so ||e(u)||_2 = ||F(y)||_2 is the paper's stopping test;
+/// the engine reports `solved` only once ||F|| <= min(tolerance, 1e-12 (1 + |d|_inf)), i.e. after the exact step,
+/// so its KKT residual is tiny.
 ///
 /// Infeasible rows make phi unbounded: the line search then finds phi increasing linearly for ever (a proof of
 /// infeasibility), or y leaves [-varpi, varpi]; either way the solve is reported `infeasible`.

@@ -63,7 +63,7 @@ struct SolverResult {
 };
 
 /// An LVI engine. setup() sizes everything; solve() then allocates nothing (except the diagnosis text of a
-/// failed solve).
+/// failed solve). Exception: `nlopt`, where NLopt's SLSQP mallocs its own work array in every nlopt_optimize().
 class LviEngine {
  public:
   LviEngine() = default;

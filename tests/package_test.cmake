@@ -10,21 +10,21 @@ function(run)
   set(LAST_OUTPUT "${out}" PARENT_SCOPE)
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
-run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples -B ${WORK_DIR}/build -DCMAKE_BUILD_TYPE=Release
-    -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
-run(${CMAKE_COMMAND} --build ${WORK_DIR}/build -j 2)
-run(${WORK_DIR}/build/example_01_kinematics)
-if(NOT LAST_OUTPUT MATCHES "paper_pushrod_6dof: 6 joints, 2 task rows")
-  message(FATAL_ERROR "unexpected output from the installed example:\n${LAST_OUTPUT}")
-endif()
-message(STATUS "find_package(redres) consumer built and ran:\n${LAST_OUTPUT}")
+# Configures SOURCE_DIR/<project> against the installed package, builds it, runs <program> and checks that its
+# output matches <expected>.
+function(build_and_run project build program expected label)
+  run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/${project} -B ${WORK_DIR}/${build} -DCMAKE_BUILD_TYPE=Release
+      -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+  run(${CMAKE_COMMAND} --build ${WORK_DIR}/${build} -j 2)
+  run(${WORK_DIR}/${build}/${program})
+  if(NOT LAST_OUTPUT MATCHES "${expected}")
+    message(FATAL_ERROR "unexpected output from the ${label}:\n${LAST_OUTPUT}")
+  endif()
+  message(STATUS "${label}:\n${LAST_OUTPUT}")
+endfunction()
 
+build_and_run(examples build example_01_kinematics "paper_pushrod_6dof: 6 joints, 2 task rows"
+              "find_package(redres) consumer")
 # The out-of-tree plugin example: one .cpp with a new constraint, used from a TOML file.
-run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/custom_plugin -B ${WORK_DIR}/plugin -DCMAKE_BUILD_TYPE=Release
-    -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
-run(${CMAKE_COMMAND} --build ${WORK_DIR}/plugin -j 2)
-run(${WORK_DIR}/plugin/custom_plugin_example)
-if(NOT LAST_OUTPUT MATCHES "200 steps, 0 failed, engine projection")
-  message(FATAL_ERROR "unexpected output from the custom plugin example:\n${LAST_OUTPUT}")
-endif()
-message(STATUS "custom plugin example:\n${LAST_OUTPUT}")
+build_and_run(examples/custom_plugin plugin custom_plugin_example "200 steps, 0 failed, engine projection"
+              "custom plugin example")

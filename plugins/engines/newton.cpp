@@ -54,7 +54,7 @@ class Newton final : public LviEngine {
     y_.setZero(m_e);
     F_.setZero(m_e);
     delta_.setZero(m_e);
-    diag_.setZero(m_e);
+    row_scale_.setZero(m_e);
     G_.setZero(m_e, m_e);
     L_.setZero(m_e, m_e);
     fallback_ = make_engine("projection", settings());
@@ -116,7 +116,7 @@ class Newton final : public LviEngine {
     }
     for (int r = 0; r < me; ++r) F[r] = -qp.d(r);
     G_.setZero();
-    double* __restrict scale = diag_.data();
+    double* __restrict scale = row_scale_.data();
     for (int r = 0; r < me; ++r) scale[r] = 0.0;
     for (int i = 0; i < n; ++i) {
       const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
@@ -156,18 +156,16 @@ class Newton final : public LviEngine {
     const double reg = 1e-13 * (1.0 + full_scale) + prox * full_scale;
     const bool check = prox == 0.0;
     // A pivot lost to cancellation (below 1e-8 of its diagonal entry) means the free joints (nearly) do not span
-    // the rows.
-    const auto pivot_ok = [&](double pivot, double diag) {
-      return (!check || pivot > 1e-8 * diag + 1e-10 * full_scale) && pivot > 0.0;
+    // the rows. The test is on pivot / scale, written without the division (scale > 0).
+    const auto pivot_ok = [&](double pivot, double diag, double scale) {
+      return (!check || pivot > (1e-8 * diag + 1e-10 * full_scale) * scale) && pivot > 0.0;
     };
     if constexpr (kRows == 2) {
       // Two rows: the same pivots as the Cholesky below (a, then the Schur complement det / a), solved in closed
       // form with one division instead of two square roots and four divisions.
       const double a = G_(0, 0) + reg, b = G_(1, 0), c = G_(1, 1) + reg;
       const double det = a * c - b * b;
-      if (check && !(a > 1e-8 * a + 1e-10 * full_scale)) return false;
-      if (check && !(det > (1e-8 * c + 1e-10 * full_scale) * a)) return false;
-      if (!(a > 0.0) || !(det > 0.0)) return false;
+      if (!pivot_ok(a, a, 1.0) || !pivot_ok(det, c, a)) return false;
       const double inv = 1.0 / det;
       delta_(0) = (-F_(0) * c + F_(1) * b) * inv;
       delta_(1) = (-F_(1) * a + F_(0) * b) * inv;
@@ -181,7 +179,7 @@ class Newton final : public LviEngine {
       const double diag_entry = L_(c, c);
       double diag = diag_entry;
       for (int k = 0; k < c; ++k) diag -= L_(c, k) * L_(c, k);
-      if (!pivot_ok(diag, diag_entry)) return false;
+      if (!pivot_ok(diag, diag_entry, 1.0)) return false;
       const double l = std::sqrt(diag);
       L_(c, c) = l;
       for (int r = c + 1; r < me; ++r) {
@@ -405,7 +403,7 @@ class Newton final : public LviEngine {
   }
 
   double full_scale_ = 0.0;
-  Eigen::VectorXd v_, x_, y_, F_, delta_, diag_, jtd_, dv_, inv_w_, w_diag_, x1_, v1_, F1_;
+  Eigen::VectorXd v_, x_, y_, F_, delta_, row_scale_, jtd_, dv_, inv_w_, w_diag_, x1_, v1_, F1_;
   bool full_step_ready_ = false;
   std::vector<char> free_;
   std::vector<double> breaks_;

@@ -10,18 +10,28 @@ Per run:
   fig6_joint_angles.png     each theta with its limits and its safety region
   fig7_joint_velocities.png each theta_dot with its velocity limits and the merged bounds
   fig9b_position_error.png  the position error over time
-Uses Debian's python3-matplotlib and python3-numpy.
+Uses matplotlib and numpy (Debian: python3-matplotlib, python3-numpy). Exit codes: 0 figures written, 3 matplotlib
+or numpy cannot be imported (with a message saying what to install), 1 or 2 any other failure.
 """
 import argparse
 import json
 import os
 import sys
 
-import matplotlib
+# A missing library has its own exit code, so that `redres --plots` can say what to install instead of reporting a
+# failed plot; the check costs nothing, as the figures need these imports anyway.
+EXIT_MISSING_LIBRARY = 3
+try:
+    import matplotlib
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: E402
+    import numpy as np  # noqa: E402
+except ImportError as e:
+    missing = e.name if e.name in ("matplotlib", "numpy") else f"a library matplotlib needs ({e})"
+    print(f"plot_run.py: {missing} is not installed for {sys.executable}: apt-get install python3-matplotlib "
+          "python3-numpy (Debian's python3) or pip install matplotlib numpy", file=sys.stderr)
+    sys.exit(EXIT_MISSING_LIBRARY)
 
 
 def load(run_dir):

@@ -7,7 +7,10 @@
 
 namespace redres::cli {
 
-/// Exit codes (DESIGN section 6).
+/// Exit codes (DESIGN section 6). kExitBadInput is every error that stops a command doing what it was asked:
+/// bad input, and also figures asked for (`run --plots`, `[output] plots = true`, `compare` without `--no-plots`)
+/// that cannot be made (no python3 on PATH, no matplotlib, no plot_run.py, or the script failed). It takes
+/// precedence over kExitFailedSteps.
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailedSteps = 1;
 inline constexpr int kExitBadInput = 2;

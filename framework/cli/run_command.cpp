@@ -1,20 +1,29 @@
 // `redres run`, `redres validate` and `redres compare`: scenarios from the command line.
 
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "redres/scenario.hpp"
+
+extern char** environ;  // the environment plot_run.py inherits (POSIX leaves the declaration to the program)
 
 namespace redres::cli {
 
@@ -61,23 +70,102 @@ class ProgressBar {
   std::chrono::steady_clock::time_point start_;
 };
 
-std::filesystem::path tools_dir() {
-  if (const char* env = std::getenv("REDRES_TOOLS_DIR")) return env;
-  return REDRES_TOOLS_DIR;
+// plot_run.py: $REDRES_TOOLS_DIR/plot_run.py when set, else <dir of this executable>/REDRES_TOOLS_RELDIR, which is
+// where `cmake --install` puts it (<prefix>/bin -> <prefix>/share/redres/tools) and where the build tree keeps a
+// copy (build/<preset>/bin -> build/<preset>/share/redres/tools). One relative rule serves both, so an installed
+// binary never depends on the source tree it was built from.
+std::filesystem::path plot_script() {
+  if (const char* env = std::getenv("REDRES_TOOLS_DIR"); env != nullptr && *env != '\0') {
+    return std::filesystem::path(env) / "plot_run.py";
+  }
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) {
+    throw std::runtime_error("cannot locate plot_run.py: /proc/self/exe: " + ec.message() +
+                             " (set REDRES_TOOLS_DIR to the directory that holds plot_run.py)");
+  }
+  return (exe.parent_path() / REDRES_TOOLS_RELDIR / "plot_run.py").lexically_normal();
 }
 
-// Renders figures with tools/plot_run.py; a missing Python or matplotlib is a warning, not a failure.
-void render_plots(const std::string& args, bool quiet) {
-  const std::filesystem::path script = tools_dir() / "plot_run.py";
-  if (!std::filesystem::exists(script)) {
-    std::cerr << "warning: " << script.string() << " not found; no plots (set REDRES_TOOLS_DIR)\n";
-    return;
+// The first executable `program` in a directory of PATH, as a shell would find it, so that the figures use the
+// interpreter the user chose (a virtualenv's, pyenv's or Debian's), never one fixed at build time. Empty if none.
+std::filesystem::path find_on_path(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  if (path == nullptr) return {};
+  std::string_view rest = path;
+  for (;;) {
+    const std::size_t colon = rest.find(':');
+    std::string dir(rest.substr(0, colon));
+    if (dir.empty()) dir = ".";  // POSIX: an empty PATH entry is the working directory
+    const std::filesystem::path candidate = std::filesystem::path(dir) / program;
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(candidate, ec) && access(candidate.c_str(), X_OK) == 0) return candidate;
+    if (colon == std::string_view::npos) return {};
+    rest.remove_prefix(colon + 1);
   }
+}
+
+// What renders the figures. Found before a run, so that a missing python3 or script fails at once instead of
+// after a long run.
+struct Plotter {
+  std::filesystem::path python;
+  std::filesystem::path script;
+  std::string request;  // what asked for the figures, for the messages: "--plots", "compare", ...
+};
+
+// Figures that were asked for but cannot be made are an error (exit code 2), never a warning: a script or CI job
+// that asked for them must not pass without them.
+Plotter find_plotter(std::string request) {
+  Plotter p{find_on_path("python3"), plot_script(), std::move(request)};
+  if (p.python.empty()) {
+    throw std::runtime_error(p.request + ": python3 not found on PATH; the figures need python3 with matplotlib and " +
+                             "numpy (apt-get install python3 python3-matplotlib python3-numpy)");
+  }
+  if (!std::filesystem::is_regular_file(p.script)) {
+    const char* env = std::getenv("REDRES_TOOLS_DIR");
+    const std::string hint = env != nullptr && *env != '\0'
+                                 ? " (REDRES_TOOLS_DIR names a directory without it)"
+                                 : "; redres installs it at " REDRES_TOOLS_RELDIR " relative to its executable, or "
+                                   "set REDRES_TOOLS_DIR to the directory that holds it";
+    throw std::runtime_error(p.request + ": " + p.script.string() + " not found" + hint);
+  }
+  return p;
+}
+
+// Exit code of plot_run.py when matplotlib or numpy cannot be imported (see there).
+constexpr int kPlotMissingLibrary = 3;
+
+// Renders figures with plot_run.py; `args` are the script's arguments, `outputs` where the run's data went (the
+// data stays valid when only the figures fail). Throws when the script cannot run or fails.
+void render_plots(const Plotter& p, std::vector<std::string> args, bool quiet, const std::string& outputs) {
+  if (quiet) args.emplace_back("--quiet");
+  args.insert(args.begin(), {p.python.string(), p.script.string()});
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
   std::cout.flush();
-  // Debian's interpreter has Debian's matplotlib and numpy; another python3 on PATH may not.
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string cmd = python + " \"" + script.string() + "\" " + args + (quiet ? " --quiet" : "");
-  if (std::system(cmd.c_str()) != 0) std::cerr << "warning: plotting failed: " << cmd << "\n";
+  // posix_spawn rather than system(): no shell, so paths need no quoting.
+  pid_t pid = 0;
+  if (const int err = posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ); err != 0) {
+    throw std::runtime_error(p.request + ": cannot start " + p.python.string() + ": " + std::strerror(err));
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw std::runtime_error(p.request + ": waiting for plot_run.py: " + std::strerror(errno));
+  }
+  const std::string kept = "; " + outputs + " were written";
+  if (WIFEXITED(status) && WEXITSTATUS(status) == kPlotMissingLibrary) {
+    throw std::runtime_error(p.request + ": matplotlib is not installed for " + p.python.string() +
+                             ", the python3 on PATH: apt-get install python3-matplotlib python3-numpy (Debian's " +
+                             "python3) or pip install matplotlib numpy, or put a python3 that has them first on PATH" +
+                             kept);
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    const std::string how = WIFEXITED(status) ? "exited with code " + std::to_string(WEXITSTATUS(status))
+                                              : "was killed by signal " + std::to_string(WTERMSIG(status));
+    throw std::runtime_error(p.request + ": plotting failed: " + p.python.string() + " " + p.script.string() + " " +
+                             how + kept);
+  }
 }
 
 struct Outcome {
@@ -85,9 +173,8 @@ struct Outcome {
   RunResult run;
 };
 
-Outcome run_one(const std::string& file, const std::vector<std::string>& overrides, const std::filesystem::path& out,
-                bool quiet) {
-  Outcome o{load_scenario(file, overrides), {}};
+Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet) {
+  Outcome o{std::move(scenario), {}};
   {
     ProgressBar bar(o.scenario.name, quiet);
     o.run = simulate(o.scenario, [&bar](double f, double t) { bar.update(f, t); });
@@ -127,11 +214,18 @@ void add_run_commands(CLI::App& app, Action& action) {
   run->add_option("--out", opts->out, "output directory")->required();
   run->add_option("--set", opts->overrides, "override a scenario value: key.path=value (repeatable)");
   run->add_flag("--quiet", opts->quiet, "no progress bar and no summary line");
-  run->add_flag("--plots", opts->plots, "render the figures (tools/plot_run.py) into the output directory");
+  run->add_flag("--plots", opts->plots,
+                "render the figures into the output directory (plot_run.py with the python3 on PATH, which needs "
+                "matplotlib; exit code 2 when they cannot be made)");
   run->callback([opts, &action] {
     action = [opts] {
-      const Outcome o = run_one(opts->scenarios.front(), opts->overrides, opts->out, opts->quiet);
-      if (opts->plots || o.scenario.plots) render_plots("\"" + opts->out + "\"", opts->quiet);
+      Scenario scenario = load_scenario(opts->scenarios.front(), opts->overrides);
+      std::optional<Plotter> plotter;
+      if (opts->plots || scenario.plots) {
+        plotter = find_plotter(opts->plots ? "--plots" : opts->scenarios.front() + ": [output] plots = true");
+      }
+      const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet);
+      if (plotter) render_plots(*plotter, {opts->out}, opts->quiet, "trajectory.csv and summary.json in " + opts->out);
       return o.run.failures > 0 ? kExitFailedSteps : kExitOk;
     };
   });
@@ -159,6 +253,8 @@ void add_run_commands(CLI::App& app, Action& action) {
   compare->callback([opts, &action] {
     action = [opts] {
       const std::filesystem::path out = opts->out;
+      std::optional<Plotter> plotter;
+      if (!opts->no_plots) plotter = find_plotter("compare (--no-plots skips the figures)");
       std::filesystem::create_directories(out);
       std::string md = table_row({"scenario", "engine", "max position error (m)", "w(0)", "w(T)", "min w",
                                   "mean w", "norm theta_dot(0)", "norm theta_dot(T)", "mean iterations", "failures",
@@ -167,11 +263,11 @@ void add_run_commands(CLI::App& app, Action& action) {
       std::string csv =
           "scenario,engine,max_position_error,w_initial,w_final,w_min,w_mean,initial_joint_velocity_norm,"
           "final_joint_velocity_norm,mean_iterations,failures,wall_time_s\n";
-      std::string dirs;
+      std::vector<std::string> plot_args = {"--compare"};
       int failures = 0;
       for (const auto& file : opts->scenarios) {
         const std::string name = std::filesystem::path(file).stem().string();
-        const Outcome o = run_one(file, opts->overrides, out / name, opts->quiet);
+        const Outcome o = run_one(load_scenario(file, opts->overrides), out / name, opts->quiet);
         failures += o.run.failures;
         const nlohmann::json s = nlohmann::json::parse(summary_json(o.scenario, o.run));
         const std::vector<std::string> cells = {
@@ -184,12 +280,15 @@ void add_run_commands(CLI::App& app, Action& action) {
         md += table_row(cells);
         for (std::size_t c = 0; c < cells.size(); ++c) csv += (c ? "," : "") + cells[c];
         csv += "\n";
-        dirs += " \"" + (out / name).string() + "\"";
+        plot_args.push_back((out / name).string());
       }
       std::ofstream(out / "comparison.md") << md;
       std::ofstream(out / "comparison.csv") << csv;
       if (!opts->quiet) std::cout << "\n" << md << "\nwritten: " << (out / "comparison.md").string() << "\n";
-      if (!opts->no_plots) render_plots("--compare" + dirs + " --out \"" + out.string() + "\"", opts->quiet);
+      if (plotter) {
+        plot_args.insert(plot_args.end(), {"--out", out.string()});
+        render_plots(*plotter, std::move(plot_args), opts->quiet, "the runs and comparison.md in " + out.string());
+      }
       return failures > 0 ? kExitFailedSteps : kExitOk;
     };
   });

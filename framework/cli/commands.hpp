@@ -7,7 +7,7 @@
 
 namespace redres::cli {
 
-/// Exit codes (DESIGN section 6). kExitBadInput is every error that stops a command doing what it was asked:
+/// Exit codes (docs/output_formats.md). kExitBadInput is every error that stops a command doing what it was asked:
 /// bad input, and also figures asked for (`run --plots`, `[output] plots = true`, `compare` without `--no-plots`)
 /// that cannot be made (no python3 on PATH, no matplotlib, no plot_run.py, or the script failed). It takes
 /// precedence over kExitFailedSteps.
@@ -24,7 +24,14 @@ void add_robot_command(CLI::App& app, Action& action);
 /// `redres run`, `redres validate`, `redres compare`.
 void add_run_commands(CLI::App& app, Action& action);
 
-/// `redres plugins [--json]`.
+/// `redres plugins [--json] [--check]`.
 void add_plugins_command(CLI::App& app, Action& action);
+
+/// Prints every registry (text or JSON).
+void print_plugins(bool json);
+
+/// Runs the registry conformance checks on every registered plugin; prints one line per check; returns the number
+/// of failures.
+int check_plugins(std::ostream& out);
 
 }  // namespace redres::cli

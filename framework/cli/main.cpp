@@ -1,16 +1,24 @@
 // redres command-line interface. Only main() catches: configuration errors and API misuse exit with code 2 and a
 // message on stderr that starts with "file:line:col:" when a file is at fault.
 
+#include <filesystem>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "redres/error.hpp"
+#include "redres/plugin_loader.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"redres: redundancy resolution of redundant manipulators (QP from plugins, solved as an LVI)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "redres 0.1.0");
   redres::cli::Action action;
+  std::vector<std::string> plugin_libraries;
+  app.add_option("--plugin", plugin_libraries,
+                 "load a plugin library (.so) before the command (repeatable); REDRES_PLUGIN_PATH lists directories "
+                 "whose libraries are all loaded");
   redres::cli::add_robot_command(app, action);
   redres::cli::add_plugins_command(app, action);
   redres::cli::add_run_commands(app, action);
@@ -21,6 +29,11 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : redres::cli::kExitBadInput;
   }
   try {
+    redres::load_plugin_path();
+    for (const auto& lib : plugin_libraries) {
+      redres::load_plugin_library(redres::resolve_plugin_library(lib, std::filesystem::current_path()),
+                                  {"--plugin " + lib, 0, 0});
+    }
     return action ? action() : redres::cli::kExitOk;
   } catch (const redres::ConfigError& e) {
     std::cerr << e.what() << "\n";

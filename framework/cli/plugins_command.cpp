@@ -1,5 +1,6 @@
-// `redres plugins`: every registered objective, constraint, velocity-limit law and LVI engine, with its keys and
-// their defaults.
+// `redres plugins`: every registered objective, constraint, velocity-limit law, path and LVI engine, with its keys:
+// type, unit, default or whether it is required (or one of a group), validity rule and meaning. The listing comes
+// from each plugin's Config schema, so it cannot drift from what the TOML reader accepts.
 
 #include <iomanip>
 #include <iostream>
@@ -8,72 +9,103 @@
 
 #include "commands.hpp"
 #include "redres/lvi.hpp"
+#include "redres/path.hpp"
 #include "redres/plugin.hpp"
+#include "redres/velocity_limit.hpp"
 
 namespace redres::cli {
 
 namespace {
 
+std::string presence_text(const KeyInfo& k) {
+  switch (k.presence) {
+    case Presence::kRequired: return "(required)";
+    case Presence::kGroup: return "(group " + k.group + ")";
+    case Presence::kOptional: break;
+  }
+  return "= " + k.default_text;
+}
+
+void print_keys(const std::vector<KeyInfo>& keys) {
+  for (const KeyInfo& k : keys) {
+    std::cout << "      " << std::left << std::setw(16) << k.name << std::setw(14) << presence_text(k) << std::right
+              << " " << k.help;
+    std::string facts = k.type;
+    if (!k.unit.empty()) facts += ", " + k.unit;
+    if (!k.rule.empty()) facts += ", " + k.rule;
+    std::cout << " [" << facts << "]\n";
+  }
+}
+
 template <class R>
-void print_registry(const R& registry, const std::string& title, const std::vector<KeySpec>& common) {
+void print_registry(const R& registry, const std::string& title, const std::vector<KeyInfo>& common,
+                    const std::string& common_title) {
   std::cout << title << "\n";
+  if (!common.empty()) {
+    std::cout << "  " << common_title << "\n";
+    print_keys(common);
+  }
   for (const auto* e : registry.entries()) {
-    std::cout << "  " << e->type << "\n      " << e->summary << "\n";
-    for (const auto* keys : {&e->keys, &common}) {
-      for (const KeySpec& k : *keys) {
-        std::cout << "      " << std::left << std::setw(16) << k.name << std::setw(12)
-                  << (k.default_value.empty() ? "(required)" : "= " + k.default_value) << std::right << " "
-                  << k.description << "\n";
-      }
-    }
+    std::cout << "  " << e->type << (e->origin == "built-in" ? "" : "   (from " + e->origin + ")") << "\n      "
+              << e->summary << "\n";
+    print_keys(e->keys);
+    for (const auto& [group, rule] : e->groups) std::cout << "      group " << group << ": " << rule << "\n";
   }
   std::cout << "\n";
+}
+
+nlohmann::json keys_json(const std::vector<KeyInfo>& keys) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const KeyInfo& k : keys) {
+    const char* presence = k.presence == Presence::kRequired ? "required"
+                           : k.presence == Presence::kGroup  ? "group"
+                                                             : "optional";
+    nlohmann::json j = {{"name", k.name}, {"presence", presence}, {"type", k.type}, {"unit", k.unit},
+                        {"rule", k.rule}, {"description", k.help}};
+    if (k.presence == Presence::kOptional) j["default"] = k.default_text;
+    if (k.presence == Presence::kGroup) j["group"] = k.group;
+    out.push_back(j);
+  }
+  return out;
 }
 
 template <class R>
 nlohmann::json registry_json(const R& registry) {
   nlohmann::json out = nlohmann::json::array();
   for (const auto* e : registry.entries()) {
-    nlohmann::json keys = nlohmann::json::array();
-    for (const KeySpec& k : e->keys) {
-      keys.push_back({{"name", k.name}, {"default", k.default_value}, {"description", k.description}});
-    }
-    out.push_back({{"type", e->type}, {"summary", e->summary}, {"keys", keys}});
+    nlohmann::json groups = nlohmann::json::object();
+    for (const auto& [group, rule] : e->groups) groups[group] = rule;
+    out.push_back({{"type", e->type}, {"summary", e->summary}, {"origin", e->origin}, {"keys", keys_json(e->keys)},
+                   {"groups", groups}});
   }
   return out;
 }
 
 }  // namespace
 
-void add_plugins_command(CLI::App& app, Action& action) {
-  auto json = std::make_shared<bool>(false);
-  CLI::App* cmd = app.add_subcommand("plugins", "List every registered plugin with its keys and defaults");
-  cmd->add_flag("--json", *json, "print JSON instead of text");
-  cmd->callback([json, &action] {
-    action = [json] {
-      if (*json) {
-        const nlohmann::json out = {{"objectives", registry_json(objective_registry())},
-                                    {"constraints", registry_json(constraint_registry())},
-                                    {"velocity_limits", registry_json(velocity_limit_registry())},
-                                    {"engines", registry_json(engine_registry())}};
-        std::cout << out.dump(2) << "\n";
-        return kExitOk;
-      }
-      const std::vector<KeySpec> plugin_common = {
-          {"name", "the type", "instance name, used in diagnoses"},
-          {"weight", "1.0", "objectives: scales W and zeta; constraints: scales their rows"},
-          {"active", "true", "false builds the plugin but leaves it out of the QP"}};
-      print_registry(objective_registry(), "objectives ([[objectives]] tables in a scenario)", plugin_common);
-      print_registry(constraint_registry(), "constraints ([[constraints]] tables in a scenario)", plugin_common);
-      print_registry(velocity_limit_registry(), "velocity-limit laws ([joints.velocity_limit] in a robot file)", {});
-      print_registry(engine_registry(), "LVI engines (`engine` in a scenario's [solver] table)",
-                     {{"tolerance", "1e-6", "stopping test ||e(u)||_2 <= tolerance"},
-                      {"varpi", "1e6", "bound on the duals standing for infinity"},
-                      {"max_iterations", "20000", "iteration cap per solve"},
-                      {"warm_start", "true", "start each solve from the previous u"}});
-      return kExitOk;
-    };
-  });
+void print_plugins(bool json) {
+  if (json) {
+    const nlohmann::json out = {{"objectives", registry_json(objective_registry())},
+                                {"objective_common_keys", keys_json(objective_common_keys())},
+                                {"constraints", registry_json(constraint_registry())},
+                                {"constraint_common_keys", keys_json(constraint_common_keys())},
+                                {"velocity_limits", registry_json(velocity_limit_registry())},
+                                {"paths", registry_json(path_registry())},
+                                {"path_common_keys", keys_json(describe_keys(PathPlacement::schema()))},
+                                {"engines", registry_json(engine_registry())},
+                                {"solver_common_keys", keys_json(solver_common_keys())}};
+    std::cout << out.dump(2) << "\n";
+    return;
+  }
+  print_registry(objective_registry(), "objectives ([[objectives]] tables in a scenario)", objective_common_keys(),
+                 "keys of every objective:");
+  print_registry(constraint_registry(), "constraints ([[constraints]] tables in a scenario; hard, no weight)",
+                 constraint_common_keys(), "keys of every constraint:");
+  print_registry(velocity_limit_registry(), "velocity-limit laws ([joints.velocity_limit] in a robot file)", {}, "");
+  print_registry(path_registry(), "paths (the [path] table of a scenario)", describe_keys(PathPlacement::schema()),
+                 "keys of every path (placement and timing):");
+  print_registry(engine_registry(), "LVI engines (the [solver] table of a scenario)", solver_common_keys(),
+                 "keys of every engine:");
 }
 
 }  // namespace redres::cli

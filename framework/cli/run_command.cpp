@@ -18,9 +18,8 @@
 #include <stdexcept>
 #include <string_view>
 
-#include <nlohmann/json.hpp>
-
 #include "commands.hpp"
+#include "redres/run_output.hpp"
 #include "redres/scenario.hpp"
 
 extern char** environ;  // the environment plot_run.py inherits (POSIX leaves the declaration to the program)
@@ -171,23 +170,24 @@ void render_plots(const Plotter& p, std::vector<std::string> args, bool quiet, c
 struct Outcome {
   Scenario scenario;
   RunResult run;
+  RunSummary summary;
 };
 
 Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet) {
-  Outcome o{std::move(scenario), {}};
+  Outcome o{std::move(scenario), {}, {}};
   {
     ProgressBar bar(o.scenario.name, quiet);
     o.run = simulate(o.scenario, [&bar](double f, double t) { bar.update(f, t); });
   }
-  write_run(o.scenario, o.run, out);
+  o.summary = summarise(o.scenario, o.run);
+  write_run(o.run, o.summary, out);
   if (!quiet) {
-    const nlohmann::json s = nlohmann::json::parse(summary_json(o.scenario, o.run));
-    std::cout << std::setprecision(4) << o.scenario.name << ": " << s["steps"] << " steps of " << o.scenario.tau
-              << " s, engine " << o.run.engine << ", max position error " << s["max_position_error"].get<double>()
-              << " m, w " << s["manipulability"]["initial"].get<double>() << " -> "
-              << s["manipulability"]["final"].get<double>() << ", " << o.run.failures << " failed steps, "
-              << o.run.wall_time_s << " s -> " << out.string() << "\n";
-    if (o.run.failures > 0) std::cout << "  first failure: " << o.run.first_failure << "\n";
+    const RunSummary& s = o.summary;
+    std::cout << std::setprecision(4) << s.name << ": " << s.steps << " steps of " << s.tau << " s, engine "
+              << s.solver.engine << ", max position error " << s.max_position_error << " m, w "
+              << s.manipulability.initial << " -> " << s.manipulability.final << ", " << s.solver.failures
+              << " failed steps, " << s.wall_time_s << " s -> " << out.string() << "\n";
+    if (s.solver.failures > 0) std::cout << "  first failure: " << s.solver.first_failure << "\n";
   }
   return o;
 }
@@ -269,14 +269,12 @@ void add_run_commands(CLI::App& app, Action& action) {
         const std::string name = std::filesystem::path(file).stem().string();
         const Outcome o = run_one(load_scenario(file, opts->overrides), out / name, opts->quiet);
         failures += o.run.failures;
-        const nlohmann::json s = nlohmann::json::parse(summary_json(o.scenario, o.run));
+        const RunSummary& s = o.summary;
         const std::vector<std::string> cells = {
-            o.scenario.name, o.run.engine, num(s["max_position_error"].get<double>(), 4),
-            num(s["manipulability"]["initial"].get<double>()), num(s["manipulability"]["final"].get<double>()),
-            num(s["manipulability"]["min"].get<double>()), num(s["manipulability"]["mean"].get<double>()),
-            num(s["initial_joint_velocity_norm"].get<double>(), 4), num(s["final_joint_velocity_norm"].get<double>(), 4),
-            num(s["solver"]["mean_iterations"].get<double>(), 4), std::to_string(o.run.failures),
-            num(o.run.wall_time_s, 3)};
+            s.name, s.solver.engine, num(s.max_position_error, 4), num(s.manipulability.initial),
+            num(s.manipulability.final), num(s.manipulability.min), num(s.manipulability.mean),
+            num(s.initial_joint_velocity_norm, 4), num(s.final_joint_velocity_norm, 4),
+            num(s.solver.mean_iterations, 4), std::to_string(s.solver.failures), num(s.wall_time_s, 3)};
         md += table_row(cells);
         for (std::size_t c = 0; c < cells.size(); ++c) csv += (c ? "," : "") + cells[c];
         csv += "\n";

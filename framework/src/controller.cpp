@@ -29,12 +29,30 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
   ctx_.r_d_dot = &r_d_dot_;
 }
 
-StepOutput Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t) {
+StepOutput Controller::make_output() const {
+  StepOutput out;
+  out.theta_dot = Eigen::VectorXd::Zero(robot_->dof());
+  out.info.diagnosis.reserve(256);
+  return out;
+}
+
+void Controller::reset() {
+  engine_->reset();
+  orientation_captured_ = false;
+}
+
+void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out) {
   REDRES_REQUIRE(path_ != nullptr, "Controller::step", "a path was given (or pass r_d and r_d_dot)");
   compute_kinematics(*robot_, theta, kin_, level_);
   const int p = path_->dim();
   path_->evaluate(t, r_d_.head(p), r_d_dot_.head(p));
   if (robot_->task_dim() > p) {
+    if (!orientation_set_ && !orientation_captured_) {
+      // Hold the orientation the end effector has at the start.
+      orientation_ = robot_->kind() == ChainKind::kPlanar ? Eigen::Vector3d(0.0, 0.0, kin_.f(2))
+                                                          : Eigen::Vector3d(kin_.f.tail<3>());
+      orientation_captured_ = true;
+    }
     const int rest = robot_->task_dim() - p;
     if (robot_->kind() == ChainKind::kPlanar) {
       r_d_(2) = orientation_.z();
@@ -43,26 +61,29 @@ StepOutput Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, doub
     }
     r_d_dot_.tail(rest).setZero();
   }
-  return solve(t);
+  solve(t, out);
 }
 
-StepOutput Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
-                            const Eigen::Ref<const Eigen::VectorXd>& r_d,
-                            const Eigen::Ref<const Eigen::VectorXd>& r_d_dot) {
+void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
+                      const Eigen::Ref<const Eigen::VectorXd>& r_d, const Eigen::Ref<const Eigen::VectorXd>& r_d_dot,
+                      StepOutput& out) {
   REDRES_REQUIRE(r_d.size() == robot_->task_dim() && r_d_dot.size() == robot_->task_dim(), "Controller::step",
                  "r_d and r_d_dot have task_dim() = " + std::to_string(robot_->task_dim()) + " entries");
   REDRES_REQUIRE(r_d.allFinite() && r_d_dot.allFinite(), "Controller::step", "r_d and r_d_dot are finite");
   compute_kinematics(*robot_, theta, kin_, level_);
   r_d_ = r_d;
   r_d_dot_ = r_d_dot;
-  return solve(t);
+  solve(t, out);
 }
 
-StepOutput Controller::solve(double t) {
+void Controller::solve(double t, StepOutput& out) {
+  REDRES_REQUIRE(out.theta_dot.size() == robot_->dof(), "Controller::step",
+                 "out was made by make_output() (theta_dot has n entries)");
   ctx_.t = t;
   scheme_->build(ctx_, qp_);
   engine_->solve(qp_, result_);
-  return {result_.x, result_.info};
+  out.theta_dot = result_.x;
+  out.info = result_.info;
 }
 
 }  // namespace redres

@@ -12,6 +12,7 @@ const char* to_string(SolverStatus status) {
     case SolverStatus::kMaxIterations: return "max_iterations";
     case SolverStatus::kInfeasible: return "infeasible";
     case SolverStatus::kNumericalError: return "numerical_error";
+    case SolverStatus::kNotRun: return "not_run";
   }
   return "unknown";
 }
@@ -164,24 +165,53 @@ void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
   warm_ = true;
 }
 
+const Schema<SolverSettings>& SolverSettings::schema() {
+  using C = SolverSettings;
+  static const Schema<C> s{
+      {field("tolerance", &C::tolerance, "", "stopping test ||e(u)||_2 <= tolerance", greater(0.0)),
+       field("varpi", &C::varpi, "", "bound on the duals standing for infinity", greater(0.0)),
+       field("max_iterations", &C::max_iterations, "", "iteration cap per solve", at_least<int>(1)),
+       field("warm_start", &C::warm_start, "", "start each solve from the previous u")}};
+  return s;
+}
+
+namespace {
+// `engine` itself, so that the listing and the reading share one definition.
+struct EngineChoice {
+  std::string engine = "projection";
+  static const Schema<EngineChoice>& schema() {
+    static const Schema<EngineChoice> s{{field("engine", &EngineChoice::engine, "", "the LVI engine (see below)")}};
+    return s;
+  }
+};
+}  // namespace
+
+const std::vector<KeyInfo>& solver_common_keys() {
+  static const std::vector<KeyInfo> keys = [] {
+    std::vector<KeyInfo> k = describe_keys(EngineChoice::schema());
+    for (auto& x : describe_keys(SolverSettings::schema())) k.push_back(std::move(x));
+    return k;
+  }();
+  return keys;
+}
+
 std::unique_ptr<LviEngine> make_engine(const TableReader& solver) {
+  EngineChoice choice;
+  read_config(solver, EngineChoice::schema(), choice);
   const EngineRegistry& reg = engine_registry();
-  std::vector<std::string> names;
-  for (const auto* e : reg.entries()) names.push_back(e->type);
-  const std::string engine = solver.choice("engine", names, "projection");
+  const auto* entry = reg.find(choice.engine);
+  if (entry == nullptr) {
+    solver.fail("engine", "expected one of the engines " + reg.names() + ", got '" + choice.engine + "'");
+  }
   SolverSettings s;
-  s.tolerance = solver.number("tolerance", s.tolerance);
-  s.varpi = solver.number("varpi", s.varpi);
-  s.max_iterations = static_cast<int>(solver.integer("max_iterations", s.max_iterations));
-  s.warm_start = solver.boolean("warm_start", s.warm_start);
-  if (!(s.tolerance > 0.0)) solver.fail("tolerance", "expected a tolerance > 0");
-  if (!(s.varpi > 0.0)) solver.fail("varpi", "expected varpi > 0");
-  if (s.max_iterations < 1) solver.fail("max_iterations", "expected max_iterations >= 1");
-  const auto* entry = reg.find(engine);
-  if (entry == nullptr) solver.fail("engine", "unknown engine '" + engine + "'");
-  auto out = entry->make(solver, s);
+  read_config(solver, SolverSettings::schema(), s);
+  const std::any config = entry->read(solver);
   solver.finish();
-  return out;
+  try {
+    return entry->make(config, s);
+  } catch (const FieldError& e) {
+    rethrow_at(solver, e);
+  }
 }
 
 std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSettings& settings) {
@@ -190,8 +220,8 @@ std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSett
     throw std::invalid_argument("make_engine: unknown engine '" + name + "'; known engines: " +
                                 engine_registry().names());
   }
-  const auto file = parse_toml_string("", "<defaults>");
-  return e->make(TableReader::root(file), settings);
+  require_valid(settings, SolverSettings::schema(), "make_engine(" + name + ")");
+  return e->make(e->defaults, settings);
 }
 
 }  // namespace redres

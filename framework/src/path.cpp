@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -9,7 +10,7 @@
 namespace redres {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 }
 
 PathSegment PathSegment::line(const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
@@ -62,6 +63,12 @@ Eigen::Vector3d PathSegment::end() const {
   Eigen::Vector3d p, t;
   at(length, p, t);
   return p;
+}
+
+void plane_axes(const Eigen::Vector3d& n, Eigen::Vector3d& e1, Eigen::Vector3d& e2) {
+  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  e1 = (helper - helper.dot(n) * n).normalized();
+  e2 = n.cross(e1);
 }
 
 PathGeometry strokes_from(std::vector<PathSegment> segments, bool stroke_each) {
@@ -156,59 +163,103 @@ PathRegistry& path_registry() {
   return registry;
 }
 
-std::unique_ptr<Path> make_path(const TableReader& table, const PathContext& context) {
-  PathDefaults defaults;
-  std::unique_ptr<PathGeometry> geometry = path_registry().create(table, context, defaults);
-  const std::string placement = table.choice("placement", {"relative", "absolute"}, "relative");
+const Schema<PathPlacement>& PathPlacement::schema() {
+  using C = PathPlacement;
+  static const Schema<C> s{
+      {field("placement", &C::placement, "", "origin absolute, or relative to the end effector's f(theta(0))"),
+       field("origin", &C::origin, "m", "path origin: [x, y] or [x, y, z] (required with placement = \"absolute\")"),
+       field("rotation_deg", &C::rotation_deg, "deg", "planar: rotation of the shape about z (default: the shape's)"),
+       field("rpy_deg", &C::rpy_deg, "deg", "spatial: roll, pitch, yaw of the shape"),
+       field("timing", &C::timing, "", "timing law sigma(u)"),
+       field("timing_scope", &C::timing_scope, "", "law per stroke or over the whole path (default: the shape's)")},
+      [](const C& c) {
+        if (c.placement == Placement::kAbsolute && !c.origin) {
+          throw FieldError("origin", "expected `origin` (the path origin in base coordinates, m) with placement = "
+                                     "\"absolute\"");
+        }
+      },
+      {}};
+  return s;
+}
+
+namespace {
+
+std::unique_ptr<Path> place(const std::string& type, PathGeometry geometry, const PathPlacement& pl,
+                            const PathContext& context) {
+  const double deg = std::numbers::pi / 180.0;
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-  if (table.has("origin")) {
-    const std::vector<double> o = table.numbers("origin", static_cast<std::size_t>(context.dim));
-    for (int k = 0; k < context.dim; ++k) origin(k) = o[static_cast<std::size_t>(k)];
-  } else if (placement == "absolute") {
-    table.fail("origin", "expected `origin` (the path origin in base coordinates, m) with placement = \"absolute\"");
+  if (pl.origin) {
+    if (static_cast<int>(pl.origin->size()) != context.dim) {
+      throw FieldError("origin", "expected " + std::to_string(context.dim) + " numbers, got " +
+                                     std::to_string(pl.origin->size()));
+    }
+    for (int k = 0; k < context.dim; ++k) origin(k) = (*pl.origin)[static_cast<std::size_t>(k)];
   }
-  if (placement == "relative") origin += context.start;
+  if (pl.placement == Placement::kRelative) origin += context.start;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   if (context.dim == 2) {
-    const double deg = table.number("rotation_deg", defaults.rotation_deg);
-    rotation = Eigen::AngleAxisd(deg * kPi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  } else if (table.has("rpy_deg")) {
-    const std::vector<double> rpy = table.numbers("rpy_deg", 3);
-    rotation = (Eigen::AngleAxisd(rpy[2] * kPi / 180.0, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(rpy[1] * kPi / 180.0, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(rpy[0] * kPi / 180.0, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
+    if (pl.rpy_deg) throw FieldError("rpy_deg", "is for spatial tasks; a planar path turns by `rotation_deg`");
+    const double angle = pl.rotation_deg.value_or(geometry.rotation_deg) * deg;
+    rotation = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  } else {
+    if (pl.rotation_deg) throw FieldError("rotation_deg", "is for planar tasks; a spatial path turns by `rpy_deg`");
+    if (pl.rpy_deg) {
+      const auto& rpy = *pl.rpy_deg;
+      rotation = (Eigen::AngleAxisd(rpy[2] * deg, Eigen::Vector3d::UnitZ()) *
+                  Eigen::AngleAxisd(rpy[1] * deg, Eigen::Vector3d::UnitY()) *
+                  Eigen::AngleAxisd(rpy[0] * deg, Eigen::Vector3d::UnitX()))
+                     .toRotationMatrix();
+    }
   }
-  const std::string law = table.choice("timing", {"cycloidal", "sin2", "quintic"}, "cycloidal");
-  const std::string scope = table.choice("timing_scope", {"per_stroke", "whole"},
-                                         defaults.scope == TimingScope::kPerStroke ? "per_stroke" : "whole");
-  table.finish();
-  const TimingLaw tl = law == "cycloidal" ? TimingLaw::kCycloidal
-                                          : (law == "sin2" ? TimingLaw::kSin2 : TimingLaw::kQuintic);
-  const TimingScope ts = scope == "per_stroke" ? TimingScope::kPerStroke : TimingScope::kWhole;
+  const TimingScope scope = pl.timing_scope.value_or(geometry.scope);
   if (context.dim == 2) {
-    for (auto& stroke : geometry->strokes) {
-      for (auto& seg : stroke) {
+    for (const auto& stroke : geometry.strokes) {
+      for (const auto& seg : stroke) {
         if (seg.kind == PathSegment::Kind::kHelix || seg.a.z() != 0.0 || seg.b.z() != 0.0) {
-          table.fail("type", "this path is spatial, but the robot's task is planar");
+          throw FieldError("type", "this path is spatial, but the robot's task is planar");
         }
       }
     }
   }
-  const std::string type = table.string("type");
   std::size_t strokes = 0;
   double length = 0.0;
-  for (const auto& stroke : geometry->strokes) {
+  for (const auto& stroke : geometry.strokes) {
     strokes += stroke.empty() ? 0 : 1;
     for (const auto& seg : stroke) length += seg.length;
   }
-  if (!(length > 0.0)) table.fail("type", "the path has zero length");
+  if (!(length > 0.0)) throw FieldError("type", "the path has zero length");
   std::ostringstream d;
   d.precision(4);
-  d << type << " (" << strokes << (strokes == 1 ? " stroke, " : " strokes, ") << length << " m, " << law << " "
-    << (ts == TimingScope::kPerStroke ? "per stroke" : "over the whole path") << ")";
-  return std::make_unique<Path>(std::move(*geometry), context.dim, context.duration, tl, ts, rotation, origin,
+  d << type << " (" << strokes << (strokes == 1 ? " stroke, " : " strokes, ") << length << " m, "
+    << config_io::enum_name(pl.timing) << " "
+    << (scope == TimingScope::kPerStroke ? "per stroke" : "over the whole path") << ")";
+  return std::make_unique<Path>(std::move(geometry), context.dim, context.duration, pl.timing, scope, rotation, origin,
                                 d.str());
+}
+
+}  // namespace
+
+std::unique_ptr<Path> make_path(const TableReader& table, const PathContext& context) {
+  PathPlacement placement;
+  read_config(table, PathPlacement::schema(), placement);
+  std::unique_ptr<PathGeometry> geometry = path_registry().create(table, context);
+  table.finish();
+  try {
+    return place(table.string("type"), std::move(*geometry), placement, context);
+  } catch (const FieldError& e) {
+    rethrow_at(table, e);
+  }
+}
+
+std::unique_ptr<Path> make_path(const std::string& type, const std::any& config, const PathPlacement& placement,
+                                const PathContext& context) {
+  try {
+    require_valid(placement, PathPlacement::schema(), "path placement");
+    std::unique_ptr<PathGeometry> geometry = path_registry().create(type, config, context);
+    return place(type, std::move(*geometry), placement, context);
+  } catch (const FieldError& e) {
+    throw std::invalid_argument("path '" + type + "': " + e.what());
+  }
 }
 
 }  // namespace redres

@@ -1,5 +1,7 @@
 #include "redres/robot.hpp"
 
+#include "redres/plugin_loader.hpp"
+
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -150,7 +152,7 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, std::set<std::str
 
   const TableReader law_table = r.table("velocity_limit");
   const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' velocity_limit");
-  jt.velocity_limit = velocity_limit_registry().create(law_reader);
+  jt.velocity_limit = make_velocity_limit(law_reader);
   law_reader.finish();
   if (auto bad = check_velocity_law(*jt.velocity_limit, jt.lower, jt.upper)) {
     law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() + "' is invalid at theta = " +
@@ -168,6 +170,7 @@ RobotModel load_robot(const std::filesystem::path& file) {
 }
 
 RobotModel load_robot(const TableReader& r) {
+  load_plugins_from(r);  // plugin libraries first: their velocity-limit laws may be named below
   RobotSpec spec;
   spec.source = r.file().path.string();
   spec.name = r.string("name");

@@ -82,7 +82,7 @@ void Scheme::build(const Context& ctx, QpProblem& qp) const {
   }
   for (std::size_t k = 0; k < constraints_.size(); ++k) {
     const auto& c = constraints_[k];
-    builder.begin(source++, c->weight(), eq_offset_[k], eq_rows_[k], in_offset_[k], in_rows_[k]);
+    builder.begin(source++, 1.0, eq_offset_[k], eq_rows_[k], in_offset_[k], in_rows_[k]);
     c->contribute(ctx, builder);
     // Inactive constraints leave their rows empty: 0 x = 0 and 0 x <= 0 are always met.
   }

@@ -4,6 +4,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "redres/formula.hpp"
+
 namespace redres {
 
 namespace {
@@ -120,6 +122,15 @@ double TableReader::to_number(std::string_view key, const toml::node& node, cons
     v = static_cast<double>(i->get());
   } else if (const auto* f = node.as_floating_point()) {
     v = f->get();
+  } else if (const auto* text = node.as_string()) {
+    // Every number in a file may be a constant formula, as theta0 entries are: "pi/2", "-3*pi/4", "0.25*2".
+    try {
+      v = evaluate_constant(text->get());
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(location_of(*file_, node),
+                        prefix() + "key '" + std::string(key) + "': expected " + what + " or a constant formula: " +
+                            e.what());
+    }
   } else {
     throw ConfigError(location_of(*file_, node),
                       prefix() + "key '" + std::string(key) + "': expected " + what + ", got " + describe_type(node));

@@ -10,6 +10,19 @@ VelocityLimitRegistry& velocity_limit_registry() {
   return registry;
 }
 
+toml::table VelocityLimitLaw::config() const {
+  toml::table out;
+  out.insert("type", type_);
+  write_config(out);
+  return out;
+}
+
+std::unique_ptr<VelocityLimitLaw> make_velocity_limit(const TableReader& table) {
+  auto law = velocity_limit_registry().create(table);
+  table.finish();
+  return law;
+}
+
 std::optional<UndefinedAt> check_velocity_law(const VelocityLimitLaw& law, double lo, double hi) {
   if (auto bad = law.undefined_in(lo, hi)) return bad;
   for (int k = 0; k < kVelocityLawSamples; ++k) {

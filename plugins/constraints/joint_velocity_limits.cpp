@@ -1,41 +1,32 @@
-/// `joint_velocity_limits`: the robot's per-joint velocity-limit laws as bounds (eq. 8, VJVL),
-///   scale theta_dot^-(theta) <= x <= scale theta_dot^+(theta).
-/// TOML keys: `scale` (0 < scale <= 1, default 1.0; e.g. 0.9 keeps a 10 % reserve).
+#include "redres/constraints/joint_velocity_limits.hpp"
 
-#include "redres/plugin.hpp"
+#include "redres/velocity_limit.hpp"
 
 namespace redres {
+
+const Schema<JointVelocityLimitsConfig>& JointVelocityLimitsConfig::schema() {
+  using C = JointVelocityLimitsConfig;
+  static const Schema<C> s{{field("scale", &C::scale, "", "fraction of the laws' limits",
+                                  rule<double>("in (0, 1]", [](double v) { return v > 0.0 && v <= 1.0; }))}};
+  return s;
+}
+
+JointVelocityLimits::JointVelocityLimits(const Config& config, const RobotModel& /*robot*/)
+    : Configured(kType, config) {}
+
+void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder) const {
+  const RobotModel& robot = *ctx.robot;
+  const Eigen::VectorXd& theta = ctx.theta();
+  const double scale = config_.scale;
+  for (int j = 0; j < robot.dof(); ++j) {
+    const VelocityBounds b = robot.joint(j).velocity_limit->bounds(theta(j));
+    builder.intersect_bound(j, scale * b.lower, scale * b.upper);
+  }
+}
+
 namespace {
-
-class JointVelocityLimits final : public Constraint {
- public:
-  explicit JointVelocityLimits(const TableReader& config) : Constraint(config), scale_(config.number("scale", 1.0)) {
-    if (!(scale_ > 0.0 && scale_ <= 1.0)) config.fail("scale", "expected 0 < scale <= 1");
-  }
-
- private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override {
-    const RobotModel& robot = *ctx.robot;
-    const Eigen::VectorXd& theta = ctx.theta();
-    for (int j = 0; j < robot.dof(); ++j) {
-      const VelocityBounds b = robot.joint(j).velocity_limit->bounds(theta(j));
-      builder.intersect_bound(j, scale_ * b.lower, scale_ * b.upper);
-    }
-  }
-
-  void write_config(toml::table& out) const override { out.insert("scale", scale_); }
-
-  double scale_;
-};
-
-const bool kRegistered = constraint_registry().add({
-    "joint_velocity_limits",
-    "scale theta_dot^-(theta) <= x <= scale theta_dot^+(theta): the robot's velocity-limit laws (eq. 8, VJVL)",
-    {{"scale", "1.0", "fraction of the law's limits, 0 < scale <= 1"}},
-    [](const TableReader& r, const RobotModel& /*robot*/) -> std::unique_ptr<Constraint> {
-      return std::make_unique<JointVelocityLimits>(r);
-    },
-});
-
+const bool kRegistered = constraint_registry().add_plugin<JointVelocityLimits>(
+    "scale theta_dot^-(theta) <= x <= scale theta_dot^+(theta): the robot's velocity-limit laws (eq. 8, VJVL)");
 }  // namespace
+
 }  // namespace redres

@@ -23,7 +23,7 @@
 #include <cmath>
 #include <limits>
 
-#include "redres/lvi.hpp"
+#include "redres/engines/newton.hpp"
 
 namespace redres {
 namespace {
@@ -36,7 +36,7 @@ constexpr int kMaxNewtonIterations = 100;
 class Newton final : public LviEngine {
  public:
   explicit Newton(const SolverSettings& s) { set_settings(s); }
-  const char* name() const override { return "newton"; }
+  std::string_view name() const override { return "newton"; }
 
  private:
   void do_setup(int n, int m_e, int m_i) override {
@@ -412,14 +412,11 @@ class Newton final : public LviEngine {
   SolverResult fallback_result_;
 };
 
-const bool kRegistered = engine_registry().add({
-    "newton",
-    "semismooth Newton on the reduced eq. 14 (exact; diagonal W, equality rows and bounds; else projection)",
-    {},
-    [](const TableReader& /*r*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
+const bool kRegistered = engine_registry().add<NewtonConfig>(
+    "newton", "semismooth Newton on the reduced eq. 14 (exact; diagonal W, equality rows and bounds; else projection)",
+    [](const NewtonConfig& /*config*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
       return std::make_unique<Newton>(s);
-    },
-});
+    });
 
 }  // namespace
 }  // namespace redres

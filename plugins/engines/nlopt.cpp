@@ -14,7 +14,7 @@
 
 #include <Eigen/QR>
 
-#include "redres/lvi.hpp"
+#include "redres/engines/nlopt.hpp"
 
 namespace redres {
 namespace {
@@ -27,7 +27,7 @@ class NloptSlsqp final : public LviEngine {
   ~NloptSlsqp() override {
     if (opt_ != nullptr) nlopt_destroy(opt_);
   }
-  const char* name() const override { return "nlopt"; }
+  std::string_view name() const override { return "nlopt"; }
 
  private:
   void do_setup(int n, int m_e, int m_i) override {
@@ -179,14 +179,11 @@ class NloptSlsqp final : public LviEngine {
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_;
 };
 
-const bool kRegistered = engine_registry().add({
-    "nlopt",
-    "NLopt SLSQP on the QP (independent cross-check; NLopt allocates its work array per solve)",
-    {},
-    [](const TableReader& /*r*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
+const bool kRegistered = engine_registry().add<NloptConfig>(
+    "nlopt", "NLopt SLSQP on the QP (independent cross-check; NLopt allocates its work array per solve)",
+    [](const NloptConfig& /*config*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
       return std::make_unique<NloptSlsqp>(s);
-    },
-});
+    });
 
 }  // namespace
 }  // namespace redres

@@ -22,7 +22,7 @@
 #include <emmintrin.h>
 #endif
 
-#include "redres/lvi.hpp"
+#include "redres/engines/projection.hpp"
 
 namespace redres {
 namespace {
@@ -33,7 +33,7 @@ inline double box(double v, double lo, double hi) { return std::min(std::max(v, 
 class Projection final : public LviEngine {
  public:
   explicit Projection(const SolverSettings& s) { set_settings(s); }
-  const char* name() const override { return "projection"; }
+  std::string_view name() const override { return "projection"; }
 
  private:
   void do_setup(int n, int m_e, int m_i) override {
@@ -308,14 +308,11 @@ class Projection final : public LviEngine {
   Eigen::VectorXd ux_, uy_, uz_, rx_, ry_, rz_, ex_, ey_, ez_, px_, py_, pz_, ry2_, py2_;
 };
 
-const bool kRegistered = engine_registry().add({
-    "projection",
-    "the paper's eq. 15 (linear convergence; the reference for fidelity)",
-    {},
-    [](const TableReader& /*r*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
+const bool kRegistered = engine_registry().add<ProjectionConfig>(
+    "projection", "the paper's eq. 15 (linear convergence; the reference for fidelity)",
+    [](const ProjectionConfig& /*config*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
       return std::make_unique<Projection>(s);
-    },
-});
+    });
 
 }  // namespace
 }  // namespace redres

@@ -1,28 +1,22 @@
-/// `min_velocity_norm`: the minimum-velocity-norm term x'x/2 (MVN; with no other objective this is the paper's
-/// p = 0 scheme). Adds W += weight * I. TOML keys: only the common ones (`name`, `weight` = 1, `active` = true).
-
-#include "redres/plugin.hpp"
+#include "redres/objectives/min_velocity_norm.hpp"
 
 namespace redres {
+
+const Schema<MinVelocityNormConfig>& MinVelocityNormConfig::schema() {
+  static const Schema<MinVelocityNormConfig> s{};
+  return s;
+}
+
+MinVelocityNorm::MinVelocityNorm(const Config& config, const RobotModel& /*robot*/) : Configured(kType, config) {}
+
+// W = I has no linear term: zeta stays zero, the gradient of a constant potential.
+std::optional<double> MinVelocityNorm::potential(const Context& /*ctx*/) const { return 0.0; }
+
+void MinVelocityNorm::add_to(const Context& /*ctx*/, QpBuilder& builder) const { builder.add_identity(); }
+
 namespace {
-
-class MinVelocityNorm final : public Objective {
- public:
-  explicit MinVelocityNorm(const TableReader& config) : Objective(config) {}
-
- private:
-  void add_to(const Context& /*ctx*/, QpBuilder& builder) const override { builder.add_identity(); }
-  void write_config(toml::table& /*out*/) const override {}
-};
-
-const bool kRegistered = objective_registry().add({
-    "min_velocity_norm",
-    "x'x/2: W += weight * I (MVN, the paper's p = 0)",
-    {},
-    [](const TableReader& r, const RobotModel& /*robot*/) -> std::unique_ptr<Objective> {
-      return std::make_unique<MinVelocityNorm>(r);
-    },
-});
-
+const bool kRegistered =
+    objective_registry().add_plugin<MinVelocityNorm>("x'x/2: W += weight * I (MVN, the paper's p = 0)");
 }  // namespace
+
 }  // namespace redres

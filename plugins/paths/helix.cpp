@@ -1,54 +1,42 @@
-/// `helix`: a helix that starts at the path origin and advances along `axis` (spatial tasks only).
-/// TOML keys: `radius` (m, default 0.04), `pitch` (m per turn, default 0.02), `turns` (default 2),
-/// `axis` (3 numbers, default [0, 0, 1]).
+#include "redres/paths/helix.hpp"
 
 #include <cmath>
-
-#include <Eigen/Geometry>
-
-#include "redres/path.hpp"
+#include <numbers>
 
 namespace redres {
+
+const Schema<HelixConfig>& HelixConfig::schema() {
+  using C = HelixConfig;
+  static const Schema<C> s{{field("radius", &C::radius, "m", "radius", greater(0.0)),
+                            field("pitch", &C::pitch, "m", "advance along the axis per turn"),
+                            field("turns", &C::turns, "", "number of turns", greater(0.0)),
+                            field("axis", &C::axis, "", "helix axis (non-zero)")}};
+  return s;
+}
+
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+std::unique_ptr<PathGeometry> make_helix(const HelixConfig& c, const PathContext& ctx) {
+  if (ctx.dim != 3) throw FieldError("type", "a helix needs a spatial task (3 position rows)");
+  Eigen::Vector3d axis(c.axis[0], c.axis[1], c.axis[2]);
+  if (!(axis.norm() > 0.0)) throw FieldError("axis", "expected a non-zero axis");
+  axis.normalize();
+  Eigen::Vector3d e1, e2;
+  plane_axes(axis, e1, e2);
+  const double two_pi = 2.0 * std::numbers::pi;
+  PathSegment s = PathSegment::arc(-c.radius * e1, c.radius, 0.0, two_pi * c.turns, e1, e2);
+  s.kind = PathSegment::Kind::kHelix;
+  s.axis = axis;
+  s.rise = c.pitch * c.turns;
+  s.length = c.turns * std::hypot(two_pi * c.radius, c.pitch);
+  auto g = std::make_unique<PathGeometry>();
+  g->scope = TimingScope::kWhole;
+  g->strokes.push_back({s});
+  return g;
+}
 
-const bool kRegistered = path_registry().add({
-    "helix",
-    "a helix through the path origin, advancing along `axis` (spatial tasks)",
-    {{"radius", "0.04", "radius (m)"},
-     {"pitch", "0.02", "advance per turn (m)"},
-     {"turns", "2", "number of turns"},
-     {"axis", "[0, 0, 1]", "helix axis"}},
-    [](const TableReader& r, const PathContext& ctx, PathDefaults& defaults) -> std::unique_ptr<PathGeometry> {
-      if (ctx.dim != 3) r.fail("type", "a helix needs a spatial task (3 position rows)");
-      const double radius = r.number("radius", 0.04);
-      const double pitch = r.number("pitch", 0.02);
-      const double turns = r.number("turns", 2.0);
-      if (!(radius > 0.0)) r.fail("radius", "expected a radius > 0 m");
-      if (!(turns > 0.0)) r.fail("turns", "expected turns > 0");
-      Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
-      if (r.has("axis")) {
-        const std::vector<double> v = r.numbers("axis", 3);
-        axis = Eigen::Vector3d(v[0], v[1], v[2]);
-        if (!(axis.norm() > 0.0)) r.fail("axis", "expected a non-zero axis");
-        axis.normalize();
-      }
-      const Eigen::Vector3d helper =
-          std::abs(axis.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-      const Eigen::Vector3d e1 = (helper - helper.dot(axis) * axis).normalized();
-      const Eigen::Vector3d e2 = axis.cross(e1);
-      PathSegment s = PathSegment::arc(-radius * e1, radius, 0.0, 2.0 * kPi * turns, e1, e2);
-      s.kind = PathSegment::Kind::kHelix;
-      s.axis = axis;
-      s.rise = pitch * turns;
-      s.length = turns * std::hypot(2.0 * kPi * radius, pitch);
-      defaults.scope = TimingScope::kWhole;
-      auto g = std::make_unique<PathGeometry>();
-      g->strokes.push_back({s});
-      return g;
-    },
-});
+const bool kRegistered = path_registry().add<HelixConfig>(
+    "helix", "a helix through the path origin, advancing along `axis` (spatial tasks)", make_helix);
 
 }  // namespace
 }  // namespace redres

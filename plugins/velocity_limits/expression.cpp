@@ -1,46 +1,50 @@
-/// `expression`: the limits are formulas of the joint position `theta`, evaluated with muParser
-/// (e.g. upper = "1.5 + 0.5*cos(theta)"). The constants `pi` and `e` are defined.
-/// TOML keys: `lower` (formula, rad/s or m/s, required), `upper` (formula, required).
-
-#include <stdexcept>
-
-#include "redres/formula.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/velocity_limits/expression.hpp"
 
 namespace redres {
-namespace {
 
-Formula compile(const TableReader& r, const char* key) {
-  const std::string text = r.string(key);
+namespace {
+bool parses(const std::string& text) {
   try {
-    return Formula(text, {"theta"});
-  } catch (const std::invalid_argument& e) {
-    r.fail(key, std::string("expected a formula of theta: ") + e.what());
+    (void)Formula(text, {"theta"});
+    return true;
+  } catch (const std::invalid_argument&) {
+    return false;
   }
 }
 
-class ExpressionLaw final : public VelocityLimitLaw {
- public:
-  explicit ExpressionLaw(const TableReader& r) : lower_(compile(r, "lower")), upper_(compile(r, "upper")) {}
-
-  VelocityBounds bounds(double theta) const override { return {lower_.evaluate({theta}), upper_.evaluate({theta})}; }
-  std::string type() const override { return "expression"; }
-  std::string describe() const override {
-    return "expression(lower=\"" + lower_.text() + "\", upper=\"" + upper_.text() + "\")";
+Formula compile(const std::string& text, const char* key) {
+  try {
+    return Formula(text, {"theta"});
+  } catch (const std::invalid_argument& e) {
+    throw FieldError(key, std::string("expected a formula of theta: ") + e.what());
   }
-
- private:
-  Formula lower_;
-  Formula upper_;
-};
-
-const bool kRegistered = velocity_limit_registry().add({
-    "expression",
-    "limits given as muParser formulas of theta",
-    {{"lower", "", "formula of theta for the lower limit (rad/s or m/s)"},
-     {"upper", "", "formula of theta for the upper limit"}},
-    [](const TableReader& r) -> std::unique_ptr<VelocityLimitLaw> { return std::make_unique<ExpressionLaw>(r); },
-});
-
+}
 }  // namespace
+
+const Schema<ExpressionLawConfig>& ExpressionLawConfig::schema() {
+  using C = ExpressionLawConfig;
+  static const Schema<C> s{
+      {field("lower", &C::lower, "rad/s or m/s", "formula of theta for the lower limit").required(),
+       field("upper", &C::upper, "rad/s or m/s", "formula of theta for the upper limit").required()},
+      [](const C& c) {
+        // Compiled here so that a syntax error names its key (and, from TOML, its file:line:col).
+        if (!parses(c.lower)) (void)compile(c.lower, "lower");
+        if (!parses(c.upper)) (void)compile(c.upper, "upper");
+      },
+      {}};
+  return s;
+}
+
+ExpressionLaw::ExpressionLaw(const Config& config)
+    : Configured(kType, config), lower_(compile(config_.lower, "lower")), upper_(compile(config_.upper, "upper")) {}
+
+std::string ExpressionLaw::describe() const {
+  return "expression(lower=\"" + config_.lower + "\", upper=\"" + config_.upper + "\")";
+}
+
+namespace {
+const bool kRegistered =
+    velocity_limit_registry().add_plugin<ExpressionLaw>("limits given as muParser formulas of theta");
+}  // namespace
+
 }  // namespace redres

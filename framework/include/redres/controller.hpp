@@ -15,10 +15,12 @@
 
 namespace redres {
 
-/// One control step's outcome; refers to buffers inside the Controller (valid until the next step).
+/// One control step's outcome, owned by the caller: step() writes into it, and nothing else does, so two outputs
+/// (e.g. the two stages of Heun's method) never alias. Make one with Controller::make_output() (sized once);
+/// step() then reuses its buffers without allocating (the diagnosis text of a failed step excepted).
 struct StepOutput {
-  const Eigen::VectorXd& theta_dot;  //!< x = theta_dot (n), inside the merged bounds
-  const SolverInfo& info;            //!< status, iterations, residual, engine, diagnosis
+  Eigen::VectorXd theta_dot;  //!< x = theta_dot (n), inside the merged bounds
+  SolverInfo info;            //!< status, iterations, residual, engine, diagnosis
 };
 
 /// Runs the scheme for one robot. The robot, scheme, engine and path must outlive the controller.
@@ -29,19 +31,29 @@ class Controller {
   Controller(const RobotModel& robot, const Scheme& scheme, LviEngine& engine, const Path* path, double T,
              double tau);
 
-  /// One step at (theta, t) with the desired values from the path (orientation rows, if the task has them,
-  /// hold the reference orientation).
-  StepOutput step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t);
-  /// One step with caller-supplied r_d and r_d_dot (size task_dim()).
-  StepOutput step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
-                  const Eigen::Ref<const Eigen::VectorXd>& r_d, const Eigen::Ref<const Eigen::VectorXd>& r_d_dot);
+  /// An output sized for this controller.
+  [[nodiscard]] StepOutput make_output() const;
 
-  /// For pose tasks: the orientation (rotation vector) the path's steps hold. Default: zero.
-  void set_orientation_reference(const Eigen::Vector3d& rotation_vector) { orientation_ = rotation_vector; }
+  /// One step at (theta, t) with the desired values from the path. Orientation rows, if the task has them, hold the
+  /// orientation reference: the one set with set_orientation_reference(), or else the end effector's orientation
+  /// at the first such step after construction or reset().
+  void step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out);
+  /// One step with caller-supplied r_d and r_d_dot (size task_dim()).
+  void step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, const Eigen::Ref<const Eigen::VectorXd>& r_d,
+            const Eigen::Ref<const Eigen::VectorXd>& r_d_dot, StepOutput& out);
+
+  /// For tasks with orientation rows: the orientation the path's steps hold (planar: the angle in z; spatial: a
+  /// rotation vector).
+  void set_orientation_reference(const Eigen::Vector3d& rotation_vector) {
+    orientation_ = rotation_vector;
+    orientation_set_ = true;
+  }
+  /// The orientation reference (meaningful once set or captured).
+  [[nodiscard]] const Eigen::Vector3d& orientation_reference() const noexcept { return orientation_; }
   /// Computes at least this much kinematics each step (e.g. kManipulability to record w with any scheme).
   void set_kinematics_level(KinematicsLevel level) { level_ = std::max(level_, level); }
-  /// Forgets the engine's warm start.
-  void reset() { engine_->reset(); }
+  /// Forgets the engine's warm start and a captured (not an explicitly set) orientation reference.
+  void reset();
 
   /// Kinematics, QP, desired values and the full solver result of the last step.
   [[nodiscard]] const KinematicsData& kinematics() const noexcept { return kin_; }
@@ -52,7 +64,7 @@ class Controller {
   [[nodiscard]] const RobotModel& robot() const noexcept { return *robot_; }
 
  private:
-  StepOutput solve(double t);
+  void solve(double t, StepOutput& out);
 
   const RobotModel* robot_;
   const Scheme* scheme_;
@@ -63,6 +75,8 @@ class Controller {
   SolverResult result_;
   Eigen::VectorXd r_d_, r_d_dot_;
   Eigen::Vector3d orientation_ = Eigen::Vector3d::Zero();
+  bool orientation_set_ = false;       // by set_orientation_reference()
+  bool orientation_captured_ = false;  // from the first path-driven step
   KinematicsLevel level_ = KinematicsLevel::kPosition;
   Context ctx_;
 };

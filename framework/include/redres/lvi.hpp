@@ -18,6 +18,8 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -32,6 +34,8 @@ struct SolverSettings {
   double varpi = 1e6;          //!< bound on the duals standing for infinity (the paper's 1e6)
   int max_iterations = 20000;  //!< iteration cap per solve
   bool warm_start = true;      //!< start from the previous solve's u
+
+  static const Schema<SolverSettings>& schema();
 };
 
 /// Outcome of one solve.
@@ -40,17 +44,19 @@ enum class SolverStatus {
   kMaxIterations,  //!< the iteration cap was reached first
   kInfeasible,     //!< bounds conflict, or J x = d cannot be met inside the bounds
   kNumericalError, //!< the iteration broke down (e.g. a zero step); see the diagnosis
+  kNotRun,         //!< no solve has run yet (recorded codes 0-3 keep their meaning)
 };
 
-/// "solved", "max_iterations", "infeasible", "numerical_error".
+/// "solved", "max_iterations", "infeasible", "numerical_error", "not_run".
 [[nodiscard]] const char* to_string(SolverStatus status);
 
 /// What a solve reports besides its answer.
 struct SolverInfo {
-  SolverStatus status = SolverStatus::kSolved;  //!< outcome
+  SolverStatus status = SolverStatus::kNotRun;  //!< outcome
   int iterations = 0;                           //!< iterations of the engine that ran
   double residual = 0.0;                        //!< ||e(u)||_2 at the returned u
-  const char* engine = "";                      //!< the engine that actually ran (a fallback names itself)
+  std::string_view engine;                      //!< the engine that actually ran (a fallback names itself);
+                                                //!< compares by value; refers to the engine's static name
   std::string diagnosis;                        //!< empty when solved; otherwise which joint, bound, plugin
 };
 
@@ -79,8 +85,8 @@ class LviEngine {
   void solve(const QpProblem& qp, SolverResult& result);
   /// Forgets the warm start.
   void reset() { warm_ = false; }
-  /// Engine name ("projection", ...).
-  [[nodiscard]] virtual const char* name() const = 0;
+  /// Engine name ("projection", ...): the registry type, a static string.
+  [[nodiscard]] virtual std::string_view name() const = 0;
   /// The settings.
   [[nodiscard]] const SolverSettings& settings() const noexcept { return settings_; }
   /// Replaces the settings.
@@ -103,7 +109,8 @@ class LviEngine {
 /// ||e(u)||_2 of the LVI (eq. 14) at u = [x; y; z].
 [[nodiscard]] double lvi_residual(const QpProblem& qp, const SolverResult& u, double varpi);
 
-/// The registry of engines; factories read engine-specific keys (if any) from the [solver] table.
+/// The registry of engines. An engine is a plugin with its own Config (engine-specific keys in the [solver]
+/// table; the built-in engines have none) and receives the common SolverSettings.
 using EngineRegistry = Registry<LviEngine, const SolverSettings&>;
 /// The process-wide engine registry.
 EngineRegistry& engine_registry();
@@ -112,7 +119,10 @@ EngineRegistry& engine_registry();
 /// builds the engine; unknown keys are ConfigErrors.
 [[nodiscard]] std::unique_ptr<LviEngine> make_engine(const TableReader& solver);
 
-/// Builds an engine by name with the given settings (for code that does not read TOML).
+/// Builds an engine by name with the given settings and its default Config (for code that does not read TOML).
 [[nodiscard]] std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSettings& settings = {});
+
+/// The [solver] table's `engine` key and the common settings, for the listing.
+[[nodiscard]] const std::vector<KeyInfo>& solver_common_keys();
 
 }  // namespace redres

@@ -14,15 +14,19 @@
 /// translated to `origin`, which is absolute (`placement = "absolute"`) or an offset from the end effector's
 /// initial position f(theta(0)) (`placement = "relative"`, the default).
 ///
-/// Paths are plugins: `type` selects a factory in path_registry(); the common keys above are read by the
-/// framework, the geometry keys by the path type.
+/// Paths are plugins: `type` selects a factory in path_registry(); the placement and timing keys above
+/// (PathPlacement) are read by the framework, the geometry keys by the path type's Config.
 
+#include <any>
+#include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "redres/config.hpp"
 #include "redres/registry.hpp"
 
 namespace redres {
@@ -55,19 +59,41 @@ struct PathSegment {
   [[nodiscard]] Eigen::Vector3d end() const;
 };
 
-/// Geometry in local path coordinates: strokes of consecutive segments.
-struct PathGeometry {
-  std::vector<std::vector<PathSegment>> strokes;  //!< each stroke is drawn from rest to rest (per_stroke timing)
-};
-
-/// Geometry from consecutive segments: one stroke, or (`stroke_each`) one stroke per segment, each drawn from rest
-/// to rest.
-[[nodiscard]] PathGeometry strokes_from(std::vector<PathSegment> segments, bool stroke_each);
+/// Orthonormal in-plane axes e1, e2 (with e1 x e2 = n) for a unit plane normal n.
+void plane_axes(const Eigen::Vector3d& n, Eigen::Vector3d& e1, Eigen::Vector3d& e2);
 
 /// Timing law sigma(u).
 enum class TimingLaw { kCycloidal, kSin2, kQuintic };
 /// Where the timing law applies.
 enum class TimingScope { kPerStroke, kWhole };
+/// Where the path origin is.
+enum class Placement { kRelative, kAbsolute };
+
+inline auto enum_names(TimingLaw) {
+  return std::array{std::pair{TimingLaw::kCycloidal, std::string_view("cycloidal")},
+                    std::pair{TimingLaw::kSin2, std::string_view("sin2")},
+                    std::pair{TimingLaw::kQuintic, std::string_view("quintic")}};
+}
+inline auto enum_names(TimingScope) {
+  return std::array{std::pair{TimingScope::kPerStroke, std::string_view("per_stroke")},
+                    std::pair{TimingScope::kWhole, std::string_view("whole")}};
+}
+inline auto enum_names(Placement) {
+  return std::array{std::pair{Placement::kRelative, std::string_view("relative")},
+                    std::pair{Placement::kAbsolute, std::string_view("absolute")}};
+}
+
+/// Geometry in local path coordinates: strokes of consecutive segments, and the placement and timing the shape
+/// prefers where the scenario does not say (e.g. the letter R is upright when rotated by 180 degrees).
+struct PathGeometry {
+  std::vector<std::vector<PathSegment>> strokes;  //!< each stroke is drawn from rest to rest (per_stroke timing)
+  double rotation_deg = 0.0;                      //!< default planar rotation of the shape
+  TimingScope scope = TimingScope::kPerStroke;    //!< default timing scope of the shape
+};
+
+/// Geometry from consecutive segments: one stroke, or (`stroke_each`) one stroke per segment, each drawn from rest
+/// to rest.
+[[nodiscard]] PathGeometry strokes_from(std::vector<PathSegment> segments, bool stroke_each);
 
 /// sigma(u) and d sigma / du for u in [0, 1].
 void timing(TimingLaw law, double u, double& sigma, double& dsigma);
@@ -109,26 +135,38 @@ class Path {
   std::string description_;
 };
 
-/// What a path factory receives besides its table.
+/// What a path plugin receives besides its Config.
 struct PathContext {
-  int dim = 2;                        //!< 2 or 3
+  int dim = 2;                                      //!< 2 or 3
   Eigen::Vector3d start = Eigen::Vector3d::Zero();  //!< f(theta(0)) position (z = 0 for planar)
-  double duration = 0.0;              //!< T (s)
+  double duration = 0.0;                            //!< T (s)
 };
 
-/// A path factory returns geometry and its default placement; the framework reads placement and timing keys.
-struct PathDefaults {
-  double rotation_deg = 0.0;  //!< default planar rotation
-  TimingScope scope = TimingScope::kPerStroke;
+/// The placement and timing keys that every path takes besides its own. Unset optionals take the shape's
+/// preference (PathGeometry) or, for `origin`, zero.
+struct PathPlacement {
+  Placement placement = Placement::kRelative;   //!< origin absolute, or relative to f(theta(0))
+  std::optional<std::vector<double>> origin;     //!< path origin (m), 2 or 3 numbers
+  std::optional<double> rotation_deg;            //!< planar: rotation about z (deg); default: the shape's
+  std::optional<std::array<double, 3>> rpy_deg;  //!< spatial: roll, pitch, yaw (deg)
+  TimingLaw timing = TimingLaw::kCycloidal;      //!< timing law
+  std::optional<TimingScope> timing_scope;       //!< per stroke or whole path; default: the shape's
+
+  static const Schema<PathPlacement>& schema();
 };
 
-/// Path geometry factories. The factory reads its own keys and fills `defaults` where it differs.
-using PathRegistry = Registry<PathGeometry, const PathContext&, PathDefaults&>;
+/// Path plugins: a Config and a factory make(const Config&, const PathContext&) -> std::unique_ptr<PathGeometry>
+/// in local coordinates; a geometry that cannot be built throws FieldError naming the key. A new curve type is
+/// one .cpp that calls path_registry().add<MyConfig>("name", "summary", make).
+using PathRegistry = Registry<PathGeometry, const PathContext&>;
 /// The process-wide path registry.
 PathRegistry& path_registry();
 
-/// Builds a path from a [path] table: `type`, the geometry keys, and the common keys `placement`, `origin`,
-/// `rotation_deg` (planar) or `rpy_deg` (spatial), `timing`, `timing_scope`.
+/// Builds a path from a [path] table: `type`, the type's keys and the PathPlacement keys; strict.
 [[nodiscard]] std::unique_ptr<Path> make_path(const TableReader& table, const PathContext& context);
+
+/// Builds a path from C++: the type, its Config (e.g. LetterRConfig{.height = 0.15}) and the placement.
+[[nodiscard]] std::unique_ptr<Path> make_path(const std::string& type, const std::any& config,
+                                              const PathPlacement& placement, const PathContext& context);
 
 }  // namespace redres

@@ -1,11 +1,16 @@
 #pragma once
 /// @file
-/// Objective and constraint plugins, the Context they read, and the QpBuilder they write through.
+/// Objective and constraint plugins.
 ///
-/// A plugin is a `final` class registered by name from its own .cpp. The framework reads the common keys
-/// (`type`, `name`, `weight`, `active`), the plugin's constructor reads its own keys from a strict TableReader,
-/// and the framework then rejects unknown keys, listing the plugin's keys. Each plugin writes its configuration
-/// back with write_config() so that a configuration survives a round trip.
+/// A plugin is a class with a typed Config (config.hpp), built from C++ or by name from its registry:
+///
+///   auto m = std::make_unique<Manipulability>(Manipulability::Config{.p = 2.0}, robot);
+///   auto c = constraint_registry().create("joint_angle_margin", JointAngleMargin::Config{.kappa = 4.0}, robot);
+///   auto t = objective_registry().create(table_reader, robot);   // from a [[objectives]] table
+///
+/// Common to every instance, outside its Config: the instance `name` (default: the type; used in diagnoses), and
+/// `active` (false builds it but leaves it out of the QP). Objectives also have a `weight` >= 0 that scales W and
+/// zeta. Constraints are hard and have no weight: a `weight` key on a constraint is rejected.
 ///
 /// The public, non-virtual contribute() calls the private virtual add_to() and then validates what the plugin
 /// wrote: every entry finite, W symmetric. Bounds are intersected (lo_i = max, hi_i = min) with the plugin as
@@ -18,68 +23,24 @@
 
 #include <Eigen/Core>
 
+#include "redres/config.hpp"
+#include "redres/context.hpp"
 #include "redres/kinematics.hpp"
-#include "redres/qp.hpp"
+#include "redres/qp_builder.hpp"
 #include "redres/registry.hpp"
 
 namespace redres {
 
-/// Everything a plugin may read at one control step. New inputs are added here, never to plugin signatures.
-struct Context {
-  double t = 0.0;    //!< time since the start of the task (s)
-  double T = 0.0;    //!< task duration (s)
-  double tau = 0.0;  //!< control step (s)
-  const RobotModel* robot = nullptr;          //!< the robot
-  const KinematicsData* kinematics = nullptr; //!< kinematics at theta (f, J, dJ, w, grad w, ...)
-  const Eigen::VectorXd* r_d = nullptr;       //!< desired task coordinates r_d(t) (m_task)
-  const Eigen::VectorXd* r_d_dot = nullptr;   //!< desired task velocity r_d_dot(t) (m_task)
+class Trajectory;
 
-  /// Joint positions theta (n).
-  [[nodiscard]] const Eigen::VectorXd& theta() const { return kinematics->theta; }
+/// A named figure that a plugin adds to the run summary (one number, or one per joint).
+struct Metric {
+  std::string name;            //!< e.g. "max_safety_region_entry"
+  std::vector<double> values;  //!< one value, or one per joint
+  std::string unit;            //!< e.g. "rad"
 };
 
-/// Writes one plugin's contributions into the QP. The framework positions it on the plugin's rows and weight.
-class QpBuilder {
- public:
-  /// Builds into `qp`, which must be sized.
-  explicit QpBuilder(QpProblem& qp) : qp_(&qp) {}
-
-  /// W += weight * scale * I.
-  void add_identity(double scale = 1.0);
-  /// W += weight * diag(diagonal).
-  void add_diagonal(const Eigen::Ref<const Eigen::VectorXd>& diagonal);
-  /// W += weight * H (H symmetric); marks W as non-diagonal when H has off-diagonal entries.
-  void add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H);
-  /// zeta += weight * z.
-  void add_linear(const Eigen::Ref<const Eigen::VectorXd>& z);
-  /// This plugin's equality rows of J (rows x n) and d; the plugin overwrites them.
-  [[nodiscard]] Eigen::Block<Eigen::MatrixXd> equality_matrix() { return qp_->J.middleRows(eq_offset_, eq_rows_); }
-  [[nodiscard]] Eigen::VectorBlock<Eigen::VectorXd> equality_rhs() { return qp_->d.segment(eq_offset_, eq_rows_); }
-  /// This plugin's inequality rows of A (rows x n) and b (A x <= b).
-  [[nodiscard]] Eigen::Block<Eigen::MatrixXd> inequality_matrix() { return qp_->A.middleRows(in_offset_, in_rows_); }
-  [[nodiscard]] Eigen::VectorBlock<Eigen::VectorXd> inequality_rhs() { return qp_->b.segment(in_offset_, in_rows_); }
-  /// lo = max(lo, lower), hi = min(hi, upper), entry-wise, remembering this plugin as the source of each change.
-  void intersect_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower, const Eigen::Ref<const Eigen::VectorXd>& upper);
-  /// The same for one joint.
-  void intersect_bound(int joint, double lower, double upper);
-  /// An n-vector of workspace (contents undefined on entry), so that contributions need no allocation.
-  [[nodiscard]] Eigen::VectorXd& scratch() noexcept { return qp_->scratch; }
-  /// The plugin's weight.
-  [[nodiscard]] double weight() const noexcept { return weight_; }
-  /// The QP being built (read access).
-  [[nodiscard]] const QpProblem& problem() const noexcept { return *qp_; }
-
-  /// Framework use: positions the builder on one plugin.
-  void begin(int source, double weight, int eq_offset, int eq_rows, int in_offset, int in_rows);
-
- private:
-  QpProblem* qp_;
-  int source_ = -1;
-  double weight_ = 1.0;
-  int eq_offset_ = 0, eq_rows_ = 0, in_offset_ = 0, in_rows_ = 0;
-};
-
-/// Base of objectives and constraints: the common keys and the configuration round trip.
+/// Base of objectives and constraints: type, instance name, active flag and the configuration round trip.
 class Plugin {
  public:
   Plugin(const Plugin&) = delete;
@@ -90,18 +51,26 @@ class Plugin {
   [[nodiscard]] const std::string& type() const noexcept { return type_; }
   /// Instance name (default: the type).
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
-  /// Weight (objectives scale W and zeta by it; constraints scale their rows, which leaves the solution as is).
-  [[nodiscard]] double weight() const noexcept { return weight_; }
+  /// Renames the instance (non-empty).
+  void set_name(std::string name);
   /// Inactive plugins are built but contribute nothing.
   [[nodiscard]] bool active() const noexcept { return active_; }
+  void set_active(bool active) noexcept { active_ = active; }
   /// The kinematics this plugin reads.
   [[nodiscard]] virtual KinematicsLevel kinematics_level() const { return KinematicsLevel::kPosition; }
-  /// The full configuration (common keys and the plugin's own), readable by the same factory.
+  /// The full configuration (type, common keys and the plugin's own), readable by the same registry.
   [[nodiscard]] toml::table config() const;
+  /// Figures this plugin adds to the run summary, computed from the recorded run (default: none).
+  virtual void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const {
+    (void)robot;
+    (void)run;
+    (void)out;
+  }
 
  protected:
-  /// Reads the common keys from `config`.
-  explicit Plugin(const TableReader& config);
+  explicit Plugin(std::string type);
+  /// Writes `type`, `name`, `active` (objectives add `weight`).
+  virtual void write_common(toml::table& out) const;
 
  private:
   /// Writes the plugin's own keys.
@@ -109,17 +78,20 @@ class Plugin {
 
   std::string type_;
   std::string name_;
-  double weight_ = 1.0;
   bool active_ = true;
 };
 
 /// An objective adds to W and zeta (weighted).
 class Objective : public Plugin {
  public:
+  /// Weight >= 0 (scales W and zeta).
+  [[nodiscard]] double weight() const noexcept { return weight_; }
+  /// Sets the weight; std::invalid_argument unless finite and >= 0.
+  void set_weight(double weight);
   /// Adds this objective's terms and validates them.
   void contribute(const Context& ctx, QpBuilder& builder) const;
   /// A scalar P(theta) whose gradient is the zeta this objective adds per unit weight, where one exists; the
-  /// conformance test checks zeta against central differences of it.
+  /// conformance checks compare zeta with central differences of it.
   [[nodiscard]] virtual std::optional<double> potential(const Context& ctx) const {
     (void)ctx;
     return std::nullopt;
@@ -129,7 +101,10 @@ class Objective : public Plugin {
   using Plugin::Plugin;
 
  private:
+  void write_common(toml::table& out) const override;
   virtual void add_to(const Context& ctx, QpBuilder& builder) const = 0;
+
+  double weight_ = 1.0;
 };
 
 /// A constraint adds equality rows, inequality rows or bounds.
@@ -155,23 +130,23 @@ class Constraint : public Plugin {
   virtual void add_to(const Context& ctx, QpBuilder& builder) const = 0;
 };
 
-/// Objective factories receive their table and the robot.
+/// Objective factories receive their Config and the robot.
 using ObjectiveRegistry = Registry<Objective, const RobotModel&>;
-/// Constraint factories receive their table and the robot.
+/// Constraint factories receive their Config and the robot.
 using ConstraintRegistry = Registry<Constraint, const RobotModel&>;
 /// The process-wide objective registry.
 ObjectiveRegistry& objective_registry();
 /// The process-wide constraint registry.
 ConstraintRegistry& constraint_registry();
 
-/// Builds an objective from a table (`type` plus keys); unknown types and keys are ConfigErrors.
-[[nodiscard]] std::unique_ptr<Objective> make_objective(const TableReader& config, const RobotModel& robot);
-/// Builds a constraint from a table.
-[[nodiscard]] std::unique_ptr<Constraint> make_constraint(const TableReader& config, const RobotModel& robot);
+/// The keys every objective takes besides its own (`name`, `weight`, `active`).
+[[nodiscard]] const std::vector<KeyInfo>& objective_common_keys();
+/// The keys every constraint takes besides its own (`name`, `active`).
+[[nodiscard]] const std::vector<KeyInfo>& constraint_common_keys();
 
-/// Reads a per-joint parameter given either as one number or as an array of n numbers.
-[[nodiscard]] Eigen::VectorXd read_per_joint(const TableReader& config, std::string_view key, double fallback, int n);
-/// Writes a per-joint parameter: one number when all entries are equal, an array otherwise.
-void write_per_joint(toml::table& out, std::string_view key, const Eigen::VectorXd& values);
+/// Builds an objective from an [[objectives]] table (`type`, common keys, the type's keys); strict.
+[[nodiscard]] std::unique_ptr<Objective> make_objective(const TableReader& config, const RobotModel& robot);
+/// Builds a constraint from a [[constraints]] table.
+[[nodiscard]] std::unique_ptr<Constraint> make_constraint(const TableReader& config, const RobotModel& robot);
 
 }  // namespace redres

@@ -1,52 +1,119 @@
 #pragma once
 /// @file
-/// String -> factory registries. Each plugin registers itself from its own .cpp (static initialisation of a
-/// namespace-scope object); unknown or duplicate names are errors that list the known names.
+/// Name -> plugin registries, one per plugin kind. A plugin registers itself from its own .cpp with a typed Config
+/// (see config.hpp); from that the registry derives reading the plugin from TOML, building it from a Config value
+/// by name, writing its configuration back, and listing its keys.
+///
+/// Plugins in a shared library loaded at run time (plugin_loader.hpp) register the same way; the registry then
+/// remembers the library as the entry's origin, and a name that exists already is recorded as a load error of that
+/// library instead of being thrown from its static initialisation.
 
-#include <algorithm>
+#include <any>
 #include <functional>
 #include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
+#include "redres/config.hpp"
 #include "redres/toml_reader.hpp"
 
 namespace redres {
 
-/// One configuration key of a plugin, for `redres plugins` and for error messages.
-struct KeySpec {
-  std::string name;           //!< TOML key
-  std::string default_value;  //!< default as TOML text; empty when the key is required
-  std::string description;    //!< what it means, with units
+/// While a plugin library is being loaded: its path and the registration errors it caused.
+struct RegistrationScope {
+  std::string library;              //!< the library being loaded
+  std::vector<std::string> errors;  //!< e.g. duplicate names
+  int added = 0;                    //!< plugins it registered
 };
 
-/// A registry of plugin factories of one kind. `Args` are extra factory arguments besides the config table.
-template <class Base, class... Args>
-class Registry {
- public:
-  /// Builds a plugin from its (strict) configuration table.
-  using Factory = std::function<std::unique_ptr<Base>(const TableReader&, Args...)>;
+/// The scope of the library being loaded, or nullptr (built-in registration).
+RegistrationScope*& current_registration_scope();
 
+/// What every registry offers to the plugin loader and `redres plugins`, independent of the plugin kind.
+class RegistryBase {
+ public:
+  explicit RegistryBase(std::string kind);
+  RegistryBase(const RegistryBase&) = delete;
+  RegistryBase& operator=(const RegistryBase&) = delete;
+  virtual ~RegistryBase();
+
+  /// The kind in messages, e.g. "objective", "velocity-limit law".
+  [[nodiscard]] const std::string& kind() const noexcept { return kind_; }
+  /// Removes the entries that `origin` (a library path) registered; returns how many.
+  virtual std::size_t remove_origin(const std::string& origin) = 0;
+  /// Every registry of the process, in creation order.
+  static std::vector<RegistryBase*>& all();
+
+ private:
+  std::string kind_;
+};
+
+/// A registry of plugins of one kind. `Args` are what a plugin's constructor takes besides its Config (e.g. the
+/// robot).
+template <class Base, class... Args>
+class Registry : public RegistryBase {
+ public:
   /// A registered plugin type.
   struct Entry {
-    std::string type;           //!< name used as `type = "..."` in TOML; equals the plugin's file name
-    std::string summary;        //!< one line
-    std::vector<KeySpec> keys;  //!< accepted keys with defaults
-    Factory make;               //!< factory
+    std::string type;                                   //!< name used as `type = "..."` in TOML
+    std::string summary;                                //!< one line
+    std::string origin;                                 //!< "built-in" or the library that registered it
+    std::vector<KeyInfo> keys;                          //!< keys with defaults, units, rules, presence
+    std::vector<std::pair<std::string, std::string>> groups;  //!< group -> what to give
+    const std::type_info* config_type = nullptr;        //!< the Config type
+    std::any defaults;                                  //!< a default Config
+    std::function<std::any(const TableReader&)> read;   //!< reads and checks a Config (does not finish())
+    std::function<void(const std::any&, toml::table&)> write;  //!< writes a Config's keys
+    std::function<std::unique_ptr<Base>(const std::any&, Args...)> make;  //!< builds from a Config
   };
 
-  /// `kind` names the registry in messages ("velocity-limit law", "objective", ...).
-  explicit Registry(std::string kind) : kind_(std::move(kind)) {}
+  explicit Registry(std::string kind) : RegistryBase(std::move(kind)) {}
 
-  /// Adds a type; a duplicate name is a std::logic_error. Returns true so it can initialise a static.
-  bool add(Entry entry) {
-    const std::string name = entry.type;
-    if (!entries_.emplace(name, std::move(entry)).second) {
-      throw std::logic_error("duplicate " + kind_ + " type '" + name + "' registered");
+  /// Registers `type` with Config type C (which has `static const Schema<C>& schema()`) and a factory
+  /// make(const C&, Args...) -> std::unique_ptr<Base>. A duplicate name is a std::logic_error for built-in
+  /// plugins and a load error of the library being loaded. Returns whether it was added (to initialise a static).
+  template <class C, class Make>
+  bool add(std::string type, std::string summary, Make make) {
+    Entry e;
+    e.type = std::move(type);
+    e.summary = std::move(summary);
+    RegistrationScope* scope = current_registration_scope();
+    e.origin = scope != nullptr ? scope->library : "built-in";
+    e.keys = describe_keys<C>(C::schema());
+    e.groups = C::schema().groups;
+    e.config_type = &typeid(C);
+    e.defaults = C{};
+    e.read = [](const TableReader& r) -> std::any {
+      C c{};
+      read_config(r, C::schema(), c);
+      return c;
+    };
+    e.write = [](const std::any& c, toml::table& out) { write_config(std::any_cast<const C&>(c), C::schema(), out); };
+    e.make = [make](const std::any& c, Args... args) -> std::unique_ptr<Base> {
+      return make(std::any_cast<const C&>(c), args...);
+    };
+    if (const auto it = entries_.find(e.type); it != entries_.end()) {
+      const std::string why = "duplicate " + kind() + " type '" + e.type + "': already registered by " +
+                              it->second.origin;
+      if (scope == nullptr) throw std::logic_error(why);
+      scope->errors.push_back(why);
+      return false;
     }
+    const std::string name = e.type;
+    entries_.emplace(name, std::move(e));
+    if (scope != nullptr) ++scope->added;
     return true;
+  }
+
+  /// Registers plugin class P: P::kType, P::Config, and a constructor P(const P::Config&, Args...).
+  template <class P>
+  bool add_plugin(std::string summary) {
+    return add<typename P::Config>(P::kType, std::move(summary), [](const typename P::Config& c, Args... args) {
+      return std::unique_ptr<Base>(std::make_unique<P>(c, args...));
+    });
   }
 
   /// The entry for `type`, or nullptr.
@@ -55,13 +122,41 @@ class Registry {
     return it == entries_.end() ? nullptr : &it->second;
   }
 
-  /// Builds the plugin named by the table's `type` key; an unknown type is a ConfigError listing known types.
-  /// The plugin's own factory reads the remaining keys and calls finish().
-  [[nodiscard]] std::unique_ptr<Base> create(const TableReader& config, Args... args) const {
-    const std::string type = config.string("type");
+  /// The entry for `type`; std::invalid_argument listing the known types when there is none.
+  [[nodiscard]] const Entry& at(const std::string& type) const {
     const Entry* e = find(type);
-    if (e == nullptr) config.fail("type", "unknown " + kind_ + " type '" + type + "'; known types: " + names());
-    return e->make(config, args...);
+    if (e == nullptr) throw std::invalid_argument("unknown " + kind() + " type '" + type + "'; known types: " + names());
+    return *e;
+  }
+
+  /// Builds `type` from a Config value (std::invalid_argument when the value is not that type's Config, or
+  /// breaks its schema).
+  [[nodiscard]] std::unique_ptr<Base> create(const std::string& type, const std::any& config, Args... args) const {
+    const Entry& e = at(type);
+    if (config.type() != *e.config_type) {
+      throw std::invalid_argument(kind() + " '" + type + "': expected its own Config type, got a value of another type");
+    }
+    return e.make(config, args...);
+  }
+
+  /// Builds `type` with its default Config.
+  [[nodiscard]] std::unique_ptr<Base> create_default(const std::string& type, Args... args) const {
+    const Entry& e = at(type);
+    return e.make(e.defaults, args...);
+  }
+
+  /// Reads the table's `type` and the type's keys (not finish()ed: the caller may read common keys too), and builds
+  /// the plugin. Unknown types and invalid keys are ConfigErrors at file:line:col.
+  [[nodiscard]] std::unique_ptr<Base> create(const TableReader& table, Args... args) const {
+    const std::string type = table.string("type");
+    const Entry* e = find(type);
+    if (e == nullptr) table.fail("type", "unknown " + kind() + " type '" + type + "'; known types: " + names());
+    const std::any config = e->read(table);
+    try {
+      return e->make(config, args...);
+    } catch (const FieldError& err) {
+      rethrow_at(table, err);
+    }
   }
 
   /// All entries, sorted by type.
@@ -78,11 +173,20 @@ class Registry {
     return out;
   }
 
-  /// The registry's kind, e.g. "velocity-limit law".
-  [[nodiscard]] const std::string& kind() const noexcept { return kind_; }
+  std::size_t remove_origin(const std::string& origin) override {
+    std::size_t n = 0;
+    for (auto it = entries_.begin(); it != entries_.end();) {
+      if (it->second.origin == origin) {
+        it = entries_.erase(it);
+        ++n;
+      } else {
+        ++it;
+      }
+    }
+    return n;
+  }
 
  private:
-  std::string kind_;
   std::map<std::string, Entry> entries_;
 };
 

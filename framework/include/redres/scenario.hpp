@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// Scenarios: a robot, an initial configuration, a duration and step, a desired path, a scheme (objectives and
-/// constraints), solver settings and output options, read from one TOML file; and the simulation that runs them.
+/// constraints), solver settings and output options, read from one TOML file. simulation.hpp runs them,
+/// run_summary.hpp summarises a run, run_output.hpp writes it.
 ///
 /// Scenario file (paths resolve relative to the file that names them):
 ///
@@ -17,7 +18,6 @@
 ///   [output]      plots = false                 # render the figures with tools/plot_run.py after a run
 
 #include <filesystem>
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,7 +42,6 @@ struct Scenario {
   std::unique_ptr<Scheme> scheme;         //!< objectives and constraints
   std::unique_ptr<LviEngine> engine;      //!< solver
   bool plots = false;                     //!< [output] plots
-  Eigen::VectorXd safety_margin;          //!< joint_angle_margin's margin per joint (zeros without it)
 
   /// Number of control steps N = round(T / tau); the run records N + 1 rows, t = 0 .. T.
   [[nodiscard]] int steps() const;
@@ -51,35 +50,5 @@ struct Scenario {
 /// Loads and checks a scenario. `overrides` are "key.path=value" strings (TOML values; a bare word is a string;
 /// array entries by 0-based index, e.g. "objectives.1.p=1"). Every problem is a ConfigError at file:line:col.
 [[nodiscard]] Scenario load_scenario(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
-
-/// The recorded run: one row per step with the columns of DESIGN section 6 (plus the velocity-law limits), and
-/// the summary figures.
-struct RunResult {
-  std::vector<std::string> columns;  //!< CSV header
-  std::vector<double> rows;          //!< row-major, rows() x columns.size()
-  int failures = 0;                  //!< steps whose solve was not `solved`
-  std::string first_failure;         //!< "t = ...: <status>: <diagnosis>" of the first failed step
-  double wall_time_s = 0.0;          //!< run time (s)
-  std::string engine;                //!< engine(s) that ran, e.g. "projection" or "newton+projection"
-
-  /// Number of rows.
-  [[nodiscard]] std::size_t size() const { return columns.empty() ? 0 : rows.size() / columns.size(); }
-  /// Value at (row, column name); throws std::out_of_range for an unknown column.
-  [[nodiscard]] double at(std::size_t row, const std::string& column) const;
-  /// Index of a column; throws std::out_of_range.
-  [[nodiscard]] std::size_t column(const std::string& name) const;
-};
-
-/// Progress of a run: fraction done in [0, 1] and the simulated time.
-using ProgressCallback = std::function<void(double fraction, double t)>;
-
-/// Runs a scenario from theta0 over [0, T] with step tau. Allocation happens before the loop only.
-[[nodiscard]] RunResult simulate(Scenario& scenario, const ProgressCallback& progress = {});
-
-/// The summary of DESIGN section 6 (plus robot and scenario facts the plotting tools need), as JSON text.
-[[nodiscard]] std::string summary_json(const Scenario& scenario, const RunResult& run);
-
-/// Writes DIR/trajectory.csv and DIR/summary.json (creating DIR).
-void write_run(const Scenario& scenario, const RunResult& run, const std::filesystem::path& dir);
 
 }  // namespace redres

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "redres/registry.hpp"
+#include "redres/toml_reader.hpp"
 
 namespace redres {
 
@@ -25,10 +26,11 @@ struct UndefinedAt {
   std::string reason;   //!< e.g. "cos(theta) = 0"
 };
 
-/// A velocity-limit law. Immutable after construction; bounds() is allocation-free and thread-safe.
+/// A velocity-limit law. Immutable after construction; bounds() is allocation-free. A law is a plugin with a typed
+/// Config (config.hpp): derive from Configured<VelocityLimitLaw, MyConfig> and register with
+/// velocity_limit_registry().add_plugin<MyLaw>("summary").
 class VelocityLimitLaw {
  public:
-  VelocityLimitLaw() = default;
   VelocityLimitLaw(const VelocityLimitLaw&) = delete;
   VelocityLimitLaw& operator=(const VelocityLimitLaw&) = delete;
   virtual ~VelocityLimitLaw() = default;
@@ -36,7 +38,7 @@ class VelocityLimitLaw {
   /// Lower and upper velocity limits at joint position `theta`.
   [[nodiscard]] virtual VelocityBounds bounds(double theta) const = 0;
   /// The registry type name.
-  [[nodiscard]] virtual std::string type() const = 0;
+  [[nodiscard]] const std::string& type() const noexcept { return type_; }
   /// One line with the parameters, e.g. "push_rod(a=0.25 m, b=0.08 m, ...)".
   [[nodiscard]] virtual std::string describe() const = 0;
   /// The first position in [lo, hi] where the law is not defined, if any (checked at load before sampling).
@@ -45,6 +47,15 @@ class VelocityLimitLaw {
     (void)hi;
     return std::nullopt;
   }
+  /// The configuration (`type` and the law's keys), readable by the same registry.
+  [[nodiscard]] toml::table config() const;
+
+ protected:
+  explicit VelocityLimitLaw(std::string type) : type_(std::move(type)) {}
+
+ private:
+  virtual void write_config(toml::table& out) const = 0;
+  std::string type_;
 };
 
 /// The registry of velocity-limit laws.
@@ -52,6 +63,9 @@ using VelocityLimitRegistry = Registry<VelocityLimitLaw>;
 
 /// The process-wide registry of velocity-limit laws (function-local static).
 VelocityLimitRegistry& velocity_limit_registry();
+
+/// Builds a law from a [joints.velocity_limit] table (`type` and the law's keys); strict (unknown keys rejected).
+[[nodiscard]] std::unique_ptr<VelocityLimitLaw> make_velocity_limit(const TableReader& table);
 
 /// Number of positions (including both ends) at which a law is sampled at load.
 inline constexpr int kVelocityLawSamples = 2001;

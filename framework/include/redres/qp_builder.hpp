@@ -1,0 +1,53 @@
+#pragma once
+/// @file
+/// QpBuilder: how a plugin writes its terms, rows and bounds into the step's QP. The framework positions it on the
+/// plugin's rows (and, for objectives, its weight) before each contribution.
+
+#include <Eigen/Core>
+
+#include "redres/qp.hpp"
+
+namespace redres {
+
+/// Writes one plugin's contributions into the QP. The framework positions it on the plugin's rows and weight.
+class QpBuilder {
+ public:
+  /// Builds into `qp`, which must be sized.
+  explicit QpBuilder(QpProblem& qp) : qp_(&qp) {}
+
+  /// W += weight * scale * I.
+  void add_identity(double scale = 1.0);
+  /// W += weight * diag(diagonal).
+  void add_diagonal(const Eigen::Ref<const Eigen::VectorXd>& diagonal);
+  /// W += weight * H (H symmetric); marks W as non-diagonal when H has off-diagonal entries.
+  void add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H);
+  /// zeta += weight * z.
+  void add_linear(const Eigen::Ref<const Eigen::VectorXd>& z);
+  /// This plugin's equality rows of J (rows x n) and d; the plugin overwrites them.
+  [[nodiscard]] Eigen::Block<Eigen::MatrixXd> equality_matrix() { return qp_->J.middleRows(eq_offset_, eq_rows_); }
+  [[nodiscard]] Eigen::VectorBlock<Eigen::VectorXd> equality_rhs() { return qp_->d.segment(eq_offset_, eq_rows_); }
+  /// This plugin's inequality rows of A (rows x n) and b (A x <= b).
+  [[nodiscard]] Eigen::Block<Eigen::MatrixXd> inequality_matrix() { return qp_->A.middleRows(in_offset_, in_rows_); }
+  [[nodiscard]] Eigen::VectorBlock<Eigen::VectorXd> inequality_rhs() { return qp_->b.segment(in_offset_, in_rows_); }
+  /// lo = max(lo, lower), hi = min(hi, upper), entry-wise, remembering this plugin as the source of each change.
+  void intersect_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower, const Eigen::Ref<const Eigen::VectorXd>& upper);
+  /// The same for one joint.
+  void intersect_bound(int joint, double lower, double upper);
+  /// An n-vector of workspace (contents undefined on entry), so that contributions need no allocation.
+  [[nodiscard]] Eigen::VectorXd& scratch() noexcept { return qp_->scratch; }
+  /// The plugin's weight.
+  [[nodiscard]] double weight() const noexcept { return weight_; }
+  /// The QP being built (read access).
+  [[nodiscard]] const QpProblem& problem() const noexcept { return *qp_; }
+
+  /// Framework use: positions the builder on one plugin.
+  void begin(int source, double weight, int eq_offset, int eq_rows, int in_offset, int in_rows);
+
+ private:
+  QpProblem* qp_;
+  int source_ = -1;
+  double weight_ = 1.0;
+  int eq_offset_ = 0, eq_rows_ = 0, in_offset_ = 0, in_rows_ = 0;
+};
+
+}  // namespace redres

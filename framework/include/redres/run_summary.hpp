@@ -1,0 +1,77 @@
+#pragma once
+/// @file
+/// The summary of a run as a value: the figures the CLI prints, `compare` tabulates, the golden tests check and
+/// summary.json serialises (field by field; docs/output_formats.md). Plugins add their own figures through
+/// Plugin::summarise(), collected under `metrics`.
+
+#include <string>
+#include <vector>
+
+#include "redres/plugin.hpp"
+#include "redres/simulation.hpp"
+
+namespace redres {
+
+/// w over the run.
+struct ManipulabilityStats {
+  double initial = 0.0, final = 0.0, min = 0.0, mean = 0.0, max = 0.0;
+};
+
+/// What the solver did over the run.
+struct SolverStats {
+  std::string engine;           //!< e.g. "projection" or "newton+projection"
+  double mean_iterations = 0.0; //!< per recorded step
+  double max_iterations = 0.0;
+  double max_residual = 0.0;    //!< largest ||e(u)||_2
+  int failures = 0;             //!< solves that were not `solved`
+  std::string first_failure;    //!< "t = ...: <status>: <diagnosis>", or empty
+};
+
+/// Facts about the robot that the plotting tools need.
+struct RobotFacts {
+  std::string name;
+  std::string kind;  //!< "planar" or "spatial"
+  std::vector<std::string> joint_names;
+  std::vector<double> lower_limits, upper_limits, link_lengths;
+};
+
+/// The figures one plugin reported.
+struct PluginMetrics {
+  std::string plugin;           //!< instance name
+  std::vector<Metric> metrics;  //!< its named figures
+};
+
+/// The summary of one run.
+struct RunSummary {
+  std::string name;        //!< scenario name
+  std::string source;      //!< scenario file
+  int steps = 0;           //!< control steps N (N + 1 rows)
+  double tau = 0.0;        //!< step (s)
+  double duration = 0.0;   //!< T (s)
+  std::string integrator;  //!< "euler" or "heun"
+  std::string path;        //!< the path's description
+  double max_position_error = 0.0;    //!< max |r_d - f| over the position rows (m)
+  double final_position_error = 0.0;  //!< at t = T (m)
+  double initial_joint_velocity_norm = 0.0;  //!< |theta_dot(0)|
+  double final_joint_velocity_norm = 0.0;    //!< |theta_dot(T)|
+  ManipulabilityStats manipulability;        //!< w = det(JJ')
+  double max_joint_angle_violation = 0.0;     //!< how far any theta left its limits (0 when never)
+  double max_joint_velocity_violation = 0.0;  //!< how far any theta_dot left its velocity law (0 when never)
+  long steps_with_active_bounds = 0;          //!< steps where some theta_dot sits on a merged bound
+  std::vector<double> final_theta;            //!< theta(T)
+  SolverStats solver;
+  double wall_time_s = 0.0;  //!< time spent in the loop (s)
+  RobotFacts robot;
+  std::vector<PluginMetrics> metrics;  //!< per plugin that reports figures
+
+  /// A plugin's metric by plugin instance name and metric name, or nullptr.
+  [[nodiscard]] const Metric* metric(const std::string& plugin, const std::string& name) const;
+};
+
+/// Summarises a run of `scenario`.
+[[nodiscard]] RunSummary summarise(const Scenario& scenario, const RunResult& run);
+
+/// The summary as JSON text (summary.json).
+[[nodiscard]] std::string to_json(const RunSummary& summary);
+
+}  // namespace redres

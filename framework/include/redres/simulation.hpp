@@ -1,0 +1,34 @@
+#pragma once
+/// @file
+/// The simulation of a scenario: from theta(0), one Controller step per control step, integrated with Euler's or
+/// Heun's method, each step recorded into a Trajectory (columns in docs/output_formats.md).
+
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "redres/scenario.hpp"
+#include "redres/trajectory.hpp"
+
+namespace redres {
+
+/// A finished run: the recorded trajectory and what the loop saw.
+struct RunResult {
+  Trajectory trajectory;               //!< one row per step, t = 0 .. T
+  int failures = 0;                    //!< solves whose status was not `solved` (both Heun stages count)
+  std::string first_failure;           //!< "t = ...: <status>: <diagnosis>" of the first failed solve
+  double wall_time_s = 0.0;            //!< time spent in the loop (s)
+  std::vector<std::string_view> engines;  //!< engines that ran, in order of first use (a fallback adds one)
+
+  /// "projection", or "newton+projection" when a fallback ran.
+  [[nodiscard]] std::string engine() const;
+};
+
+/// Progress of a run: fraction done in [0, 1] and the simulated time.
+using ProgressCallback = std::function<void(double fraction, double t)>;
+
+/// Runs a scenario from theta0 over [0, T] with step tau. Everything is allocated before the loop.
+[[nodiscard]] RunResult simulate(Scenario& scenario, const ProgressCallback& progress = {});
+
+}  // namespace redres

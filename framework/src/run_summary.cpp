@@ -1,0 +1,155 @@
+#include "redres/run_summary.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+namespace redres {
+
+const Metric* RunSummary::metric(const std::string& plugin, const std::string& name) const {
+  for (const auto& pm : metrics) {
+    if (pm.plugin != plugin) continue;
+    for (const auto& m : pm.metrics) {
+      if (m.name == name) return &m;
+    }
+  }
+  return nullptr;
+}
+
+RunSummary summarise(const Scenario& s, const RunResult& run) {
+  const RobotModel& robot = *s.robot;
+  const Trajectory& tr = run.trajectory;
+  const int n = robot.dof();
+  const std::size_t rows = tr.size();
+  REDRES_REQUIRE(rows > 0, "summarise", "the run recorded at least one step");
+
+  // Column indices, looked up once.
+  const std::size_t c_err = tr.column("position_error"), c_w = tr.column("manipulability"),
+                    c_res = tr.column("solver_residual"), c_it = tr.column("solver_iterations");
+  std::vector<std::size_t> c_th, c_thd, c_vlo, c_vhi, c_lo, c_hi;
+  for (int j = 1; j <= n; ++j) {
+    const std::string J = std::to_string(j);
+    c_th.push_back(tr.column("theta_" + J));
+    c_thd.push_back(tr.column("theta_dot_" + J));
+    c_vlo.push_back(tr.column("vel_lo_" + J));
+    c_vhi.push_back(tr.column("vel_hi_" + J));
+    c_lo.push_back(tr.column("lo_" + J));
+    c_hi.push_back(tr.column("hi_" + J));
+  }
+  double max_err = 0.0, w_min = 1e300, w_max = -1e300, w_sum = 0.0, angle_viol = 0.0, vel_viol = 0.0;
+  double max_res = 0.0, it_sum = 0.0, it_max = 0.0;
+  long active_steps = 0;
+  for (std::size_t r = 0; r < rows; ++r) {
+    max_err = std::max(max_err, tr(r, c_err));
+    const double wv = tr(r, c_w);
+    w_min = std::min(w_min, wv);
+    w_max = std::max(w_max, wv);
+    w_sum += wv;
+    max_res = std::max(max_res, tr(r, c_res));
+    it_sum += tr(r, c_it);
+    it_max = std::max(it_max, tr(r, c_it));
+    bool active = false;
+    for (int j = 0; j < n; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      const double th = tr(r, c_th[k]), thd = tr(r, c_thd[k]);
+      angle_viol = std::max({angle_viol, th - robot.upper_limits()(j), robot.lower_limits()(j) - th});
+      vel_viol = std::max({vel_viol, thd - tr(r, c_vhi[k]), tr(r, c_vlo[k]) - thd});
+      const double blo = tr(r, c_lo[k]), bhi = tr(r, c_hi[k]);
+      active = active || std::abs(thd - blo) <= 1e-9 * (1.0 + std::abs(blo)) ||
+               std::abs(thd - bhi) <= 1e-9 * (1.0 + std::abs(bhi));
+    }
+    active_steps += active ? 1 : 0;
+  }
+  const auto joint_velocity_norm = [&](std::size_t r) {
+    double sq = 0.0;
+    for (std::size_t k = 0; k < c_thd.size(); ++k) sq += std::pow(tr(r, c_thd[k]), 2);
+    return std::sqrt(sq);
+  };
+
+  RunSummary out;
+  out.name = s.name;
+  out.source = s.source;
+  out.steps = s.steps();
+  out.tau = s.tau;
+  out.duration = s.duration;
+  out.integrator = s.integrator == Integrator::kEuler ? "euler" : "heun";
+  out.path = s.path->description();
+  out.max_position_error = max_err;
+  out.final_position_error = tr(rows - 1, c_err);
+  out.initial_joint_velocity_norm = joint_velocity_norm(0);
+  out.final_joint_velocity_norm = joint_velocity_norm(rows - 1);
+  out.manipulability = {tr(0, c_w), tr(rows - 1, c_w), w_min, w_sum / static_cast<double>(rows), w_max};
+  out.max_joint_angle_violation = std::max(0.0, angle_viol);
+  out.max_joint_velocity_violation = std::max(0.0, vel_viol);
+  out.steps_with_active_bounds = active_steps;
+  for (int j = 0; j < n; ++j) out.final_theta.push_back(tr(rows - 1, c_th[static_cast<std::size_t>(j)]));
+  out.solver = {run.engine(), it_sum / static_cast<double>(rows), it_max, max_res, run.failures, run.first_failure};
+  out.wall_time_s = run.wall_time_s;
+  out.robot.name = robot.name();
+  out.robot.kind = to_string(robot.kind());
+  for (int j = 0; j < n; ++j) {
+    out.robot.joint_names.push_back(robot.joint(j).name);
+    out.robot.lower_limits.push_back(robot.lower_limits()(j));
+    out.robot.upper_limits.push_back(robot.upper_limits()(j));
+    out.robot.link_lengths.push_back(robot.joint(j).length);
+  }
+  const auto collect = [&](const Plugin& p) {
+    if (!p.active()) return;
+    PluginMetrics pm{p.name(), {}};
+    p.summarise(robot, tr, pm.metrics);
+    if (!pm.metrics.empty()) out.metrics.push_back(std::move(pm));
+  };
+  for (const auto& o : s.scheme->objectives()) collect(*o);
+  for (const auto& c : s.scheme->constraints()) collect(*c);
+  return out;
+}
+
+std::string to_json(const RunSummary& s) {
+  nlohmann::json metrics = nlohmann::json::object();
+  for (const auto& pm : s.metrics) {
+    nlohmann::json figures = nlohmann::json::object();
+    for (const auto& m : pm.metrics) {
+      figures[m.name] = m.values.size() == 1 ? nlohmann::json(m.values.front()) : nlohmann::json(m.values);
+    }
+    metrics[pm.plugin] = figures;
+  }
+  const ManipulabilityStats& w = s.manipulability;
+  const nlohmann::json j = {
+      {"name", s.name},
+      {"source", s.source},
+      {"steps", s.steps},
+      {"tau", s.tau},
+      {"duration", s.duration},
+      {"integrator", s.integrator},
+      {"path", s.path},
+      {"max_position_error", s.max_position_error},
+      {"final_position_error", s.final_position_error},
+      {"initial_joint_velocity_norm", s.initial_joint_velocity_norm},
+      {"final_joint_velocity_norm", s.final_joint_velocity_norm},
+      {"manipulability", {{"initial", w.initial}, {"final", w.final}, {"min", w.min}, {"mean", w.mean}, {"max", w.max}}},
+      {"max_joint_angle_violation", s.max_joint_angle_violation},
+      {"max_joint_velocity_violation", s.max_joint_velocity_violation},
+      {"steps_with_active_bounds", s.steps_with_active_bounds},
+      {"final_theta", s.final_theta},
+      {"solver",
+       {{"engine", s.solver.engine},
+        {"mean_iterations", s.solver.mean_iterations},
+        {"max_iterations", s.solver.max_iterations},
+        {"max_residual", s.solver.max_residual},
+        {"failures", s.solver.failures},
+        {"first_failure", s.solver.first_failure}}},
+      {"wall_time_s", s.wall_time_s},
+      {"robot",
+       {{"name", s.robot.name},
+        {"kind", s.robot.kind},
+        {"joint_names", s.robot.joint_names},
+        {"lower_limits", s.robot.lower_limits},
+        {"upper_limits", s.robot.upper_limits},
+        {"link_lengths", s.robot.link_lengths}}},
+      {"metrics", metrics},
+  };
+  return j.dump(2);
+}
+
+}  // namespace redres

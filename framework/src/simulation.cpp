@@ -1,0 +1,106 @@
+#include "redres/simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+namespace redres {
+
+namespace {
+
+std::vector<std::string> trajectory_columns(const RobotModel& robot) {
+  const int n = robot.dof();
+  std::vector<std::string> cols;
+  cols.emplace_back("t");
+  const auto add = [&cols, n](const std::string& prefix) {
+    for (int j = 1; j <= n; ++j) cols.push_back(prefix + std::to_string(j));
+  };
+  add("theta_");
+  add("theta_dot_");
+  add("lo_");
+  add("hi_");
+  for (const auto& name : robot.task_names()) cols.push_back("rd_" + name);
+  for (const auto& name : robot.task_names()) cols.push_back("r_" + name);
+  for (const char* c : {"position_error", "manipulability", "solver_iterations", "solver_residual"}) cols.emplace_back(c);
+  add("vel_lo_");
+  add("vel_hi_");
+  cols.emplace_back("solver_status");
+  return cols;
+}
+
+}  // namespace
+
+std::string RunResult::engine() const {
+  std::string out;
+  for (const auto e : engines) out += (out.empty() ? "" : "+") + std::string(e);
+  return out;
+}
+
+RunResult simulate(Scenario& s, const ProgressCallback& progress) {
+  const RobotModel& robot = *s.robot;
+  const int n = robot.dof();
+  const int m = robot.task_dim();
+  const int position_rows = robot.kind() == ChainKind::kPlanar ? 2 : 3;
+  const int steps = s.steps();
+  RunResult run;
+  run.trajectory = Trajectory(trajectory_columns(robot), static_cast<std::size_t>(steps) + 1);
+  run.engines.reserve(4);
+
+  Controller ctrl(robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
+  ctrl.set_kinematics_level(KinematicsLevel::kManipulability);
+  StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
+  Eigen::VectorXd theta = s.theta0, theta_pred(n), vlo(n), vhi(n);
+  const auto start = std::chrono::steady_clock::now();
+  const int report_every = std::max(1, steps / 200);
+  const auto note = [&run](const StepOutput& o, double t) {
+    if (std::find(run.engines.begin(), run.engines.end(), o.info.engine) == run.engines.end()) {
+      run.engines.push_back(o.info.engine);
+    }
+    if (o.info.status != SolverStatus::kSolved && run.failures++ == 0) {
+      std::ostringstream msg;
+      msg << "t = " << t << " s: " << to_string(o.info.status) << ": " << o.info.diagnosis;
+      run.first_failure = msg.str();
+    }
+  };
+
+  for (int k = 0; k <= steps; ++k) {
+    const double t = k == steps ? s.duration : k * s.tau;
+    ctrl.step(theta, t, out);
+    const KinematicsData& kin = ctrl.kinematics();
+    const QpProblem& qp = ctrl.qp();
+    robot.velocity_limits(theta, vlo, vhi);
+    double* row = run.trajectory.append_row();
+    std::size_t c = 0;
+    row[c++] = t;
+    for (int j = 0; j < n; ++j) row[c++] = theta(j);
+    for (int j = 0; j < n; ++j) row[c++] = out.theta_dot(j);
+    for (int j = 0; j < n; ++j) row[c++] = qp.lo(j);
+    for (int j = 0; j < n; ++j) row[c++] = qp.hi(j);
+    for (int r = 0; r < m; ++r) row[c++] = ctrl.r_d()(r);
+    for (int r = 0; r < m; ++r) row[c++] = kin.f(r);
+    row[c++] = (ctrl.r_d().head(position_rows) - kin.f.head(position_rows)).norm();
+    row[c++] = kin.w;
+    row[c++] = out.info.iterations;
+    row[c++] = out.info.residual;
+    for (int j = 0; j < n; ++j) row[c++] = vlo(j);
+    for (int j = 0; j < n; ++j) row[c++] = vhi(j);
+    row[c++] = static_cast<double>(static_cast<int>(out.info.status));
+    note(out, t);
+    if (progress && (k % report_every == 0 || k == steps)) progress(static_cast<double>(k) / steps, t);
+    if (k == steps) break;
+    if (s.integrator == Integrator::kEuler) {
+      theta += s.tau * out.theta_dot;
+    } else {
+      // Heun: average the slopes at theta and at the Euler prediction (one more QP per step, into its own output).
+      theta_pred = theta + s.tau * out.theta_dot;
+      const double t2 = std::min(s.duration, t + s.tau);
+      ctrl.step(theta_pred, t2, out2);
+      note(out2, t2);
+      theta += 0.5 * s.tau * (out.theta_dot + out2.theta_dot);
+    }
+  }
+  run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+}  // namespace redres

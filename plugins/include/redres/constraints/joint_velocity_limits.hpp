@@ -1,0 +1,27 @@
+#pragma once
+/// @file
+/// `joint_velocity_limits`: the robot's per-joint velocity-limit laws as bounds (eq. 8, VJVL),
+///   scale theta_dot^-(theta) <= x <= scale theta_dot^+(theta).
+
+#include "redres/plugin.hpp"
+
+namespace redres {
+
+/// The configuration of `joint_velocity_limits`.
+struct JointVelocityLimitsConfig {
+  double scale = 1.0;  //!< fraction of the laws' limits, 0 < scale <= 1 (e.g. 0.9 keeps a 10 % reserve)
+
+  static const Schema<JointVelocityLimitsConfig>& schema();
+};
+
+/// The varying joint-velocity limits constraint.
+class JointVelocityLimits final : public Configured<Constraint, JointVelocityLimitsConfig> {
+ public:
+  static constexpr const char* kType = "joint_velocity_limits";
+  JointVelocityLimits(const Config& config, const RobotModel& robot);
+
+ private:
+  void add_to(const Context& ctx, QpBuilder& builder) const override;
+};
+
+}  // namespace redres

@@ -1,0 +1,33 @@
+#pragma once
+/// @file
+/// `task_tracking`: the end-effector task with position-error feedback (eq. 6), m equality rows
+///   J x = r_d_dot + K (r_d - f(theta)),
+/// where m is the robot's number of task rows and K = diag(gain). For spatial `pose` tasks the orientation rows use
+/// the rotation-vector error log(R_d R') (r_d's orientation entries are a rotation vector).
+
+#include "redres/plugin.hpp"
+
+namespace redres {
+
+/// The configuration of `task_tracking`.
+struct TaskTrackingConfig {
+  PerJoint gain = 8.0;  //!< feedback gain K (1/s): one number or one per task row (the paper: 8)
+
+  static const Schema<TaskTrackingConfig>& schema();
+};
+
+/// The end-effector task constraint.
+class TaskTracking final : public Configured<Constraint, TaskTrackingConfig> {
+ public:
+  static constexpr const char* kType = "task_tracking";
+  TaskTracking(const Config& config, const RobotModel& robot);
+  [[nodiscard]] int equality_rows(const RobotModel& robot) const override { return robot.task_dim(); }
+  [[nodiscard]] KinematicsLevel kinematics_level() const override { return KinematicsLevel::kJacobian; }
+
+ private:
+  void add_to(const Context& ctx, QpBuilder& builder) const override;
+
+  Eigen::VectorXd gain_;
+};
+
+}  // namespace redres

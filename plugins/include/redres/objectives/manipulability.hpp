@@ -1,0 +1,71 @@
+#pragma once
+/// @file
+/// `manipulability`: the manipulability-maximising term of eq. 5, zeta += -weight p(t) grad w. Together with
+/// `min_velocity_norm` (W = I) it is the paper's index |x - p q|^2 / 2 up to a constant (eq. 4). The measure is
+/// w = det(J J') (`det`, the paper) or Yoshikawa's sqrt(det(J J')) (`yoshikawa`); its gradient comes from the
+/// kinematics (adjugate / SVD forms, exact at singularities).
+///
+/// Coefficient schedules p(t), t in [0, T]:
+/// - `constant`: p(t) = p;
+/// - `sine`: p(t) = p sin(pi t / T) (the paper's TVCMM with p = 2; p(0) = p(T) = 0);
+/// - `smoothstep`: p s(t / t_r) while t < t_r, p while t_r <= t <= T - t_r, p s((T - t) / t_r) after, with
+///   s(u) = 3u^2 - 2u^3 and t_r = ramp_fraction T;
+/// - `expression`: p(t) = `formula` of t and T (muParser); `p` is not used.
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "redres/formula.hpp"
+#include "redres/plugin.hpp"
+
+namespace redres {
+
+/// The configuration of `manipulability`.
+struct ManipulabilityConfig {
+  enum class Measure { kDet, kYoshikawa };
+  enum class Schedule { kConstant, kSine, kSmoothstep, kExpression };
+
+  Measure measure = Measure::kDet;        //!< det(JJ') (the paper) or sqrt(det(JJ'))
+  Schedule schedule = Schedule::kSine;    //!< p(t)
+  double p = 2.0;                         //!< coefficient magnitude
+  double ramp_fraction = 0.25;            //!< smoothstep: each ramp's share of T
+  std::optional<std::string> formula;     //!< expression: p(t) as a formula of t and T
+
+  static const Schema<ManipulabilityConfig>& schema();
+};
+
+/// Names of the enums in TOML.
+inline auto enum_names(ManipulabilityConfig::Measure) {
+  using M = ManipulabilityConfig::Measure;
+  return std::array{std::pair{M::kDet, std::string_view("det")}, std::pair{M::kYoshikawa, std::string_view("yoshikawa")}};
+}
+inline auto enum_names(ManipulabilityConfig::Schedule) {
+  using S = ManipulabilityConfig::Schedule;
+  return std::array{std::pair{S::kConstant, std::string_view("constant")}, std::pair{S::kSine, std::string_view("sine")},
+                    std::pair{S::kSmoothstep, std::string_view("smoothstep")},
+                    std::pair{S::kExpression, std::string_view("expression")}};
+}
+
+/// The manipulability objective.
+class Manipulability final : public Configured<Objective, ManipulabilityConfig> {
+ public:
+  static constexpr const char* kType = "manipulability";
+  using Measure = ManipulabilityConfig::Measure;
+  using Schedule = ManipulabilityConfig::Schedule;
+
+  Manipulability(const Config& config, const RobotModel& robot);
+
+  /// The coefficient p(t).
+  [[nodiscard]] double coefficient(double t, double T) const;
+  [[nodiscard]] KinematicsLevel kinematics_level() const override;
+  [[nodiscard]] std::optional<double> potential(const Context& ctx) const override;
+
+ private:
+  void add_to(const Context& ctx, QpBuilder& builder) const override;
+
+  std::unique_ptr<Formula> formula_;
+};
+
+}  // namespace redres

@@ -2,48 +2,62 @@
 //
 //   example_02_control_loop [robot.toml]
 //
-// Builds the TVCMM scheme in code (plugins by name, from TOML text), then runs a 100 Hz loop that moves the end
-// effector 5 cm along -x with a cycloidal profile. Each cycle calls Controller::step(theta, t, r_d, r_d_dot),
-// which allocates nothing, and checks the solver's status before using theta_dot.
+// Builds the paper's TVCMM scheme in C++ from typed plugin configurations (no TOML text), then runs a 100 Hz loop
+// that moves the end effector 5 cm along -x with a cycloidal profile. Each cycle calls
+// Controller::step(theta, t, r_d, r_d_dot, out), which allocates nothing, and checks the solver's status before
+// using theta_dot.
 
 #include <cmath>
 #include <iostream>
+#include <numbers>
 
+#include <redres/constraints/joint_angle_margin.hpp>
+#include <redres/constraints/joint_velocity_limits.hpp>
+#include <redres/constraints/task_tracking.hpp>
 #include <redres/controller.hpp>
+#include <redres/engines/newton.hpp>
+#include <redres/objectives/manipulability.hpp>
+#include <redres/objectives/min_velocity_norm.hpp>
 
 int main(int argc, char** argv) {
+  using namespace redres;
   try {
-    const redres::RobotModel robot = redres::load_robot(argc > 1 ? argv[1] : REDRES_EXAMPLE_ROBOT);
-    const auto scheme_toml = redres::parse_toml_string(R"(
-      [[objectives]]
-      type = "min_velocity_norm"
-      [[objectives]]
-      type = "manipulability"
-      schedule = "sine"
-      [[constraints]]
-      type = "task_tracking"
-      [[constraints]]
-      type = "joint_angle_margin"
-      [[constraints]]
-      type = "joint_velocity_limits"
-    )", "<scheme>");
-    const redres::Scheme scheme = redres::Scheme::from_toml(redres::TableReader::root(scheme_toml), robot);
-    const auto engine = redres::make_engine("newton");
+    const RobotModel robot = load_robot(argc > 1 ? argv[1] : REDRES_EXAMPLE_ROBOT);
+
+    // The scheme: |x|^2/2 - p(t) grad w' x with p(t) = 2 sin(pi t / T), the task, the joint-angle safety margin
+    // and the push-rod velocity limits. Every plugin is built from its Config; omitted fields keep their defaults.
+    std::vector<std::unique_ptr<Objective>> objectives;
+    objectives.push_back(std::make_unique<MinVelocityNorm>(MinVelocityNorm::Config{}, robot));
+    objectives.push_back(std::make_unique<Manipulability>(
+        Manipulability::Config{.measure = Manipulability::Measure::kDet, .schedule = Manipulability::Schedule::kSine,
+                               .p = 2.0},
+        robot));
+    std::vector<std::unique_ptr<Constraint>> constraints;
+    constraints.push_back(std::make_unique<TaskTracking>(TaskTracking::Config{.gain = 8.0}, robot));
+    // By name from the registry, with a config value: the same as the class, for code that picks plugins by name.
+    constraints.push_back(
+        constraint_registry().create("joint_angle_margin", JointAngleMargin::Config{.kappa = 4.0, .margin = 0.0349}, robot));
+    constraints.push_back(std::make_unique<JointVelocityLimits>(JointVelocityLimits::Config{.scale = 1.0}, robot));
+    const Scheme scheme(robot, std::move(objectives), std::move(constraints));
+    const auto engine = engine_registry().create("newton", NewtonConfig{}, SolverSettings{.tolerance = 1e-6});
+
     const double T = 5.0, tau = 0.01;
-    redres::Controller controller(robot, scheme, *engine, nullptr, T, tau);
+    Controller controller(robot, scheme, *engine, nullptr, T, tau);
+    StepOutput out = controller.make_output();  // sized once; step() writes into it
 
     Eigen::VectorXd theta = robot.home();
-    redres::KinematicsData k(robot);
-    redres::compute_kinematics(robot, theta, k, redres::KinematicsLevel::kPosition);
+    KinematicsData k(robot);
+    compute_kinematics(robot, theta, k, KinematicsLevel::kPosition);
     const Eigen::VectorXd start = k.f;
     Eigen::VectorXd r_d = start, r_d_dot = Eigen::VectorXd::Zero(robot.task_dim());
+    constexpr double two_pi = 2.0 * std::numbers::pi;
     for (int i = 0; i <= 500; ++i) {  // the control loop
       const double t = i * tau, u = t / T;
-      r_d(0) = start(0) - 0.05 * (u - std::sin(2 * M_PI * u) / (2 * M_PI));
-      r_d_dot(0) = -0.05 * (1 - std::cos(2 * M_PI * u)) / T;
-      const redres::StepOutput out = controller.step(theta, t, r_d, r_d_dot);
-      if (out.info.status != redres::SolverStatus::kSolved) {
-        std::cerr << "t = " << t << ": " << redres::to_string(out.info.status) << ": " << out.info.diagnosis << "\n";
+      r_d(0) = start(0) - 0.05 * (u - std::sin(two_pi * u) / two_pi);
+      r_d_dot(0) = -0.05 * (1 - std::cos(two_pi * u)) / T;
+      controller.step(theta, t, r_d, r_d_dot, out);
+      if (out.info.status != SolverStatus::kSolved) {
+        std::cerr << "t = " << t << ": " << to_string(out.info.status) << ": " << out.info.diagnosis << "\n";
         return 1;
       }
       theta += tau * out.theta_dot;  // send theta_dot to the drives; here: integrate

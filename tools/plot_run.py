@@ -135,9 +135,21 @@ def joint_panels(run_dir, n, name, title, filename, ylabel, draw):
     plt.close(fig)
 
 
+def safety_margin(summary, n):
+    """The widest safety margin per joint that any plugin reports (metric `safety_margin`), else zeros."""
+    margin = [0.0] * n
+    for figures in summary.get("metrics", {}).values():
+        m = figures.get("safety_margin")
+        if m is None:
+            continue
+        m = m if isinstance(m, list) else [m] * n
+        margin = [max(a, b) for a, b in zip(margin, m)]
+    return margin
+
+
 def fig_angles(run_dir, data, summary, n, name):
     lo, hi = summary["robot"]["lower_limits"], summary["robot"]["upper_limits"]
-    margin = summary["robot"]["safety_margin"]
+    margin = safety_margin(summary, n)
     t = data["t"]
 
     def draw(ax, j):

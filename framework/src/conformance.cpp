@@ -248,7 +248,8 @@ void check_path(const PathRegistry::Entry& e, const Recorder& rec) {
     const std::string on = " (" + std::to_string(dim) + "-D)";
     Eigen::VectorXd r(dim), v(dim), up(dim), down(dim), dummy(dim);
     path->evaluate(0.0, r, v);
-    const double start_error = (r - ctx.start.head(dim)).norm();
+    const Eigen::VectorXd origin = Eigen::VectorXd(ctx.start).head(dim);
+    const double start_error = (r - origin).norm();
     rec("starts at origin", start_error < 1e-12, "|r_d(0) - origin| = " + std::to_string(start_error) + on);
     double worst = 0.0;
     const double h = 1e-6;

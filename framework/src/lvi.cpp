@@ -201,7 +201,9 @@ std::unique_ptr<LviEngine> make_engine(const TableReader& solver) {
   const EngineRegistry& reg = engine_registry();
   const auto* entry = reg.find(choice.engine);
   if (entry == nullptr) {
-    solver.fail("engine", "expected one of the engines " + reg.names() + ", got '" + choice.engine + "'");
+    std::string names;
+    for (const auto* e : reg.entries()) names += (names.empty() ? "'" : ", '") + e->type + "'";
+    solver.fail("engine", "expected one of " + names + ", got '" + choice.engine + "'");
   }
   SolverSettings s;
   read_config(solver, SolverSettings::schema(), s);

@@ -310,11 +310,11 @@ struct Field {
 /// A Config's field list and the rules that span several fields.
 template <class C>
 struct Schema {
-  std::vector<Field<C>> fields;
+  std::vector<Field<C>> fields = {};
   /// Rules across fields (e.g. "either file or the arrays"); throws FieldError. May be empty.
-  std::function<void(const C&)> validate;
+  std::function<void(const C&)> validate = {};
   /// Group name -> what to give, for the listing.
-  std::vector<std::pair<std::string, std::string>> groups;
+  std::vector<std::pair<std::string, std::string>> groups = {};
 };
 
 /// A value as short TOML text for messages and listings: numbers with 15 significant digits ("0.05", not

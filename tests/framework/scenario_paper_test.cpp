@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/scenario.hpp"
+#include "redres/simulation.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -32,7 +32,7 @@ const PaperRun& cached(const std::string& config) {
 
 double joint_velocity_norm(const PaperRun& r, std::size_t row) {
   double sq = 0.0;
-  for (int j = 1; j <= r.scenario.robot->dof(); ++j) sq += std::pow(r.result.at(row, "theta_dot_" + std::to_string(j)), 2);
+  for (int j = 1; j <= r.scenario.robot->dof(); ++j) sq += std::pow(r.result.trajectory.at(row, "theta_dot_" + std::to_string(j)), 2);
   return std::sqrt(sq);
 }
 
@@ -40,8 +40,8 @@ TEST(PaperClaims, RunsUseTheSettingsOfThePaper) {
   const PaperRun& tv = cached("paper_r_tvcmm");
   EXPECT_EQ(tv.scenario.steps(), 4000);
   EXPECT_DOUBLE_EQ(tv.scenario.tau, 0.01);
-  EXPECT_STREQ(tv.scenario.engine->name(), "projection");
-  EXPECT_EQ(tv.result.size(), 4001u);
+  EXPECT_EQ(tv.scenario.engine->name(), "projection");
+  EXPECT_EQ(tv.result.trajectory.size(), 4001u);
   EXPECT_EQ(tv.result.failures, 0) << tv.result.first_failure;
   EXPECT_LT((tv.scenario.theta0 - paper_theta0()).norm(), 1e-15);
 }
@@ -50,31 +50,31 @@ TEST(PaperClaims, TvcmmStartsAndEndsAtRestWhileConstantPDoesNot) {
   const PaperRun& tv = cached("paper_r_tvcmm");
   const PaperRun& p1 = cached("paper_r_constant_p");
   EXPECT_LE(joint_velocity_norm(tv, 0), 1e-4);
-  EXPECT_LE(joint_velocity_norm(tv, tv.result.size() - 1), 1e-4);
+  EXPECT_LE(joint_velocity_norm(tv, tv.result.trajectory.size() - 1), 1e-4);
   EXPECT_GE(joint_velocity_norm(p1, 0), 0.05);
 }
 
 TEST(PaperClaims, TvcmmManipulabilityIsNeverBelowMvn) {
   const PaperRun& tv = cached("paper_r_tvcmm");
   const PaperRun& mvn = cached("paper_r_mvn");
-  ASSERT_EQ(tv.result.size(), mvn.result.size());
+  ASSERT_EQ(tv.result.trajectory.size(), mvn.result.trajectory.size());
   double worst = 1e300;
-  for (std::size_t k = 1; k < tv.result.size(); ++k) {
-    const double d = tv.result.at(k, "manipulability") - mvn.result.at(k, "manipulability");
+  for (std::size_t k = 1; k < tv.result.trajectory.size(); ++k) {
+    const double d = tv.result.trajectory.at(k, "manipulability") - mvn.result.trajectory.at(k, "manipulability");
     worst = std::min(worst, d);
-    ASSERT_GE(d, -1e-9) << "t = " << tv.result.at(k, "t");
+    ASSERT_GE(d, -1e-9) << "t = " << tv.result.trajectory.at(k, "t");
   }
   // And it is clearly larger over the task.
-  EXPECT_GT(tv.result.at(2000, "manipulability"), mvn.result.at(2000, "manipulability") + 0.005);
+  EXPECT_GT(tv.result.trajectory.at(2000, "manipulability"), mvn.result.trajectory.at(2000, "manipulability") + 0.005);
 }
 
 TEST(PaperClaims, ConstantPLeadsEarlyThenTvcmmCatchesUpAfterEightSeconds) {
   const PaperRun& tv = cached("paper_r_tvcmm");
   const PaperRun& p1 = cached("paper_r_constant_p");
   int early_lead = 0, early = 0;
-  for (std::size_t k = 1; k < tv.result.size(); ++k) {
-    const double t = tv.result.at(k, "t");
-    const double w_tv = tv.result.at(k, "manipulability"), w_p1 = p1.result.at(k, "manipulability");
+  for (std::size_t k = 1; k < tv.result.trajectory.size(); ++k) {
+    const double t = tv.result.trajectory.at(k, "t");
+    const double w_tv = tv.result.trajectory.at(k, "manipulability"), w_p1 = p1.result.trajectory.at(k, "manipulability");
     if (t <= 4.0) {
       ++early;
       early_lead += w_p1 > w_tv ? 1 : 0;
@@ -92,10 +92,10 @@ TEST_P(PaperSafety, LimitsHoldAndTheTaskIsTracked) {
   const PaperRun& r = cached(GetParam());
   const RobotModel& robot = *r.scenario.robot;
   double angle_viol = 0.0, safety_entry = 0.0, vel_viol = 0.0, max_err = 0.0;
-  for (std::size_t k = 0; k < r.result.size(); ++k) {
+  for (std::size_t k = 0; k < r.result.trajectory.size(); ++k) {
     for (int j = 0; j < robot.dof(); ++j) {
       const std::string J = std::to_string(j + 1);
-      const double th = r.result.at(k, "theta_" + J), thd = r.result.at(k, "theta_dot_" + J);
+      const double th = r.result.trajectory.at(k, "theta_" + J), thd = r.result.trajectory.at(k, "theta_dot_" + J);
       const double lo = robot.lower_limits()(j), hi = robot.upper_limits()(j);
       angle_viol = std::max({angle_viol, th - hi, lo - th});
       safety_entry = std::max({safety_entry, th - (hi - 0.0349), (lo + 0.0349) - th});
@@ -103,7 +103,7 @@ TEST_P(PaperSafety, LimitsHoldAndTheTaskIsTracked) {
       const VelocityBounds b = robot.joint(j).velocity_limit->bounds(th);
       vel_viol = std::max({vel_viol, thd - b.upper, b.lower - thd});
     }
-    max_err = std::max(max_err, r.result.at(k, "position_error"));
+    max_err = std::max(max_err, r.result.trajectory.at(k, "position_error"));
   }
   EXPECT_LE(angle_viol, 0.0);
   EXPECT_LE(safety_entry, 1e-6);
@@ -120,12 +120,12 @@ class PaperEngines : public ::testing::TestWithParam<const char*> {};
 TEST_P(PaperEngines, NewtonEndsWhereProjectionEnds) {
   const PaperRun& proj = cached(GetParam());
   const PaperRun newton = run(GetParam(), {"solver.engine=newton"});
-  EXPECT_EQ(newton.result.engine, "newton");
+  EXPECT_EQ(newton.result.engine(), "newton");
   EXPECT_EQ(newton.result.failures, 0);
-  const std::size_t last = proj.result.size() - 1;
+  const std::size_t last = proj.result.trajectory.size() - 1;
   for (int j = 1; j <= proj.scenario.robot->dof(); ++j) {
     const std::string c = "theta_" + std::to_string(j);
-    EXPECT_NEAR(newton.result.at(last, c), proj.result.at(last, c), 1e-6) << c;
+    EXPECT_NEAR(newton.result.trajectory.at(last, c), proj.result.trajectory.at(last, c), 1e-6) << c;
   }
 }
 
@@ -139,18 +139,18 @@ TEST(PaperFast, VelocityBoundsAreActiveAndNeverViolated) {
   const RobotModel& robot = *r.scenario.robot;
   int law_active = 0;
   double viol = 0.0;
-  for (std::size_t k = 0; k < r.result.size(); ++k) {
+  for (std::size_t k = 0; k < r.result.trajectory.size(); ++k) {
     bool active = false;
     for (int j = 0; j < robot.dof(); ++j) {
       const std::string J = std::to_string(j + 1);
-      const double th = r.result.at(k, "theta_" + J), thd = r.result.at(k, "theta_dot_" + J);
+      const double th = r.result.trajectory.at(k, "theta_" + J), thd = r.result.trajectory.at(k, "theta_dot_" + J);
       const VelocityBounds b = robot.joint(j).velocity_limit->bounds(th);
       viol = std::max({viol, thd - b.upper, b.lower - thd});
       active = active || std::abs(thd - b.upper) <= 1e-9 || std::abs(thd - b.lower) <= 1e-9;
     }
     law_active += active ? 1 : 0;
   }
-  const double fraction = static_cast<double>(law_active) / static_cast<double>(r.result.size());
+  const double fraction = static_cast<double>(law_active) / static_cast<double>(r.result.trajectory.size());
   RecordProperty("velocity_law_active_fraction", std::to_string(fraction));
   EXPECT_GT(fraction, 0.03);
   EXPECT_LT(fraction, 0.3);

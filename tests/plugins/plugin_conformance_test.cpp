@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "qp_util.hpp"
+#include "redres/velocity_limit.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -83,7 +84,7 @@ auto build_and_round_trip(const Entry& entry, const RobotModel& robot, Make make
   EXPECT_EQ(to_text(again->config()), to_text(config));
   for (const auto& [k, v] : config) {
     const std::string key(k.str());
-    if (key == "type" || key == "name" || key == "weight" || key == "active") continue;
+    if (key == "type" || key == "name" || key == "weight" || key == "active") continue;  // the common keys
     bool documented = false;
     for (const auto& spec : entry.keys) documented = documented || spec.name == key;
     EXPECT_TRUE(documented) << "key '" << key << "' is written but not listed";
@@ -109,7 +110,6 @@ TEST(PluginConformance, EveryObjective) {
         QpBuilder b(qp);
         b.begin(0, p->weight(), 0, 0, 0, 0);
         p->contribute(st.ctx, b);
-        ASSERT_EQ(qp.W.rows(), robot->dof());
         EXPECT_TRUE(qp.W.allFinite() && qp.zeta.allFinite());
         EXPECT_TRUE(qp.W.isApprox(qp.W.transpose()));
         // An analytic gradient, where the objective has a potential: zeta = weight * grad P, against central
@@ -155,7 +155,7 @@ TEST(PluginConformance, EveryConstraint) {
         st.randomise(rng, *robot);
         qp.clear();
         QpBuilder b(qp);
-        b.begin(0, p->weight(), 0, me, 0, mi);
+        b.begin(0, 1.0, 0, me, 0, mi);
         p->contribute(st.ctx, b);
         EXPECT_TRUE(qp.J.allFinite() && qp.d.allFinite() && qp.A.allFinite() && qp.b.allFinite());
         EXPECT_FALSE(qp.lo.array().isNaN().any() || qp.hi.array().isNaN().any());
@@ -189,7 +189,14 @@ TEST(PluginConformance, EveryVelocityLimitLaw) {
     EXPECT_EQ(law->type(), entry->type);
     EXPECT_FALSE(law->describe().empty());
     EXPECT_FALSE(check_velocity_law(*law, -1.0, 1.0).has_value());
-    for (const auto& spec : entry->keys) EXPECT_FALSE(spec.description.empty()) << spec.name;
+    for (const auto& spec : entry->keys) EXPECT_FALSE(spec.help.empty()) << spec.name;
+    // The configuration survives a round trip through TOML.
+    const auto again = make_velocity_limit(TableReader::root(parse_toml_string(to_text(law->config()), "<rt>")));
+    EXPECT_EQ(to_text(again->config()), to_text(law->config()));
+    for (double th = -1.0; th <= 1.0; th += 0.125) {
+      EXPECT_EQ(again->bounds(th).lower, law->bounds(th).lower);
+      EXPECT_EQ(again->bounds(th).upper, law->bounds(th).upper);
+    }
   }
 }
 

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "redres/scenario.hpp"
+#include "redres/run_summary.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -36,11 +36,11 @@ TEST_P(Golden, SummaryStaysWithinTolerances) {
   const std::string name = GetParam();
   Scenario s = load_scenario(source_path("configs/" + name + ".toml"));
   const RunResult run = simulate(s);
-  const nlohmann::json got = nlohmann::json::parse(summary_json(s, run));
+  const RunSummary got = summarise(s, run);
   const std::filesystem::path file = source_path("tests/golden/" + name + ".json");
   if (std::getenv("REDRES_UPDATE_GOLDEN") != nullptr) {
     std::filesystem::create_directories(file.parent_path());
-    nlohmann::json keep = got;
+    nlohmann::json keep = nlohmann::json::parse(to_json(got));
     keep.erase("wall_time_s");
     keep.erase("source");
     std::ofstream(file) << keep.dump(2) << "\n";
@@ -50,25 +50,26 @@ TEST_P(Golden, SummaryStaysWithinTolerances) {
   ASSERT_TRUE(in) << "no golden file " << file << "; record it with REDRES_UPDATE_GOLDEN=1";
   const nlohmann::json want = nlohmann::json::parse(in);
 
-  EXPECT_EQ(got["steps"], want["steps"]);
-  EXPECT_EQ(got["solver"]["failures"], want["solver"]["failures"]);
-  EXPECT_EQ(got["solver"]["engine"], want["solver"]["engine"]);
-  for (const char* k : {"initial", "final", "mean", "min", "max"}) {
-    const double w = want["manipulability"][k];
-    EXPECT_NEAR(got["manipulability"][k].get<double>(), w, 1e-6 * std::abs(w)) << "manipulability." << k;
+  EXPECT_EQ(got.steps, want["steps"].get<int>());
+  EXPECT_EQ(got.solver.failures, want["solver"]["failures"].get<int>());
+  EXPECT_EQ(got.solver.engine, want["solver"]["engine"].get<std::string>());
+  const ManipulabilityStats& w = got.manipulability;
+  const std::pair<const char*, double> ws[] = {
+      {"initial", w.initial}, {"final", w.final}, {"mean", w.mean}, {"min", w.min}, {"max", w.max}};
+  for (const auto& [k, v] : ws) {
+    const double expected = want["manipulability"][k];
+    EXPECT_NEAR(v, expected, 1e-6 * std::abs(expected)) << "manipulability." << k;
   }
-  for (const char* k : {"initial_joint_velocity_norm", "final_joint_velocity_norm"}) {
-    EXPECT_NEAR(got[k].get<double>(), want[k].get<double>(), 1e-6) << k;
-  }
-  for (const char* k : {"max_position_error", "final_position_error"}) {
-    const double w = want[k];
-    EXPECT_NEAR(got[k].get<double>(), w, 0.1 * w + 1e-8) << k;
-  }
-  EXPECT_LE(got["max_joint_angle_violation"].get<double>(), 0.0);
-  EXPECT_LE(got["max_joint_velocity_violation"].get<double>(), 0.0);
-  ASSERT_EQ(got["final_theta"].size(), want["final_theta"].size());
-  for (std::size_t j = 0; j < want["final_theta"].size(); ++j) {
-    EXPECT_NEAR(got["final_theta"][j].get<double>(), want["final_theta"][j].get<double>(), 1e-6) << "joint " << j + 1;
+  EXPECT_NEAR(got.initial_joint_velocity_norm, want["initial_joint_velocity_norm"].get<double>(), 1e-6);
+  EXPECT_NEAR(got.final_joint_velocity_norm, want["final_joint_velocity_norm"].get<double>(), 1e-6);
+  const double e_max = want["max_position_error"], e_final = want["final_position_error"];
+  EXPECT_NEAR(got.max_position_error, e_max, 0.1 * e_max + 1e-8);
+  EXPECT_NEAR(got.final_position_error, e_final, 0.1 * e_final + 1e-8);
+  EXPECT_LE(got.max_joint_angle_violation, 0.0);
+  EXPECT_LE(got.max_joint_velocity_violation, 0.0);
+  ASSERT_EQ(got.final_theta.size(), want["final_theta"].size());
+  for (std::size_t j = 0; j < got.final_theta.size(); ++j) {
+    EXPECT_NEAR(got.final_theta[j], want["final_theta"][j].get<double>(), 1e-6) << "joint " << j + 1;
   }
 }
 

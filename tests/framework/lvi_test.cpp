@@ -120,7 +120,7 @@ TEST(Lvi, PaperFamilyEnginesAgreeAtThePapersTolerance) {
     ASSERT_EQ(proj.result.info.status, newton.result.info.status) << rep << ": " << newton.result.info.diagnosis;
     if (newton.result.info.status != SolverStatus::kSolved) continue;
     ++feasible;
-    ASSERT_STREQ(newton.result.info.engine, "newton");
+    ASSERT_EQ(newton.result.info.engine, "newton");
     const double dx = (proj.result.x - newton.result.x).cwiseAbs().maxCoeff();
     EXPECT_LE(dx, 5e-5) << rep;
     over += dx > 1e-5;
@@ -166,7 +166,7 @@ TEST(Lvi, PaperStepAllEnginesAgree) {
   const Solved nlopt = solve_with("nlopt", step->qp);
   ASSERT_EQ(proj.result.info.status, SolverStatus::kSolved) << proj.result.info.diagnosis;
   ASSERT_EQ(newton.result.info.status, SolverStatus::kSolved) << newton.result.info.diagnosis;
-  EXPECT_STREQ(newton.result.info.engine, "newton");
+  EXPECT_EQ(newton.result.info.engine, "newton");
   EXPECT_LE(kkt_residual(step->qp, newton.result), 1e-10);
   EXPECT_LE((proj.result.x - newton.result.x).cwiseAbs().maxCoeff(), 1e-5);
   EXPECT_LE((nlopt.result.x - newton.result.x).cwiseAbs().maxCoeff(), 1e-5);

@@ -13,6 +13,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"redres: redundancy resolution of redundant manipulators (QP from plugins, solved as an LVI)"};
   app.require_subcommand(1);
+  app.fallthrough();  // options of the main command (--plugin) may also follow the subcommand
   app.set_version_flag("--version", "redres 0.1.0");
   redres::cli::Action action;
   std::vector<std::string> plugin_libraries;

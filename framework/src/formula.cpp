@@ -2,7 +2,6 @@
 
 #include <array>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
 
 #include <muParser.h>
@@ -20,7 +19,6 @@ struct Formula::Impl {
   std::vector<std::string> names;
   std::array<double, kMaxVariables> values{};
   mu::Parser parser;
-  std::mutex mutex;
 };
 
 Formula::Formula(std::string text, std::vector<std::string> variables) : impl_(std::make_unique<Impl>()) {
@@ -48,7 +46,6 @@ Formula::Formula(Formula&&) noexcept = default;
 Formula& Formula::operator=(Formula&&) noexcept = default;
 
 double Formula::evaluate(std::initializer_list<double> values) const {
-  const std::lock_guard<std::mutex> lock(impl_->mutex);
   std::size_t k = 0;
   for (double v : values) {
     if (k < kMaxVariables) impl_->values[k] = v;

@@ -47,7 +47,7 @@ KinematicsData::KinematicsData(const RobotModel& model)
       svd_(model.task_dim(), model.dof(), Eigen::ComputeThinU | Eigen::ComputeThinV) {}
 
 double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> adj,
-                              Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>& eig) {
+                              TaskEigenSolver& eig) {
   const Eigen::Index m = A.rows();
   switch (m) {
     case 1:

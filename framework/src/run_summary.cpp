@@ -7,11 +7,11 @@
 
 namespace redres {
 
-const Metric* RunSummary::metric(const std::string& plugin, const std::string& name) const {
+const Metric* RunSummary::metric(const std::string& plugin, const std::string& metric_name) const {
   for (const auto& pm : metrics) {
     if (pm.plugin != plugin) continue;
     for (const auto& m : pm.metrics) {
-      if (m.name == name) return &m;
+      if (m.name == metric_name) return &m;
     }
   }
   return nullptr;
@@ -110,7 +110,7 @@ std::string to_json(const RunSummary& s) {
   for (const auto& pm : s.metrics) {
     nlohmann::json figures = nlohmann::json::object();
     for (const auto& m : pm.metrics) {
-      figures[m.name] = m.values.size() == 1 ? nlohmann::json(m.values.front()) : nlohmann::json(m.values);
+      figures[m.name] = m.values.size() == 1 && !m.per_joint ? nlohmann::json(m.values.front()) : nlohmann::json(m.values);
     }
     metrics[pm.plugin] = figures;
   }

@@ -8,12 +8,17 @@ namespace redres {
 Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
                std::vector<std::unique_ptr<Constraint>> constraints)
     : robot_(&robot), objectives_(std::move(objectives)), constraints_(std::move(constraints)) {
+  std::set<std::string> names;
   for (const auto& o : objectives_) {
     REDRES_REQUIRE(o != nullptr, "Scheme", "every objective is non-null");
+    REDRES_REQUIRE(names.insert(o->name()).second, "Scheme",
+                   "plugin names are unique (two are named '" + o->name() + "'; rename one with set_name())");
     level_ = std::max(level_, o->kinematics_level());
   }
   for (const auto& c : constraints_) {
     REDRES_REQUIRE(c != nullptr, "Scheme", "every constraint is non-null");
+    REDRES_REQUIRE(names.insert(c->name()).second, "Scheme",
+                   "plugin names are unique (two are named '" + c->name() + "'; rename one with set_name())");
     level_ = std::max(level_, c->kinematics_level());
     const int e = c->equality_rows(robot);
     const int i = c->inequality_rows(robot);

@@ -1,6 +1,11 @@
 #include "redres/constraints/task_tracking.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Geometry>
+
+#include "redres/trajectory.hpp"
 
 namespace redres {
 
@@ -38,6 +43,36 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
     const Eigen::AngleAxisd err(rotation_of(ctx.r_d->tail<3>()) * k.ee_pose.linear().transpose());
     d.tail(3) = ctx.r_d_dot->tail<3>() + gain_.tail<3>().cwiseProduct(err.angle() * err.axis());
   }
+}
+
+namespace {
+// The angle between two orientations: planar, the difference of the angles phi; spatial, the angle of R_d R'.
+double orientation_error(const RobotModel& robot, const Eigen::Vector3d& desired, const Eigen::Vector3d& actual) {
+  if (robot.kind() == ChainKind::kPlanar) return std::abs(desired.z() - actual.z());
+  return Eigen::AngleAxisd(rotation_of(desired) * rotation_of(actual).transpose()).angle();
+}
+}  // namespace
+
+void TaskTracking::summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const {
+  const auto& names = robot.task_names();
+  const std::size_t position_rows = robot.kind() == ChainKind::kPlanar ? 2 : 3;
+  if (names.size() <= position_rows) return;  // no orientation rows
+  std::vector<std::size_t> rd, r;
+  for (std::size_t k = position_rows; k < names.size(); ++k) {
+    rd.push_back(run.column("rd_" + names[k]));
+    r.push_back(run.column("r_" + names[k]));
+  }
+  double worst = 0.0;
+  for (std::size_t row = 0; row < run.size(); ++row) {
+    Eigen::Vector3d want = Eigen::Vector3d::Zero(), got = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < rd.size(); ++k) {
+      const auto i = static_cast<Eigen::Index>(rd.size() == 1 ? 2 : k);
+      want(i) = run(row, rd[k]);
+      got(i) = run(row, r[k]);
+    }
+    worst = std::max(worst, orientation_error(robot, want, got));
+  }
+  out.push_back({"max_orientation_error", {worst}, "rad"});
 }
 
 namespace {

@@ -1,4 +1,4 @@
-/// `newton`: an exact, fast engine for the same LVI (DESIGN section 2). For diagonal W > 0 with equality rows and
+/// `newton`: an exact, fast engine for the same LVI (docs/lvi.md). For diagonal W > 0 with equality rows and
 /// bounds, eq. 14 reduces to the m_e dual unknowns y:
 ///   x(y) = P_[lo,hi](W^-1 (J' y - zeta)),   F(y) = J x(y) - d = 0,
 /// where F is minus the gradient of the concave dual function
@@ -298,9 +298,13 @@ class Newton final : public LviEngine {
     result.x = fallback_result_.x;
     result.y = fallback_result_.y;
     result.z = fallback_result_.z;
-    const std::string diagnosis = std::move(result.info.diagnosis);
-    result.info = fallback_result_.info;  // names "projection" as the engine that ran
-    if (result.info.diagnosis.empty()) result.info.diagnosis = diagnosis;
+    // Field by field, so that result.info.diagnosis keeps the capacity reserved at setup (no allocation).
+    const SolverInfo& fb = fallback_result_.info;
+    result.info.status = fb.status;
+    result.info.iterations = fb.iterations;
+    result.info.residual = fb.residual;
+    result.info.engine = fb.engine;  // names "projection" as the engine that ran
+    if (!fb.diagnosis.empty()) result.info.diagnosis = fb.diagnosis;
     y_ = result.y;
   }
 

@@ -2,7 +2,7 @@
 ///   u^{k+1} = u^k - (||e(u^k)||^2 / ||phi(u^k)||^2) phi(u^k),  phi = (M' + I) e,
 /// stopped when ||e(u^k)||_2 <= tolerance. It converges globally and linearly.
 ///
-/// Choices (DESIGN section 2):
+/// Choices (docs/lvi.md):
 /// - The iterate u^k is not kept inside Omega, so its x may leave [lo, hi] by about the tolerance. The returned x
 ///   is the projection of the final iterate onto [lo, hi] (the bounds then hold exactly); the reported residual is
 ///   ||e|| of the iterate itself, i.e. the paper's stopping test. The engine keeps the unprojected iterate for the

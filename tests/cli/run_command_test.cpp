@@ -1,5 +1,5 @@
 // The scenario commands of the CLI: run, validate, compare, --set, exit codes, and the output formats of
-// DESIGN section 6.
+// docs/output_formats.md.
 
 #include <sys/wait.h>
 
@@ -11,34 +11,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_util.hpp"
 #include "test_util.hpp"
 
 namespace redres {
 namespace {
 
-struct Cli {
-  int code = -1;
-  std::string out;
-};
-
-// Runs the CLI from the source tree with stderr merged into the captured output.
-Cli redres(const std::string& args) {
-  const std::string cmd = "cd '" + std::string(REDRES_SOURCE_DIR) + "' && '" + REDRES_CLI + "' " + args + " 2>&1";
-  Cli r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p) != nullptr) r.out += buf;
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-std::filesystem::path scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("redres_cli_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  return dir;
-}
 
 std::string first_line(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -47,7 +25,7 @@ std::string first_line(const std::filesystem::path& file) {
   return line;
 }
 
-TEST(CliScenario, RunWritesTheTrajectoryAndSummaryOfDesignSection6) {
+TEST(CliScenario, RunWritesTheTrajectoryAndSummaryOfOutputFormats) {
   const auto dir = scratch("run");
   const Cli r = redres("run configs/paper_r_mvn.toml --out '" + dir.string() + "' --quiet");
   ASSERT_EQ(r.code, 0) << r.out;

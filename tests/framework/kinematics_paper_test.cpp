@@ -1,4 +1,4 @@
-// The paper's arm at theta(0): the values of DESIGN section 4, computed independently, to 1e-9.
+// The paper's arm at theta(0): the reference values of docs/paper.md, computed independently, to 1e-9.
 
 #include <cmath>
 

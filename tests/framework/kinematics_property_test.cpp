@@ -153,7 +153,7 @@ TEST(KinematicsSingular, GradientsStayFiniteAndCorrectAtAndNearSingularity) {
   EXPECT_LT(k.grad_w.norm(), 1e-14);
   // The adjugate's defining identity adj(A) A = det(A) I, on SPD matrices of the cofactor sizes and of the
   // eigen-decomposition path.
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(5);
+  TaskEigenSolver eig(5);
   for (int m : {2, 3, 5}) {
     Eigen::MatrixXd B(m, m + 2);
     for (int r = 0; r < m; ++r)

@@ -1,4 +1,4 @@
-// Paths: the letter R of DESIGN section 5, timing laws, and r_d_dot against central differences of r_d for every
+// Paths: the letter R of docs/letter_r.md, timing laws, and r_d_dot against central differences of r_d for every
 // path type.
 
 #include <cmath>

@@ -49,8 +49,11 @@ namespace redres {
 /// turns it into a ConfigError at the key's file:line:col, the C++ path into std::invalid_argument.
 class FieldError : public std::invalid_argument {
  public:
-  FieldError(std::string key, const std::string& message)
-      : std::invalid_argument("key '" + key + "': " + message), key_(std::move(key)), message_(message) {}
+  /// what() is "[<who>: ]key '<key>': <message>".
+  FieldError(std::string key, const std::string& message, const std::string& who = "")
+      : std::invalid_argument((who.empty() ? "" : who + ": ") + "key '" + key + "': " + message),
+        key_(std::move(key)),
+        message_(message) {}
   /// The offending key ("" for the table as a whole).
   [[nodiscard]] const std::string& key() const noexcept { return key_; }
   /// What was expected, without the key.
@@ -482,7 +485,7 @@ void require_valid(const C& c, const Schema<C>& schema, const std::string& who) 
   try {
     check_config(c, schema);
   } catch (const FieldError& e) {
-    throw FieldError(e.key(), who + ": " + e.message());
+    throw FieldError(e.key(), e.message(), who);
   }
 }
 

@@ -7,8 +7,8 @@
 ///   same config ("round trip"); every key config() writes is documented in the schema ("documented keys");
 ///   contributions at random configurations and times are finite, W symmetric, bounds not NaN ("finite");
 ///   objectives with potential(): zeta per unit weight matches central differences of the potential ("gradient");
-/// - velocity-limit laws and engines: the default Config builds (or, with required keys, is rejected naming one);
-///   the built instance's config round-trips; engines solve a small feasible QP to tolerance;
+/// - velocity-limit laws: the default Config builds (or, with required keys, is rejected naming one), and the built
+///   law's config round-trips; engines: the default Config builds and solves a small feasible QP to tolerance;
 /// - paths: built from defaults in the dimensions they support; r_d(0) is the path origin; r_d_dot matches central
 ///   differences of r_d.
 

@@ -11,7 +11,9 @@
 
 namespace redres {
 
-/// A compiled formula of named variables. evaluate() is allocation-free and thread-safe (serialised).
+/// A compiled formula of named variables. evaluate() is allocation-free and takes no lock: each Formula owns its
+/// parser and variable slots, so one instance is evaluated by one thread at a time (every plugin or law instance
+/// holds its own; a scenario loaded per thread shares nothing).
 class Formula {
  public:
   /// Compiles `text`; throws std::invalid_argument with muParser's message if it does not parse or names an

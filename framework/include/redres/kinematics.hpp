@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Exact kinematics of a RobotModel: f(theta), J, the kinematic Hessian dJ/dtheta_i, the manipulability
-/// w = det(J J') with its gradient q (eq. 5, DESIGN section 4), and Yoshikawa's mu = sqrt(det(J J')) with its
+/// w = det(J J') with its gradient q (eq. 5, docs/paper.md), and Yoshikawa's mu = sqrt(det(J J')) with its
 /// gradient. All results live in a KinematicsData workspace sized once for the model; compute() allocates
 /// nothing.
 ///
@@ -28,6 +28,10 @@ enum class KinematicsLevel {
   kManipulability,  //!< + dJ/dtheta_i, w, q = grad w
   kAll,             //!< + Yoshikawa's mu and grad mu
 };
+
+/// Eigen-decomposition of an m x m task-space matrix, m <= 6 task rows. Its storage is fixed at 6 x 6, so that
+/// compute() allocates nothing: with dynamic storage, Eigen's tridiagonalisation allocates a work vector per call.
+using TaskEigenSolver = Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>>;
 
 /// Per-call buffers and results for one model. Reentrant: use one per thread.
 class KinematicsData {
@@ -61,7 +65,7 @@ class KinematicsData {
   Eigen::MatrixXd adj_;                                   // adj(A) (m x m)
   Eigen::MatrixXd weighted_;                              // adj(A) J or U diag(c) V' (m x n)
   Eigen::VectorXd products_;                              // prod_{j != k} s_j (m)
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig_;    // for adj(A) when m > 3
+  TaskEigenSolver eig_;                                   // for adj(A) when m > 3
   Eigen::JacobiSVD<Eigen::MatrixXd> svd_;                 // for mu
 };
 
@@ -70,9 +74,9 @@ class KinematicsData {
 void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
                         KinematicsData& data, KinematicsLevel level = KinematicsLevel::kManipulability);
 
-/// det(A) and adj(A) of a symmetric m x m matrix without inverting it (cofactors for m <= 3, eigen-decomposition
-/// otherwise, using `eig` as scratch). Allocation-free when `adj` and `eig` are sized.
+/// det(A) and adj(A) of a symmetric m x m matrix (m <= 6) without inverting it (cofactors for m <= 3,
+/// eigen-decomposition otherwise, using `eig` as scratch). Allocation-free when `adj` is sized.
 double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> adj,
-                              Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>& eig);
+                              TaskEigenSolver& eig);
 
 }  // namespace redres

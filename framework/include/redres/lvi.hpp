@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// LVI engines: solve the step's QP through its linear variational inequality (eqs. 13-15, DESIGN section 2).
+/// LVI engines: solve the step's QP through its linear variational inequality (eqs. 13-15, docs/lvi.md).
 ///
 /// With u = [x; y; z] (x = theta_dot, y duals of J x = d, z duals of A x <= b),
 ///   M = [W -J' A'; J 0 0; -A 0 0],  g = [zeta; -d; b],
@@ -98,7 +98,8 @@ class LviEngine {
 
  private:
   virtual void do_setup(int n, int m_e, int m_i) = 0;
-  /// Runs the engine. `result` holds the previous u when warm(). Must set status, iterations, residual, engine.
+  /// Runs the engine. `result` holds the previous u when warm(). Must set status, iterations and residual (solve()
+  /// names the engine before; a fallback that runs another engine names that one).
   virtual void do_solve(const QpProblem& qp, SolverResult& result) = 0;
 
   SolverSettings settings_;

@@ -44,7 +44,7 @@ struct PathSegment {
   double start_angle = 0.0;  //!< angle at the segment start (rad), measured from e1 towards e2
   double sweep = 0.0;        //!< signed angle swept (rad); negative is clockwise about e1 x e2
   double rise = 0.0;         //!< helix: advance along the axis over the whole segment (m)
-  double length = 0.0;       //!< arc length (m), set by finalise()
+  double length = 0.0;       //!< arc length (m), set by line() and arc() (a helix sets it itself)
 
   /// A line from p to q.
   static PathSegment line(const Eigen::Vector3d& p, const Eigen::Vector3d& q);
@@ -86,7 +86,7 @@ inline auto enum_names(Placement) {
 /// Geometry in local path coordinates: strokes of consecutive segments, and the placement and timing the shape
 /// prefers where the scenario does not say (e.g. the letter R is upright when rotated by 180 degrees).
 struct PathGeometry {
-  std::vector<std::vector<PathSegment>> strokes;  //!< each stroke is drawn from rest to rest (per_stroke timing)
+  std::vector<std::vector<PathSegment>> strokes{};  //!< each stroke is drawn from rest to rest (per_stroke timing)
   double rotation_deg = 0.0;                      //!< default planar rotation of the shape
   TimingScope scope = TimingScope::kPerStroke;    //!< default timing scope of the shape
 };
@@ -118,13 +118,13 @@ class Path {
   [[nodiscard]] const std::string& description() const noexcept { return description_; }
 
  private:
-  std::vector<PathSegment> segments_;
-  std::vector<double> seg_start_;     // arc length at each segment start (whole path)
-  std::vector<int> stroke_first_;     // first segment of each stroke
-  std::vector<double> stroke_start_;  // arc length at each stroke start
-  std::vector<double> stroke_length_;
-  std::vector<double> stroke_t0_;     // start time of each stroke
-  std::vector<double> stroke_T_;      // duration of each stroke
+  std::vector<PathSegment> segments_{};
+  std::vector<double> seg_start_{};     // arc length at each segment start (whole path)
+  std::vector<int> stroke_first_{};     // first segment of each stroke
+  std::vector<double> stroke_start_{};  // arc length at each stroke start
+  std::vector<double> stroke_length_{};
+  std::vector<double> stroke_t0_{};     // start time of each stroke
+  std::vector<double> stroke_T_{};      // duration of each stroke
   int dim_;
   double duration_;
   double total_ = 0.0;
@@ -132,7 +132,7 @@ class Path {
   TimingScope scope_;
   Eigen::Matrix3d rotation_;
   Eigen::Vector3d origin_;
-  std::string description_;
+  std::string description_{};
 };
 
 /// What a path plugin receives besides its Config.
@@ -146,11 +146,11 @@ struct PathContext {
 /// preference (PathGeometry) or, for `origin`, zero.
 struct PathPlacement {
   Placement placement = Placement::kRelative;   //!< origin absolute, or relative to f(theta(0))
-  std::optional<std::vector<double>> origin;     //!< path origin (m), 2 or 3 numbers
-  std::optional<double> rotation_deg;            //!< planar: rotation about z (deg); default: the shape's
-  std::optional<std::array<double, 3>> rpy_deg;  //!< spatial: roll, pitch, yaw (deg)
+  std::optional<std::vector<double>> origin{};     //!< path origin (m), 2 or 3 numbers
+  std::optional<double> rotation_deg{};            //!< planar: rotation about z (deg); default: the shape's
+  std::optional<std::array<double, 3>> rpy_deg{};  //!< spatial: roll, pitch, yaw (deg)
   TimingLaw timing = TimingLaw::kCycloidal;      //!< timing law
-  std::optional<TimingScope> timing_scope;       //!< per stroke or whole path; default: the shape's
+  std::optional<TimingScope> timing_scope{};       //!< per stroke or whole path; default: the shape's
 
   static const Schema<PathPlacement>& schema();
 };

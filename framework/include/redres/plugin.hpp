@@ -38,6 +38,7 @@ struct Metric {
   std::string name;            //!< e.g. "max_safety_region_entry"
   std::vector<double> values;  //!< one value, or one per joint
   std::string unit;            //!< e.g. "rad"
+  bool per_joint = false;      //!< values has one entry per joint (written as an array even for one joint)
 };
 
 /// Base of objectives and constraints: type, instance name, active flag and the configuration round trip.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The quadratic program built at every control step (eqs. 10-12, DESIGN section 2), with x = theta_dot in R^n:
+/// The quadratic program built at every control step (eqs. 10-12, docs/lvi.md), with x = theta_dot in R^n:
 ///
 ///   minimise   x'Wx/2 + zeta'x
 ///   subject to J x = d          (m_e equality rows, e.g. the end-effector task, eq. 11)

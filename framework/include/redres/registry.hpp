@@ -92,8 +92,10 @@ class Registry : public RegistryBase {
       return c;
     };
     e.write = [](const std::any& c, toml::table& out) { write_config(std::any_cast<const C&>(c), C::schema(), out); };
-    e.make = [make](const std::any& c, Args... args) -> std::unique_ptr<Base> {
-      return make(std::any_cast<const C&>(c), args...);
+    e.make = [make, type = e.type](const std::any& c, Args... args) -> std::unique_ptr<Base> {
+      const C& config = std::any_cast<const C&>(c);
+      require_valid(config, C::schema(), type);  // a Config built in C++ obeys the same rules as one read from TOML
+      return make(config, args...);
     };
     if (const auto it = entries_.find(e.type); it != entries_.end()) {
       const std::string why = "duplicate " + kind() + " type '" + e.type + "': already registered by " +

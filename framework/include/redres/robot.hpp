@@ -8,7 +8,7 @@
 /// Geometry. Every joint j is a fixed transform A_j, then the joint motion (Rz(theta_j) for revolute, Tz(theta_j)
 /// for prismatic), then a fixed transform B_j; the end effector is a fixed transform E after the last joint:
 ///   T(theta) = A_1 M_1(theta_1) B_1 ... A_n M_n(theta_n) B_n E.
-/// - planar chains (relative joint angles, eq. in DESIGN section 5): A_j = I, B_j = Tx(l_j);
+/// - planar chains (relative joint angles, docs/letter_r.md): A_j = I, B_j = Tx(l_j);
 ///   so x = sum_i l_i cos(theta_1 + ... + theta_i) and y likewise with sin.
 /// - spatial, standard DH (`convention = "dh"`): A_j = Rz(theta_offset_j) [Tz(d_j) if prismatic],
 ///   B_j = [Tz(d_j) if revolute] Tx(a_j) Rx(alpha_j). Joint j moves about/along the z axis of frame j-1.

@@ -65,7 +65,7 @@ struct RunSummary {
   std::vector<PluginMetrics> metrics;  //!< per plugin that reports figures
 
   /// A plugin's metric by plugin instance name and metric name, or nullptr.
-  [[nodiscard]] const Metric* metric(const std::string& plugin, const std::string& name) const;
+  [[nodiscard]] const Metric* metric(const std::string& plugin, const std::string& metric_name) const;
 };
 
 /// Summarises a run of `scenario`.

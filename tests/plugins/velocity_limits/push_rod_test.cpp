@@ -1,5 +1,5 @@
 // The push-rod law (eq. 2) of the paper's arm against the formula computed by hand, and the `redres robot`
-// command on the paper's arm (DESIGN section 4 values).
+// command on the paper's arm (the reference values of docs/paper.md).
 
 #include <sys/wait.h>
 

@@ -4,6 +4,8 @@
 ///   J x = r_d_dot + K (r_d - f(theta)),
 /// where m is the robot's number of task rows and K = diag(gain). For spatial `pose` tasks the orientation rows use
 /// the rotation-vector error log(R_d R') (r_d's orientation entries are a rotation vector).
+/// Reports to the run summary, for tasks with orientation rows: `max_orientation_error` (rad), the largest angle
+/// between the desired and the actual orientation over the run.
 
 #include "redres/plugin.hpp"
 
@@ -23,6 +25,7 @@ class TaskTracking final : public Configured<Constraint, TaskTrackingConfig> {
   TaskTracking(const Config& config, const RobotModel& robot);
   [[nodiscard]] int equality_rows(const RobotModel& robot) const override { return robot.task_dim(); }
   [[nodiscard]] KinematicsLevel kinematics_level() const override { return KinematicsLevel::kJacobian; }
+  void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const override;
 
  private:
   void add_to(const Context& ctx, QpBuilder& builder) const override;

@@ -31,7 +31,7 @@ struct ManipulabilityConfig {
   Schedule schedule = Schedule::kSine;    //!< p(t)
   double p = 2.0;                         //!< coefficient magnitude
   double ramp_fraction = 0.25;            //!< smoothstep: each ramp's share of T
-  std::optional<std::string> formula;     //!< expression: p(t) as a formula of t and T
+  std::optional<std::string> formula{};     //!< expression: p(t) as a formula of t and T
 
   static const Schema<ManipulabilityConfig>& schema();
 };

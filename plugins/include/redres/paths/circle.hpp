@@ -18,7 +18,7 @@ struct CircleConfig {
   double turns = 1.0;                            //!< number of turns
   double start_angle_deg = 0.0;                  //!< the origin's angle on the circle (deg)
   Direction direction = Direction::kCcw;         //!< about the normal
-  std::optional<std::array<double, 3>> normal;   //!< plane normal (spatial tasks; default: z)
+  std::optional<std::array<double, 3>> normal{};   //!< plane normal (spatial tasks; default: z)
 
   static const Schema<CircleConfig>& schema();
 };

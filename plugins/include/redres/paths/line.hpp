@@ -10,7 +10,7 @@ namespace redres {
 
 /// The configuration of `line`.
 struct LineConfig {
-  std::vector<double> delta;  //!< displacement from the origin (m): [dx, dy] or [dx, dy, dz]; required
+  std::vector<double> delta{};  //!< displacement from the origin (m): [dx, dy] or [dx, dy, dz]; required
 
   static const Schema<LineConfig>& schema();
 };

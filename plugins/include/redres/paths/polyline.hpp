@@ -15,16 +15,16 @@ namespace redres {
 
 /// One polyline segment: a line (`to`) or an arc (`center` and `sweep_deg`).
 struct PolylineSegment {
-  std::optional<std::array<double, 2>> to;      //!< line end (m)
-  std::optional<std::array<double, 2>> center;  //!< arc centre (m)
-  std::optional<double> sweep_deg;              //!< arc sweep (deg), counter-clockwise for > 0
+  std::optional<std::array<double, 2>> to{};      //!< line end (m)
+  std::optional<std::array<double, 2>> center{};  //!< arc centre (m)
+  std::optional<double> sweep_deg{};              //!< arc sweep (deg), counter-clockwise for > 0
 
   static const Schema<PolylineSegment>& schema();
 };
 
 /// The configuration of `polyline`.
 struct PolylineConfig {
-  std::vector<PolylineSegment> segments;  //!< required, non-empty
+  std::vector<PolylineSegment> segments{};  //!< required, non-empty
   bool stop_at_corners = true;            //!< every segment drawn from rest to rest
 
   static const Schema<PolylineConfig>& schema();

@@ -13,8 +13,8 @@ namespace redres {
 
 /// The configuration of `expression`. Both keys are required.
 struct ExpressionLawConfig {
-  std::string lower;  //!< formula of theta for the lower limit (rad/s or m/s)
-  std::string upper;  //!< formula of theta for the upper limit
+  std::string lower{};  //!< formula of theta for the lower limit (rad/s or m/s)
+  std::string upper{};  //!< formula of theta for the upper limit
 
   static const Schema<ExpressionLawConfig>& schema();
 };

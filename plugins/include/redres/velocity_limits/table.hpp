@@ -15,10 +15,10 @@ namespace redres {
 
 /// The configuration of `table`: either `file`, or `theta`, `lower` and `upper` (group "points").
 struct TableLawConfig {
-  std::vector<double> theta;                  //!< joint positions (rad or m), strictly increasing
-  std::vector<double> lower;                  //!< lower limits at those positions
-  std::vector<double> upper;                  //!< upper limits at those positions
-  std::optional<std::filesystem::path> file;  //!< CSV with columns theta,lower,upper (instead of the arrays)
+  std::vector<double> theta{};                  //!< joint positions (rad or m), strictly increasing
+  std::vector<double> lower{};                  //!< lower limits at those positions
+  std::vector<double> upper{};                  //!< upper limits at those positions
+  std::optional<std::filesystem::path> file{};  //!< CSV with columns theta,lower,upper (instead of the arrays)
 
   static const Schema<TableLawConfig>& schema();
 };

@@ -1,0 +1,110 @@
+// Plugin libraries in the stock CLI: named by a scenario (`plugins = [...]`, relative to the file), by --plugin,
+// or found through REDRES_PLUGIN_PATH; a library that cannot be loaded, registers a name that exists, or registers
+// nothing is exit 2 with the library (and the file:line:col that named it) in the message.
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "cli_util.hpp"
+#include "test_util.hpp"
+
+namespace redres {
+namespace {
+
+const std::string kPlugin = REDRES_TEST_PLUGIN;
+
+// A scenario in `dir` that uses the test plugin's objective and constraint; `plugins` is the TOML array text.
+std::filesystem::path write_scenario(const std::filesystem::path& dir, const std::string& plugins) {
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "scenario.toml") << "plugins = " << plugins << "\n"
+                                       << "robot = \"" << source_path("robots/paper_pushrod_6dof.toml").string() << "\"\n"
+                                       << R"(theta0 = ["pi/4", "pi/12", "pi/12", "pi/12", "pi/36", "pi/36"]
+duration = 2.0
+step = 0.01
+[path]
+type = "line"
+delta = [-0.02, 0.0]
+[[objectives]]
+type = "test_damping"
+gain = 2.0
+[[constraints]]
+type = "task_tracking"
+[[constraints]]
+type = "test_cap"
+cap = 0.2
+[solver]
+engine = "newton"
+)";
+  return dir / "scenario.toml";
+}
+
+TEST(PluginLoader, AScenarioNamesALibraryRelativeToItself) {
+  const auto dir = scratch("plugin_relative");
+  std::filesystem::create_directories(dir / "lib");
+  std::filesystem::copy_file(kPlugin, dir / "lib" / "libmine.so");
+  const auto file = write_scenario(dir, "[\"lib/libmine.so\"]");
+  const Cli r = redres("run '" + file.string() + "' --out '" + (dir / "out").string() + "' --quiet");
+  EXPECT_EQ(r.code, 0) << r.out;
+  std::ifstream summary(dir / "out" / "summary.json");
+  std::stringstream text;
+  text << summary.rdbuf();
+  EXPECT_NE(text.str().find("\"failures\": 0"), std::string::npos) << text.str();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(PluginLoader, PluginOptionAndSearchPathLoadLibrariesForEveryCommand) {
+  const Cli listed = redres("--plugin '" + kPlugin + "' plugins");
+  EXPECT_EQ(listed.code, 0) << listed.out;
+  EXPECT_NE(listed.out.find("test_damping   (from "), std::string::npos) << listed.out;
+  EXPECT_NE(listed.out.find("test_cap   (from "), std::string::npos) << listed.out;
+  const Cli without = redres("plugins");
+  EXPECT_EQ(without.out.find("test_damping"), std::string::npos);
+
+  const auto dir = scratch("plugin_path");
+  std::filesystem::create_directories(dir / "search");
+  std::filesystem::copy_file(kPlugin, dir / "search" / "libmine.so");
+  // A bare name in the scenario, found through REDRES_PLUGIN_PATH (which also loads it at start: loaded once).
+  const auto file = write_scenario(dir, "[\"libmine.so\"]");
+  const Cli r = redres("validate '" + file.string() + "'");
+  EXPECT_EQ(r.code, 2) << "the bare name must not be found without the search path: " << r.out;
+  const std::string env = "REDRES_PLUGIN_PATH='" + (dir / "search").string() + "' ";
+  const Cli found = redres_env(env, "validate '" + file.string() + "'");
+  EXPECT_EQ(found.code, 0) << found.out;
+  const Cli check = redres_env(env, "plugins --check");
+  EXPECT_EQ(check.code, 0) << check.out;
+  EXPECT_NE(check.out.find("checks passed, 0 failed"), std::string::npos) << check.out;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(PluginLoader, BadLibrariesAreExitTwoNamingTheLibrary) {
+  const Cli dup = redres("--plugin '" + std::string(REDRES_TEST_PLUGIN_DUPLICATE) + "' plugins");
+  EXPECT_EQ(dup.code, 2);
+  EXPECT_NE(dup.out.find(REDRES_TEST_PLUGIN_DUPLICATE), std::string::npos) << dup.out;
+  EXPECT_NE(dup.out.find("duplicate objective type 'manipulability': already registered by built-in"),
+            std::string::npos)
+      << dup.out;
+
+  const Cli empty = redres("--plugin '" + std::string(REDRES_TEST_PLUGIN_EMPTY) + "' plugins");
+  EXPECT_EQ(empty.code, 2);
+  EXPECT_NE(empty.out.find("registered no plugin"), std::string::npos) << empty.out;
+
+  const auto dir = scratch("plugin_bad");
+  // Not a shared library at all.
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "libjunk.so") << "not an ELF file\n";
+  const Cli junk = redres("validate '" + write_scenario(dir, "[\"libjunk.so\"]").string() + "'");
+  EXPECT_EQ(junk.code, 2);
+  EXPECT_NE(junk.out.find("scenario.toml:1:12: plugin library"), std::string::npos) << junk.out;
+  EXPECT_NE(junk.out.find("cannot be loaded"), std::string::npos) << junk.out;
+  // Missing.
+  const Cli missing = redres("validate '" + write_scenario(dir, "[\"nowhere/libnone.so\"]").string() + "'");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.out.find("scenario.toml:1:12: plugin library"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("no such file"), std::string::npos) << missing.out;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace redres

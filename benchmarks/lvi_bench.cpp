@@ -15,7 +15,6 @@
 #include "qp_util.hpp"
 #include "test_util.hpp"
 
-
 namespace {
 
 using redres::QpProblem;

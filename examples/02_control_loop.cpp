@@ -29,14 +29,14 @@ int main(int argc, char** argv) {
     std::vector<std::unique_ptr<Objective>> objectives;
     objectives.push_back(std::make_unique<MinVelocityNorm>(MinVelocityNorm::Config{}, robot));
     objectives.push_back(std::make_unique<Manipulability>(
-        Manipulability::Config{.measure = Manipulability::Measure::kDet, .schedule = Manipulability::Schedule::kSine,
-                               .p = 2.0},
+        Manipulability::Config{
+            .measure = Manipulability::Measure::kDet, .schedule = Manipulability::Schedule::kSine, .p = 2.0},
         robot));
     std::vector<std::unique_ptr<Constraint>> constraints;
     constraints.push_back(std::make_unique<TaskTracking>(TaskTracking::Config{.gain = 8.0}, robot));
     // By name from the registry, with a config value: the same as the class, for code that picks plugins by name.
-    constraints.push_back(
-        constraint_registry().create("joint_angle_margin", JointAngleMargin::Config{.kappa = 4.0, .margin = 0.0349}, robot));
+    constraints.push_back(constraint_registry().create(
+        "joint_angle_margin", JointAngleMargin::Config{.kappa = 4.0, .margin = 0.0349}, robot));
     constraints.push_back(std::make_unique<JointVelocityLimits>(JointVelocityLimits::Config{.scale = 1.0}, robot));
     const Scheme scheme(robot, std::move(objectives), std::move(constraints));
     const auto engine = engine_registry().create("newton", NewtonConfig{}, SolverSettings{.tolerance = 1e-6});

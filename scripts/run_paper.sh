@@ -6,5 +6,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/build.sh release
+# The figures run plot_run.py with the python3 found on PATH; put Debian's, which has the matplotlib and numpy that
+# install_deps.sh installed, first (another python3, e.g. a pyenv shim, may come first and lack them).
+export PATH="/usr/bin:$PATH"
 ./build/release/bin/redres compare configs/paper_r_tvcmm.toml configs/paper_r_constant_p.toml \
   configs/paper_r_mvn.toml --out out/paper "$@"

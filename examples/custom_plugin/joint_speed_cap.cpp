@@ -26,8 +26,8 @@ class JointSpeedCap final : public redres::Configured<redres::Constraint, JointS
     for (int j : config_.joints) {
       // Checks that need the robot throw FieldError: from TOML it becomes file:line:col at the key.
       if (j > robot.dof()) {
-        throw redres::FieldError("joints", "expected joint numbers from 1 to " + std::to_string(robot.dof()) +
-                                               ", got " + std::to_string(j));
+        throw redres::FieldError(
+            "joints", "expected joint numbers from 1 to " + std::to_string(robot.dof()) + ", got " + std::to_string(j));
       }
     }
   }

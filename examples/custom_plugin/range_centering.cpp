@@ -1,5 +1,6 @@
 // `range_centering`: an objective that keeps every joint near the middle of its range,
-//   P(theta) = lambda/2 sum_j ((theta_j - m_j) / h_j)^2,   m_j = (theta_j^+ + theta_j^-)/2, h_j = (theta_j^+ - theta_j^-)/2,
+//   P(theta) = lambda/2 sum_j ((theta_j - m_j) / h_j)^2,   m_j = (theta_j^+ + theta_j^-)/2, h_j = (theta_j^+ -
+//   theta_j^-)/2,
 // added as zeta += weight * grad P = weight * lambda (theta_j - m_j) / h_j^2. Unlike joint_centering it scales each
 // joint by its own range, so a narrow joint is pulled as hard as a wide one.
 

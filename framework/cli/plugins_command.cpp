@@ -60,8 +60,8 @@ nlohmann::json keys_json(const std::vector<KeyInfo>& keys) {
     const char* presence = k.presence == Presence::kRequired ? "required"
                            : k.presence == Presence::kGroup  ? "group"
                                                              : "optional";
-    nlohmann::json j = {{"name", k.name}, {"presence", presence}, {"type", k.type}, {"unit", k.unit},
-                        {"rule", k.rule}, {"description", k.help}};
+    nlohmann::json j = {{"name", k.name}, {"presence", presence}, {"type", k.type},
+                        {"unit", k.unit}, {"rule", k.rule},       {"description", k.help}};
     if (k.presence == Presence::kOptional) j["default"] = k.default_text;
     if (k.presence == Presence::kGroup) j["group"] = k.group;
     out.push_back(j);
@@ -75,7 +75,10 @@ nlohmann::json registry_json(const R& registry) {
   for (const auto* e : registry.entries()) {
     nlohmann::json groups = nlohmann::json::object();
     for (const auto& [group, rule] : e->groups) groups[group] = rule;
-    out.push_back({{"type", e->type}, {"summary", e->summary}, {"origin", e->origin}, {"keys", keys_json(e->keys)},
+    out.push_back({{"type", e->type},
+                   {"summary", e->summary},
+                   {"origin", e->origin},
+                   {"keys", keys_json(e->keys)},
                    {"groups", groups}});
   }
   return out;

@@ -32,8 +32,10 @@ Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model) {
     }
   }
   if (static_cast<int>(values.size()) != model.dof()) {
-    throw std::invalid_argument("--theta: expected " + std::to_string(model.dof()) + " comma-separated values (one "
-                                "per joint), got " + std::to_string(values.size()));
+    throw std::invalid_argument("--theta: expected " + std::to_string(model.dof()) +
+                                " comma-separated values (one "
+                                "per joint), got " +
+                                std::to_string(values.size()));
   }
   Eigen::VectorXd theta = Eigen::Map<Eigen::VectorXd>(values.data(), model.dof());
   REDRES_REQUIRE(theta.allFinite(), "--theta", "every value is finite");
@@ -78,8 +80,8 @@ std::string row(const Eigen::Ref<const Eigen::VectorXd>& v) {
   return s.str();
 }
 
-void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::VectorXd& lo,
-                const Eigen::VectorXd& hi, bool at_home) {
+void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
+                bool at_home) {
   std::ostream& o = std::cout;
   std::string rows;
   for (const auto& n : model.task_names()) rows += (rows.empty() ? "" : ", ") + n;

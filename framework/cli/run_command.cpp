@@ -41,7 +41,8 @@ struct RunOptions {
 class ProgressBar {
  public:
   ProgressBar(std::string label, bool quiet)
-      : label_(std::move(label)), enabled_(!quiet && isatty(STDERR_FILENO) != 0),
+      : label_(std::move(label)),
+        enabled_(!quiet && isatty(STDERR_FILENO) != 0),
         start_(std::chrono::steady_clock::now()) {}
   ~ProgressBar() {
     if (shown_) std::fprintf(stderr, "\r\033[K");
@@ -122,10 +123,10 @@ Plotter find_plotter(std::string request) {
   }
   if (!std::filesystem::is_regular_file(p.script)) {
     const char* env = std::getenv("REDRES_TOOLS_DIR");
-    const std::string hint = env != nullptr && *env != '\0'
-                                 ? " (REDRES_TOOLS_DIR names a directory without it)"
-                                 : "; redres installs it at " REDRES_TOOLS_RELDIR " relative to its executable, or "
-                                   "set REDRES_TOOLS_DIR to the directory that holds it";
+    const std::string hint = env != nullptr && *env != '\0' ? " (REDRES_TOOLS_DIR names a directory without it)"
+                                                            : "; redres installs it at " REDRES_TOOLS_RELDIR
+                                                              " relative to its executable, or "
+                                                              "set REDRES_TOOLS_DIR to the directory that holds it";
     throw std::runtime_error(p.request + ": " + p.script.string() + " not found" + hint);
   }
   return p;
@@ -230,7 +231,8 @@ void add_run_commands(CLI::App& app, Action& action) {
     };
   });
 
-  CLI::App* validate = app.add_subcommand("validate", "Check a scenario (robot, path, plugins, solver) without running it");
+  CLI::App* validate =
+      app.add_subcommand("validate", "Check a scenario (robot, path, plugins, solver) without running it");
   validate->add_option("SCENARIO", opts->scenarios, "scenario TOML file")->required()->expected(1);
   validate->add_option("--set", opts->overrides, "override a scenario value: key.path=value (repeatable)");
   validate->callback([opts, &action] {
@@ -256,9 +258,9 @@ void add_run_commands(CLI::App& app, Action& action) {
       std::optional<Plotter> plotter;
       if (!opts->no_plots) plotter = find_plotter("compare (--no-plots skips the figures)");
       std::filesystem::create_directories(out);
-      std::string md = table_row({"scenario", "engine", "max position error (m)", "w(0)", "w(T)", "min w",
-                                  "mean w", "norm theta_dot(0)", "norm theta_dot(T)", "mean iterations", "failures",
-                                  "wall time (s)"});
+      std::string md =
+          table_row({"scenario", "engine", "max position error (m)", "w(0)", "w(T)", "min w", "mean w",
+                     "norm theta_dot(0)", "norm theta_dot(T)", "mean iterations", "failures", "wall time (s)"});
       md += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       std::string csv =
           "scenario,engine,max_position_error,w_initial,w_final,w_min,w_mean,initial_joint_velocity_norm,"
@@ -270,11 +272,18 @@ void add_run_commands(CLI::App& app, Action& action) {
         const Outcome o = run_one(load_scenario(file, opts->overrides), out / name, opts->quiet);
         failures += o.run.failures;
         const RunSummary& s = o.summary;
-        const std::vector<std::string> cells = {
-            s.name, s.solver.engine, num(s.max_position_error, 4), num(s.manipulability.initial),
-            num(s.manipulability.final), num(s.manipulability.min), num(s.manipulability.mean),
-            num(s.initial_joint_velocity_norm, 4), num(s.final_joint_velocity_norm, 4),
-            num(s.solver.mean_iterations, 4), std::to_string(s.solver.failures), num(s.wall_time_s, 3)};
+        const std::vector<std::string> cells = {s.name,
+                                                s.solver.engine,
+                                                num(s.max_position_error, 4),
+                                                num(s.manipulability.initial),
+                                                num(s.manipulability.final),
+                                                num(s.manipulability.min),
+                                                num(s.manipulability.mean),
+                                                num(s.initial_joint_velocity_norm, 4),
+                                                num(s.final_joint_velocity_norm, 4),
+                                                num(s.solver.mean_iterations, 4),
+                                                std::to_string(s.solver.failures),
+                                                num(s.wall_time_s, 3)};
         md += table_row(cells);
         for (std::size_t c = 0; c < cells.size(); ++c) csv += (c ? "," : "") + cells[c];
         csv += "\n";

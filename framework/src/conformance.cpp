@@ -224,8 +224,8 @@ void check_defaults(const Entry& e, Build build, const Recorder& rec) {
     rec("defaults", true, "the default Config builds");
   } catch (const std::exception& ex) {
     const std::string what = ex.what();
-    const bool expected = has_required && (what.find("required") != std::string::npos ||
-                                           what.find("expected") != std::string::npos);
+    const bool expected =
+        has_required && (what.find("required") != std::string::npos || what.find("expected") != std::string::npos);
     rec("defaults", expected,
         expected ? "has required keys; the default Config is rejected: " + what : "the default Config fails: " + what);
   }
@@ -323,7 +323,8 @@ std::vector<ConformanceResult> check_registries(const std::string& origin) {
   for (const auto* e : velocity_limit_registry().entries()) {
     if (!wanted(e->origin, origin)) continue;
     const Recorder rec{out, "velocity-limit law", e->type};
-    check_defaults(*e, [e] { (void)e->make(e->defaults); }, rec);
+    check_defaults(
+        *e, [e] { (void)e->make(e->defaults); }, rec);
     try {
       const auto law = e->make(e->defaults);
       const auto file = parse_toml_string(toml_text(law->config()), "<" + e->type + " config>");

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include <muParser.h>
@@ -10,8 +11,6 @@ namespace redres {
 
 namespace {
 constexpr std::size_t kMaxVariables = 8;
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kE = 2.71828182845904523536;
 }  // namespace
 
 struct Formula::Impl {
@@ -29,8 +28,8 @@ Formula::Formula(std::string text, std::vector<std::string> variables) : impl_(s
   impl_->names = std::move(variables);
   try {
     for (std::size_t k = 0; k < impl_->names.size(); ++k) impl_->parser.DefineVar(impl_->names[k], &impl_->values[k]);
-    impl_->parser.DefineConst("pi", kPi);
-    impl_->parser.DefineConst("e", kE);
+    impl_->parser.DefineConst("pi", std::numbers::pi);
+    impl_->parser.DefineConst("e", std::numbers::e);
     impl_->parser.SetExpr(impl_->text);
     (void)impl_->parser.Eval();  // compiles now, so syntax errors and unknown names surface at load
   } catch (const mu::Parser::exception_type& e) {

@@ -50,9 +50,7 @@ double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen:
                               TaskEigenSolver& eig) {
   const Eigen::Index m = A.rows();
   switch (m) {
-    case 1:
-      adj(0, 0) = 1.0;
-      return A(0, 0);
+    case 1: adj(0, 0) = 1.0; return A(0, 0);
     case 2:
       adj(0, 0) = A(1, 1);
       adj(1, 1) = A(0, 0);
@@ -91,14 +89,15 @@ double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen:
   }
 }
 
-void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
-                        KinematicsData& data, KinematicsLevel level) {
+void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
+                        KinematicsLevel level) {
   const int n = model.dof();
-  REDRES_REQUIRE(theta.size() == n, "compute_kinematics",
-          "theta.size() == dof() (got " + std::to_string(theta.size()) + ", expected " + std::to_string(n) + ")");
+  REDRES_REQUIRE(
+      theta.size() == n, "compute_kinematics",
+      "theta.size() == dof() (got " + std::to_string(theta.size()) + ", expected " + std::to_string(n) + ")");
   REDRES_REQUIRE(theta.allFinite(), "compute_kinematics", "theta is finite (it contains NaN or Inf)");
   REDRES_REQUIRE(data.J.cols() == n && data.J.rows() == model.task_dim(), "compute_kinematics",
-          "data was sized for this model (KinematicsData(model))");
+                 "data was sized for this model (KinematicsData(model))");
 
   data.theta = theta;
 

@@ -42,7 +42,8 @@ namespace {
 
 std::string joint_label(const QpProblem& qp, int i) {
   std::string s = "joint " + std::to_string(i + 1);
-  if (i < static_cast<int>(qp.variable_names.size())) s += " ('" + qp.variable_names[static_cast<std::size_t>(i)] + "')";
+  if (i < static_cast<int>(qp.variable_names.size()))
+    s += " ('" + qp.variable_names[static_cast<std::size_t>(i)] + "')";
   return s;
 }
 
@@ -219,8 +220,8 @@ std::unique_ptr<LviEngine> make_engine(const TableReader& solver) {
 std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSettings& settings) {
   const auto* e = engine_registry().find(name);
   if (e == nullptr) {
-    throw std::invalid_argument("make_engine: unknown engine '" + name + "'; known engines: " +
-                                engine_registry().names());
+    throw std::invalid_argument("make_engine: unknown engine '" + name +
+                                "'; known engines: " + engine_registry().names());
   }
   require_valid(settings, SolverSettings::schema(), "make_engine(" + name + ")");
   return e->make(e->defaults, settings);

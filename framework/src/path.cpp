@@ -10,8 +10,8 @@
 namespace redres {
 
 namespace {
-constexpr double kPi = std::numbers::pi;
-}
+using std::numbers::pi;
+}  // namespace
 
 PathSegment PathSegment::line(const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
   PathSegment s;
@@ -85,13 +85,13 @@ void timing(TimingLaw law, double u, double& sigma, double& dsigma) {
   u = std::clamp(u, 0.0, 1.0);
   switch (law) {
     case TimingLaw::kCycloidal:
-      sigma = u - std::sin(2.0 * kPi * u) / (2.0 * kPi);
-      dsigma = 1.0 - std::cos(2.0 * kPi * u);
+      sigma = u - std::sin(2.0 * pi * u) / (2.0 * pi);
+      dsigma = 1.0 - std::cos(2.0 * pi * u);
       return;
     case TimingLaw::kSin2: {
-      const double s = std::sin(0.5 * kPi * u);
+      const double s = std::sin(0.5 * pi * u);
       sigma = s * s;
-      dsigma = 0.5 * kPi * std::sin(kPi * u);
+      dsigma = 0.5 * pi * std::sin(pi * u);
       return;
     }
     case TimingLaw::kQuintic:
@@ -103,7 +103,12 @@ void timing(TimingLaw law, double u, double& sigma, double& dsigma) {
 
 Path::Path(PathGeometry geometry, int dim, double duration, TimingLaw law, TimingScope scope,
            const Eigen::Matrix3d& rotation, const Eigen::Vector3d& origin, std::string description)
-    : dim_(dim), duration_(duration), law_(law), scope_(scope), rotation_(rotation), origin_(origin),
+    : dim_(dim),
+      duration_(duration),
+      law_(law),
+      scope_(scope),
+      rotation_(rotation),
+      origin_(origin),
       description_(std::move(description)) {
   REDRES_REQUIRE(dim == 2 || dim == 3, "Path", "dim is 2 or 3");
   REDRES_REQUIRE(duration > 0.0, "Path", "duration > 0");
@@ -174,8 +179,9 @@ const Schema<PathPlacement>& PathPlacement::schema() {
        field("timing_scope", &C::timing_scope, "", "law per stroke or over the whole path (default: the shape's)")},
       [](const C& c) {
         if (c.placement == Placement::kAbsolute && !c.origin) {
-          throw FieldError("origin", "expected `origin` (the path origin in base coordinates, m) with placement = "
-                                     "\"absolute\"");
+          throw FieldError("origin",
+                           "expected `origin` (the path origin in base coordinates, m) with placement = "
+                           "\"absolute\"");
         }
       },
       {}};
@@ -190,8 +196,8 @@ std::unique_ptr<Path> place(const std::string& type, PathGeometry geometry, cons
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   if (pl.origin) {
     if (static_cast<int>(pl.origin->size()) != context.dim) {
-      throw FieldError("origin", "expected " + std::to_string(context.dim) + " numbers, got " +
-                                     std::to_string(pl.origin->size()));
+      throw FieldError(
+          "origin", "expected " + std::to_string(context.dim) + " numbers, got " + std::to_string(pl.origin->size()));
     }
     for (int k = 0; k < context.dim; ++k) origin(k) = (*pl.origin)[static_cast<std::size_t>(k)];
   }

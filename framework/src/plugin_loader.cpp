@@ -56,8 +56,9 @@ std::filesystem::path resolve_plugin_library(const std::string& name, const std:
 void load_plugin_library(const std::filesystem::path& library, const SourceLocation& where) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(library, ec)) {
-    fail(where, library, "no such file (a path relative to the file that names it, or a name found in "
-                         "REDRES_PLUGIN_PATH)");
+    fail(where, library,
+         "no such file (a path relative to the file that names it, or a name found in "
+         "REDRES_PLUGIN_PATH)");
   }
   const std::filesystem::path canonical = std::filesystem::canonical(library, ec);
   if (std::find(loaded().begin(), loaded().end(), canonical) != loaded().end()) return;

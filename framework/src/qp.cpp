@@ -107,9 +107,10 @@ std::string describe(const BoundConflict& c, const std::vector<std::string>& joi
   std::ostringstream s;
   s.precision(9);
   s << "joint " << c.joint + 1;
-  if (c.joint < static_cast<int>(joint_names.size())) s << " ('" << joint_names[static_cast<std::size_t>(c.joint)] << "')";
-  s << ": lower bound " << c.lo << " (from '" << c.lo_source << "') > upper bound " << c.hi << " (from '"
-    << c.hi_source << "')";
+  if (c.joint < static_cast<int>(joint_names.size()))
+    s << " ('" << joint_names[static_cast<std::size_t>(c.joint)] << "')";
+  s << ": lower bound " << c.lo << " (from '" << c.lo_source << "') > upper bound " << c.hi << " (from '" << c.hi_source
+    << "')";
   return s.str();
 }
 

@@ -7,7 +7,6 @@
 
 namespace redres {
 
-
 void QpBuilder::begin(int source, double weight, int eq_offset, int eq_rows, int in_offset, int in_rows) {
   source_ = source;
   weight_ = weight;

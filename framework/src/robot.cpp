@@ -10,9 +10,7 @@ namespace redres {
 
 const char* to_string(ChainKind kind) { return kind == ChainKind::kPlanar ? "planar" : "spatial"; }
 const char* to_string(JointType type) { return type == JointType::kRevolute ? "revolute" : "prismatic"; }
-const char* to_string(DhConvention convention) {
-  return convention == DhConvention::kStandard ? "dh" : "modified_dh";
-}
+const char* to_string(DhConvention convention) { return convention == DhConvention::kStandard ? "dh" : "modified_dh"; }
 const char* to_string(TaskRows rows) { return rows == TaskRows::kPosition ? "position" : "pose"; }
 
 namespace {
@@ -48,19 +46,21 @@ void validate(const RobotSpec& spec) {
     REDRES_REQUIRE(!jt.name.empty(), fn, "joint " + std::to_string(j + 1) + " has a name");
     REDRES_REQUIRE(names.insert(jt.name).second, fn, who + " has a unique name");
     REDRES_REQUIRE(std::isfinite(jt.lower) && std::isfinite(jt.upper), fn, who + " limits are finite");
-    REDRES_REQUIRE(jt.lower < jt.upper, fn, who + " lower limit < upper limit (" + num(jt.lower) + " vs " +
-                                         num(jt.upper) + ")");
+    REDRES_REQUIRE(jt.lower < jt.upper, fn,
+                   who + " lower limit < upper limit (" + num(jt.lower) + " vs " + num(jt.upper) + ")");
     REDRES_REQUIRE(jt.velocity_limit != nullptr, fn, who + " has a velocity-limit law");
-    REDRES_REQUIRE(std::isfinite(jt.a) && std::isfinite(jt.alpha) && std::isfinite(jt.d) && std::isfinite(jt.theta_offset),
-            fn, who + " DH parameters are finite");
+    REDRES_REQUIRE(
+        std::isfinite(jt.a) && std::isfinite(jt.alpha) && std::isfinite(jt.d) && std::isfinite(jt.theta_offset), fn,
+        who + " DH parameters are finite");
     if (spec.kind == ChainKind::kPlanar) {
-      REDRES_REQUIRE(jt.type == JointType::kRevolute, fn, who + " is revolute (planar chains have revolute joints only)");
+      REDRES_REQUIRE(jt.type == JointType::kRevolute, fn,
+                     who + " is revolute (planar chains have revolute joints only)");
       REDRES_REQUIRE(std::isfinite(jt.length) && jt.length > 0.0, fn, who + " length > 0 (got " + num(jt.length) + ")");
     }
   }
   if (spec.home.size() != 0) {
     REDRES_REQUIRE(spec.home.size() == static_cast<Eigen::Index>(spec.joints.size()), fn,
-            "home.size() == number of joints");
+                   "home.size() == number of joints");
     REDRES_REQUIRE(spec.home.allFinite(), fn, "home is finite");
   }
 }
@@ -107,7 +107,7 @@ void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta,
                                  Eigen::Ref<Eigen::VectorXd> upper) const {
   const int n = dof();
   REDRES_REQUIRE(theta.size() == n && lower.size() == n && upper.size() == n, "RobotModel::velocity_limits",
-          "theta, lower and upper have size dof() = " + std::to_string(n));
+                 "theta, lower and upper have size dof() = " + std::to_string(n));
   for (int j = 0; j < n; ++j) {
     const VelocityBounds b = spec_.joints[static_cast<std::size_t>(j)].velocity_limit->bounds(theta(j));
     lower(j) = b.lower;
@@ -146,8 +146,8 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, std::set<std::str
   jt.lower = lim[0];
   jt.upper = lim[1];
   if (!(jt.lower < jt.upper)) {
-    r.fail("limits", "expected [lower, upper] with lower < upper, got lower " + num(jt.lower) + " >= upper " +
-                         num(jt.upper));
+    r.fail("limits",
+           "expected [lower, upper] with lower < upper, got lower " + num(jt.lower) + " >= upper " + num(jt.upper));
   }
 
   const TableReader law_table = r.table("velocity_limit");
@@ -155,9 +155,9 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, std::set<std::str
   jt.velocity_limit = make_velocity_limit(law_reader);
   law_reader.finish();
   if (auto bad = check_velocity_law(*jt.velocity_limit, jt.lower, jt.upper)) {
-    law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() + "' is invalid at theta = " +
-                    num(bad->theta) + (jt.type == JointType::kRevolute ? " rad" : " m") + " (joint range [" +
-                    num(jt.lower) + ", " + num(jt.upper) + "]): " + bad->reason);
+    law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() + "' is invalid at theta = " + num(bad->theta) +
+                    (jt.type == JointType::kRevolute ? " rad" : " m") + " (joint range [" + num(jt.lower) + ", " +
+                    num(jt.upper) + "]): " + bad->reason);
   }
   r.finish();
   return jt;
@@ -192,12 +192,11 @@ RobotModel load_robot(const TableReader& r) {
       const std::vector<double> p = e.has("position") ? e.numbers("position", 2) : std::vector<double>{0.0, 0.0};
       spec.end_effector = trans(p[0], p[1], 0.0) * rot_z(e.number("angle", 0.0));
     } else {
-      const std::vector<double> p =
-          e.has("position") ? e.numbers("position", 3) : std::vector<double>{0.0, 0.0, 0.0};
+      const std::vector<double> p = e.has("position") ? e.numbers("position", 3) : std::vector<double>{0.0, 0.0, 0.0};
       const std::vector<double> rpy = e.has("rpy") ? e.numbers("rpy", 3) : std::vector<double>{0.0, 0.0, 0.0};
-      spec.end_effector = trans(p[0], p[1], p[2]) * Isometry3d(AngleAxisd(rpy[2], Vector3d::UnitZ()) *
-                                                               AngleAxisd(rpy[1], Vector3d::UnitY()) *
-                                                               AngleAxisd(rpy[0], Vector3d::UnitX()));
+      spec.end_effector = trans(p[0], p[1], p[2]) *
+                          Isometry3d(AngleAxisd(rpy[2], Vector3d::UnitZ()) * AngleAxisd(rpy[1], Vector3d::UnitY()) *
+                                     AngleAxisd(rpy[0], Vector3d::UnitX()));
     }
     e.finish();
   }
@@ -208,8 +207,8 @@ RobotModel load_robot(const TableReader& r) {
     for (Eigen::Index j = 0; j < n; ++j) {
       const JointSpec& jt = spec.joints[static_cast<std::size_t>(j)];
       if (h[static_cast<std::size_t>(j)] < jt.lower || h[static_cast<std::size_t>(j)] > jt.upper) {
-        r.fail("home", "expected joint '" + jt.name + "' within its limits [" + num(jt.lower) + ", " +
-                           num(jt.upper) + "], got " + num(h[static_cast<std::size_t>(j)]));
+        r.fail("home", "expected joint '" + jt.name + "' within its limits [" + num(jt.lower) + ", " + num(jt.upper) +
+                           "], got " + num(h[static_cast<std::size_t>(j)]));
       }
     }
   }

@@ -110,7 +110,8 @@ std::string to_json(const RunSummary& s) {
   for (const auto& pm : s.metrics) {
     nlohmann::json figures = nlohmann::json::object();
     for (const auto& m : pm.metrics) {
-      figures[m.name] = m.values.size() == 1 && !m.per_joint ? nlohmann::json(m.values.front()) : nlohmann::json(m.values);
+      figures[m.name] =
+          m.values.size() == 1 && !m.per_joint ? nlohmann::json(m.values.front()) : nlohmann::json(m.values);
     }
     metrics[pm.plugin] = figures;
   }
@@ -127,7 +128,8 @@ std::string to_json(const RunSummary& s) {
       {"final_position_error", s.final_position_error},
       {"initial_joint_velocity_norm", s.initial_joint_velocity_norm},
       {"final_joint_velocity_norm", s.final_joint_velocity_norm},
-      {"manipulability", {{"initial", w.initial}, {"final", w.final}, {"min", w.min}, {"mean", w.mean}, {"max", w.max}}},
+      {"manipulability",
+       {{"initial", w.initial}, {"final", w.final}, {"min", w.min}, {"mean", w.mean}, {"max", w.max}}},
       {"max_joint_angle_violation", s.max_joint_angle_violation},
       {"max_joint_velocity_violation", s.max_joint_velocity_violation},
       {"steps_with_active_bounds", s.steps_with_active_bounds},

@@ -66,8 +66,10 @@ void Scheme::setup(QpProblem& qp) const {
   for (const auto& c : constraints_) qp.source_names.push_back(c->name());
   const int base = static_cast<int>(objectives_.size());
   for (std::size_t k = 0; k < constraints_.size(); ++k) {
-    for (int r = 0; r < eq_rows_[k]; ++r) qp.eq_source[static_cast<std::size_t>(eq_offset_[k] + r)] = base + static_cast<int>(k);
-    for (int r = 0; r < in_rows_[k]; ++r) qp.in_source[static_cast<std::size_t>(in_offset_[k] + r)] = base + static_cast<int>(k);
+    for (int r = 0; r < eq_rows_[k]; ++r)
+      qp.eq_source[static_cast<std::size_t>(eq_offset_[k] + r)] = base + static_cast<int>(k);
+    for (int r = 0; r < in_rows_[k]; ++r)
+      qp.in_source[static_cast<std::size_t>(in_offset_[k] + r)] = base + static_cast<int>(k);
   }
 }
 

@@ -21,7 +21,8 @@ std::vector<std::string> trajectory_columns(const RobotModel& robot) {
   add("hi_");
   for (const auto& name : robot.task_names()) cols.push_back("rd_" + name);
   for (const auto& name : robot.task_names()) cols.push_back("r_" + name);
-  for (const char* c : {"position_error", "manipulability", "solver_iterations", "solver_residual"}) cols.emplace_back(c);
+  for (const char* c : {"position_error", "manipulability", "solver_iterations", "solver_residual"})
+    cols.emplace_back(c);
   add("vel_lo_");
   add("vel_hi_");
   cols.emplace_back("solver_status");
@@ -32,7 +33,10 @@ std::vector<std::string> trajectory_columns(const RobotModel& robot) {
 
 std::string RunResult::engine() const {
   std::string out;
-  for (const auto e : engines) out += (out.empty() ? "" : "+") + std::string(e);
+  for (const auto e : engines) {
+    if (!out.empty()) out += '+';
+    out += e;
+  }
   return out;
 }
 

@@ -127,9 +127,8 @@ double TableReader::to_number(std::string_view key, const toml::node& node, cons
     try {
       v = evaluate_constant(text->get());
     } catch (const std::invalid_argument& e) {
-      throw ConfigError(location_of(*file_, node),
-                        prefix() + "key '" + std::string(key) + "': expected " + what + " or a constant formula: " +
-                            e.what());
+      throw ConfigError(location_of(*file_, node), prefix() + "key '" + std::string(key) + "': expected " + what +
+                                                       " or a constant formula: " + e.what());
     }
   } else {
     throw ConfigError(location_of(*file_, node),

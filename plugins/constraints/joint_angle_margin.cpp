@@ -43,7 +43,8 @@ void JointAngleMargin::summarise(const RobotModel& robot, const Trajectory& run,
     for (std::size_t r = 0; r < run.size(); ++r) entry = std::max({entry, run(r, c) - hi, lo - run(r, c)});
   }
   out.push_back({"max_safety_region_entry", {entry}, "rad or m"});
-  out.push_back({"safety_margin", std::vector<double>(margin_.data(), margin_.data() + margin_.size()), "rad or m", true});
+  out.push_back(
+      {"safety_margin", std::vector<double>(margin_.data(), margin_.data() + margin_.size()), "rad or m", true});
 }
 
 namespace {

@@ -41,8 +41,7 @@ class NloptSlsqp final : public LviEngine {
       nlopt_add_equality_mconstraint(opt_, static_cast<unsigned>(m_e), &NloptSlsqp::equality, this, tol_eq_.data());
     }
     if (m_i > 0) {
-      nlopt_add_inequality_mconstraint(opt_, static_cast<unsigned>(m_i), &NloptSlsqp::inequality, this,
-                                       tol_in_.data());
+      nlopt_add_inequality_mconstraint(opt_, static_cast<unsigned>(m_i), &NloptSlsqp::inequality, this, tol_in_.data());
     }
     nlopt_set_xtol_abs1(opt_, 1e-14);
     nlopt_set_ftol_abs(opt_, 1e-16);

@@ -213,7 +213,7 @@ class Projection final : public LviEngine {
       }
       for (int r = 0; r < mi; ++r) rz[r] = b[r];
       for (int i = 0; i < n; ++i) {
-        double* ry_part = (i & 1) ? ry2 : ry;  // two partial sums halve the dependency chain
+        double* ry_part = (i & 1) ? ry2 : ry;                       // two partial sums halve the dependency chain
         const double* Wi = W + static_cast<std::ptrdiff_t>(i) * n;  // column i (W symmetric)
         double wx = 0.0;
         if constexpr (kDiagonal) {

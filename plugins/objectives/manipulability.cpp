@@ -14,7 +14,8 @@ const Schema<ManipulabilityConfig>& ManipulabilityConfig::schema() {
        field("p", &C::p, "", "coefficient magnitude (not used by the expression schedule)"),
        field("ramp_fraction", &C::ramp_fraction, "", "smoothstep: each ramp's share of T",
              rule<double>("in (0, 0.5]", [](double v) { return v > 0.0 && v <= 0.5; })),
-       field("formula", &C::formula, "", "expression schedule: p(t) as a formula of t and T, e.g. \"2*sin(pi*t/T)^2\"")},
+       field("formula", &C::formula, "",
+             "expression schedule: p(t) as a formula of t and T, e.g. \"2*sin(pi*t/T)^2\"")},
       [](const C& c) {
         if (c.schedule == C::Schedule::kExpression && !c.formula) {
           throw FieldError("formula", "is required with schedule = \"expression\"");

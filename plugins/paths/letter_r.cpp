@@ -5,8 +5,7 @@
 namespace redres {
 
 const Schema<LetterRConfig>& LetterRConfig::schema() {
-  static const Schema<LetterRConfig> s{
-      {field("height", &LetterRConfig::height, "m", "letter height h", greater(0.0))}};
+  static const Schema<LetterRConfig> s{{field("height", &LetterRConfig::height, "m", "letter height h", greater(0.0))}};
   return s;
 }
 
@@ -26,7 +25,8 @@ std::unique_ptr<PathGeometry> make_letter_r(const LetterRConfig& config, const P
 }
 
 const bool kRegistered = path_registry().add<LetterRConfig>(
-    "letter_r", "the letter R of the paper's experiment (stem, bowl, leg; docs/letter_r.md); rotated 180 deg by default",
+    "letter_r",
+    "the letter R of the paper's experiment (stem, bowl, leg; docs/letter_r.md); rotated 180 deg by default",
     make_letter_r);
 
 }  // namespace

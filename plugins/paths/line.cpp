@@ -12,7 +12,8 @@ namespace {
 
 std::unique_ptr<PathGeometry> make_line(const LineConfig& c, const PathContext& ctx) {
   if (static_cast<int>(c.delta.size()) != ctx.dim) {
-    throw FieldError("delta", "expected " + std::to_string(ctx.dim) + " numbers, got " + std::to_string(c.delta.size()));
+    throw FieldError("delta",
+                     "expected " + std::to_string(ctx.dim) + " numbers, got " + std::to_string(c.delta.size()));
   }
   const Eigen::Vector3d to(c.delta[0], c.delta[1], ctx.dim == 3 ? c.delta[2] : 0.0);
   if (!(to.norm() > 0.0)) throw FieldError("delta", "expected a non-zero displacement");

@@ -7,19 +7,19 @@ namespace redres {
 
 const Schema<PolylineSegment>& PolylineSegment::schema() {
   using S = PolylineSegment;
-  static const Schema<S> s{{field("to", &S::to, "m", "a line to this point").in_group("segment"),
-                            field("center", &S::center, "m", "an arc about this centre").in_group("segment"),
-                            field("sweep_deg", &S::sweep_deg, "deg", "the arc's sweep, counter-clockwise for > 0")
-                                .in_group("segment")},
-                           [](const S& seg) {
-                             if (seg.to && (seg.center || seg.sweep_deg)) {
-                               throw FieldError("to", "expected a line (`to`) or an arc (`center`, `sweep_deg`), not both");
-                             }
-                             if (!seg.to && !(seg.center && seg.sweep_deg)) {
-                               throw FieldError("", "expected `to` (a line) or `center` and `sweep_deg` (an arc)");
-                             }
-                           },
-                           {{"segment", "give `to`, or `center` and `sweep_deg`"}}};
+  static const Schema<S> s{
+      {field("to", &S::to, "m", "a line to this point").in_group("segment"),
+       field("center", &S::center, "m", "an arc about this centre").in_group("segment"),
+       field("sweep_deg", &S::sweep_deg, "deg", "the arc's sweep, counter-clockwise for > 0").in_group("segment")},
+      [](const S& seg) {
+        if (seg.to && (seg.center || seg.sweep_deg)) {
+          throw FieldError("to", "expected a line (`to`) or an arc (`center`, `sweep_deg`), not both");
+        }
+        if (!seg.to && !(seg.center && seg.sweep_deg)) {
+          throw FieldError("", "expected `to` (a line) or `center` and `sweep_deg` (an arc)");
+        }
+      },
+      {{"segment", "give `to`, or `center` and `sweep_deg`"}}};
   return s;
 }
 
@@ -51,7 +51,8 @@ std::unique_ptr<PathGeometry> make_polyline(const PolylineConfig& c, const PathC
       const Eigen::Vector3d centre((*seg.center)[0], (*seg.center)[1], 0.0);
       const double radius = (p - centre).norm();
       if (!(radius > 0.0)) {
-        throw FieldError("segments", "segment " + std::to_string(k + 1) + ": expected a centre away from the current point");
+        throw FieldError("segments",
+                         "segment " + std::to_string(k + 1) + ": expected a centre away from the current point");
       }
       const double a0 = std::atan2(p.y() - centre.y(), p.x() - centre.x());
       all.push_back(PathSegment::arc(centre, radius, a0, *seg.sweep_deg * std::numbers::pi / 180.0));

@@ -6,8 +6,9 @@ namespace redres {
 
 const Schema<WaypointsConfig>& WaypointsConfig::schema() {
   using C = WaypointsConfig;
-  static const Schema<C> s{{field("file", &C::file, "", "CSV file with columns x,y[,z], relative to the scenario").required(),
-                            field("stop_at_points", &C::stop_at_points, "", "stop at every point")}};
+  static const Schema<C> s{
+      {field("file", &C::file, "", "CSV file with columns x,y[,z], relative to the scenario").required(),
+       field("stop_at_points", &C::stop_at_points, "", "stop at every point")}};
   return s;
 }
 

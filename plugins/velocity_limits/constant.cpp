@@ -6,8 +6,9 @@ namespace redres {
 
 const Schema<ConstantLawConfig>& ConstantLawConfig::schema() {
   using C = ConstantLawConfig;
-  static const Schema<C> s{{field("lower", &C::lower, "rad/s or m/s", "lower velocity limit", less(0.0)).required(),
-                            field("upper", &C::upper, "rad/s or m/s", "upper velocity limit", greater(0.0)).required()}};
+  static const Schema<C> s{
+      {field("lower", &C::lower, "rad/s or m/s", "lower velocity limit", less(0.0)).required(),
+       field("upper", &C::upper, "rad/s or m/s", "upper velocity limit", greater(0.0)).required()}};
   return s;
 }
 

@@ -11,11 +11,11 @@ namespace {
 // The points as given (arrays) or read from the file; FieldError names the key at fault.
 void check_points(const std::vector<double>& theta, const std::vector<double>& lower, const std::vector<double>& upper,
                   const char* where) {
-  if (theta.size() < 2) throw FieldError(where, "expected at least 2 table points, got " + std::to_string(theta.size()));
+  if (theta.size() < 2)
+    throw FieldError(where, "expected at least 2 table points, got " + std::to_string(theta.size()));
   if (lower.size() != theta.size() || upper.size() != theta.size()) {
-    throw FieldError(where, "expected as many lower and upper limits as theta points (" +
-                                std::to_string(theta.size()) + "), got " + std::to_string(lower.size()) + " and " +
-                                std::to_string(upper.size()));
+    throw FieldError(where, "expected as many lower and upper limits as theta points (" + std::to_string(theta.size()) +
+                                "), got " + std::to_string(lower.size()) + " and " + std::to_string(upper.size()));
   }
   for (std::size_t k = 1; k < theta.size(); ++k) {
     if (!(theta[k] > theta[k - 1])) {
@@ -37,7 +37,8 @@ const Schema<TableLawConfig>& TableLawConfig::schema() {
            .in_group("points")},
       [](const C& c) {
         const bool arrays = !c.theta.empty() || !c.lower.empty() || !c.upper.empty();
-        if (c.file && arrays) throw FieldError("file", "expected either `file` or the `theta`/`lower`/`upper` arrays, not both");
+        if (c.file && arrays)
+          throw FieldError("file", "expected either `file` or the `theta`/`lower`/`upper` arrays, not both");
         if (!c.file && !arrays) throw FieldError("", "expected `file`, or the `theta`, `lower` and `upper` arrays");
         if (!c.file) check_points(c.theta, c.lower, c.upper, "theta");
       },

@@ -19,7 +19,8 @@ const std::string kPlugin = REDRES_TEST_PLUGIN;
 std::filesystem::path write_scenario(const std::filesystem::path& dir, const std::string& plugins) {
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "scenario.toml") << "plugins = " << plugins << "\n"
-                                       << "robot = \"" << source_path("robots/paper_pushrod_6dof.toml").string() << "\"\n"
+                                       << "robot = \"" << source_path("robots/paper_pushrod_6dof.toml").string()
+                                       << "\"\n"
                                        << R"(theta0 = ["pi/4", "pi/12", "pi/12", "pi/12", "pi/36", "pi/36"]
 duration = 2.0
 step = 0.01

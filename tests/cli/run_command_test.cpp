@@ -17,7 +17,6 @@
 namespace redres {
 namespace {
 
-
 std::string first_line(const std::filesystem::path& file) {
   std::ifstream in(file);
   std::string line;
@@ -37,10 +36,10 @@ TEST(CliScenario, RunWritesTheTrajectoryAndSummaryOfOutputFormats) {
   EXPECT_EQ(first_line(dir / "trajectory.csv").rfind(expected, 0), 0u) << first_line(dir / "trajectory.csv");
   std::ifstream js(dir / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(js);
-  for (const char* k : {"steps", "tau", "duration", "max_position_error", "final_position_error",
-                        "initial_joint_velocity_norm", "final_joint_velocity_norm", "manipulability",
-                        "max_joint_angle_violation", "max_joint_velocity_violation", "final_theta", "solver",
-                        "wall_time_s"}) {
+  for (const char* k :
+       {"steps", "tau", "duration", "max_position_error", "final_position_error", "initial_joint_velocity_norm",
+        "final_joint_velocity_norm", "manipulability", "max_joint_angle_violation", "max_joint_velocity_violation",
+        "final_theta", "solver", "wall_time_s"}) {
     EXPECT_TRUE(s.contains(k)) << k;
   }
   for (const char* k : {"initial", "final", "min", "mean", "max"}) EXPECT_TRUE(s["manipulability"].contains(k)) << k;
@@ -79,7 +78,8 @@ TEST(CliScenario, BadScenarioFilesReportFileLineColumn) {
     return (dir / name).string();
   };
   const std::string robot = source_path("robots/paper_pushrod_6dof.toml").string();
-  const std::string base = "robot = \"" + robot + "\"\nduration = 4.0\nstep = 0.01\n[path]\ntype = \"letter_r\"\n"
+  const std::string base = "robot = \"" + robot +
+                           "\"\nduration = 4.0\nstep = 0.01\n[path]\ntype = \"letter_r\"\n"
                            "[[objectives]]\ntype = \"min_velocity_norm\"\n";
   const std::string typo = write("typo.toml", base + "[[constraints]]\ntype = \"task_tracking\"\ngian = 8.0\n");
   Cli r = redres("validate '" + typo + "'");
@@ -103,8 +103,8 @@ TEST(CliScenario, BadScenarioFilesReportFileLineColumn) {
 TEST(CliScenario, FailedStepsGiveExitCodeOne) {
   const auto dir = scratch("fail");
   // The R in 0.5 s asks for more than the push-rod joints can give.
-  const Cli r = redres("run configs/paper_r_tvcmm.toml --out '" + dir.string() +
-                       "' --quiet --set duration=0.5 --set step=0.01");
+  const Cli r =
+      redres("run configs/paper_r_tvcmm.toml --out '" + dir.string() + "' --quiet --set duration=0.5 --set step=0.01");
   EXPECT_EQ(r.code, 1) << r.out;
   std::ifstream js(dir / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(js);

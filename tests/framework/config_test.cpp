@@ -23,7 +23,8 @@ namespace {
 
 enum class Colour { kRed, kGreen };
 auto enum_names(Colour) {
-  return std::array{std::pair{Colour::kRed, std::string_view("red")}, std::pair{Colour::kGreen, std::string_view("green")}};
+  return std::array{std::pair{Colour::kRed, std::string_view("red")},
+                    std::pair{Colour::kGreen, std::string_view("green")}};
 }
 
 struct Point {
@@ -52,10 +53,11 @@ struct Sample {
   static const Schema<Sample>& schema() {
     using C = Sample;
     static const Schema<C> s{
-        {field("gain", &C::gain, "1/s", "a gain", greater(0.0)), field("count", &C::count, "", "a count", at_least<int>(1)),
-         field("flag", &C::flag, "", "a flag"), field("label", &C::label, "", "a label"),
-         field("colour", &C::colour, "", "a colour"), field("values", &C::values, "", "some values"),
-         field("axis", &C::axis, "", "an axis"), field("margin", &C::margin, "rad", "per joint", at_least<PerJoint>(0.0)),
+        {field("gain", &C::gain, "1/s", "a gain", greater(0.0)),
+         field("count", &C::count, "", "a count", at_least<int>(1)), field("flag", &C::flag, "", "a flag"),
+         field("label", &C::label, "", "a label"), field("colour", &C::colour, "", "a colour"),
+         field("values", &C::values, "", "some values"), field("axis", &C::axis, "", "an axis"),
+         field("margin", &C::margin, "rad", "per joint", at_least<PerJoint>(0.0)),
          field("extra", &C::extra, "", "optional"), field("points", &C::points, "", "points"),
          field("needed", &C::needed, "", "must be given").required()},
         [](const C& c) {
@@ -110,7 +112,8 @@ TEST(Config, ReadsEveryKindOfMemberAndKeepsDefaultsForAbsentKeys) {
 }
 
 TEST(Config, ErrorsNameTheFileTheLineTheKeyAndWhatWasExpected) {
-  EXPECT_EQ(error_of("needed = 1\ngain = -1\n").rfind("sample.toml:2:8: sample: key 'gain': expected > 0, got -1.0", 0), 0u)
+  EXPECT_EQ(error_of("needed = 1\ngain = -1\n").rfind("sample.toml:2:8: sample: key 'gain': expected > 0, got -1.0", 0),
+            0u)
       << error_of("needed = 1\ngain = -1\n");
   EXPECT_NE(error_of("gain = 1\n").find("missing required key 'needed'"), std::string::npos);
   const std::string unknown = error_of("needed = 1\ncolor = \"red\"\n");
@@ -193,8 +196,8 @@ TEST(Config, EveryRegisteredDefaultIsValidTomlThatReadsBackToItself) {
 TEST(Config, ConfigsBuiltInCppAreValidatedWithTheKeyInTheMessage) {
   const RobotModel robot = load_robot(source_path("robots/paper_pushrod_6dof.toml"));
   try {
-    (void)Manipulability(Manipulability::Config{.schedule = Manipulability::Schedule::kSmoothstep, .ramp_fraction = 0.7},
-                         robot);
+    (void)Manipulability(
+        Manipulability::Config{.schedule = Manipulability::Schedule::kSmoothstep, .ramp_fraction = 0.7}, robot);
     ADD_FAILURE() << "accepted ramp_fraction = 0.7";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("manipulability: key 'ramp_fraction': expected in (0, 0.5], got 0.7"),
@@ -223,7 +226,8 @@ TEST(Config, APluginBuiltInCppContributesExactlyAsTheSamePluginReadFromToml) {
   std::vector<std::unique_ptr<Objective>> objectives;
   objectives.push_back(objective_registry().create(
       "manipulability",
-      Manipulability::Config{.schedule = Manipulability::Schedule::kSmoothstep, .p = 1.5, .ramp_fraction = 0.2}, robot));
+      Manipulability::Config{.schedule = Manipulability::Schedule::kSmoothstep, .p = 1.5, .ramp_fraction = 0.2},
+      robot));
   objectives.back()->set_weight(0.5);
   const Scheme from_cpp(robot, std::move(objectives), {});
   EXPECT_EQ(text_of(from_cpp.objectives()[0]->config()), text_of(from_toml.objectives()[0]->config()));
@@ -249,9 +253,10 @@ TEST(Config, APluginBuiltInCppContributesExactlyAsTheSamePluginReadFromToml) {
 
 TEST(Config, ConstraintsRejectAWeightAndObjectivesCheckTheirs) {
   const RobotModel robot = load_robot(source_path("robots/paper_pushrod_6dof.toml"));
-  const auto bad = parse_toml_string("[[objectives]]\ntype = \"min_velocity_norm\"\n[[constraints]]\n"
-                                     "type = \"task_tracking\"\nweight = 2.0\n",
-                                     "w.toml");
+  const auto bad = parse_toml_string(
+      "[[objectives]]\ntype = \"min_velocity_norm\"\n[[constraints]]\n"
+      "type = \"task_tracking\"\nweight = 2.0\n",
+      "w.toml");
   try {
     (void)Scheme::from_toml(TableReader::root(bad), robot);
     ADD_FAILURE() << "a constraint weight was accepted";

@@ -44,7 +44,8 @@ TEST(Conformance, EveryBuiltInPluginPassesAndEveryTypeIsChecked) {
     EXPECT_EQ(kinds_checks.count({type, "finite"}), 1u) << type;
   }
   for (const char* type : {"letter_r", "circle", "helix"}) EXPECT_EQ(kinds_checks.count({type, "r_d_dot"}), 1u) << type;
-  for (const char* type : {"projection", "newton", "nlopt"}) EXPECT_EQ(kinds_checks.count({type, "solves"}), 1u) << type;
+  for (const char* type : {"projection", "newton", "nlopt"})
+    EXPECT_EQ(kinds_checks.count({type, "solves"}), 1u) << type;
 }
 
 // Faulty plugins, registered under an origin of their own and removed afterwards.
@@ -109,12 +110,12 @@ TEST(Conformance, CatchesAWrongGradientAnUndocumentedKeyAndAWrongEngine) {
       "faulty_undocumented", "faulty", [](const GainConfig& c, const RobotModel& robot) -> std::unique_ptr<Constraint> {
         return std::make_unique<Undocumented>(c, robot);
       });
-  (void)engine_registry().add<GainConfig>("faulty_liar", "faulty",
-                                          [](const GainConfig& /*c*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
-                                            auto e = std::make_unique<Liar>();
-                                            e->set_settings(s);
-                                            return e;
-                                          });
+  (void)engine_registry().add<GainConfig>(
+      "faulty_liar", "faulty", [](const GainConfig& /*c*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
+        auto e = std::make_unique<Liar>();
+        e->set_settings(s);
+        return e;
+      });
   current_registration_scope() = nullptr;
   ASSERT_EQ(scope.added, 3);
   ASSERT_TRUE(scope.errors.empty());

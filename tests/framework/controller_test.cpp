@@ -62,9 +62,11 @@ TEST(ControllerRealTime, ThousandStepsWithEveryPerStepPluginAllocateNothing) {
       {"robots/paper_pushrod_6dof.toml", {.schedule = M::Schedule::kSine}, "projection"},
       {"robots/paper_pushrod_6dof.toml", {.schedule = M::Schedule::kSmoothstep}, "newton"},
       {"tests/data/robots/planar_laws_pose.toml",
-       {.schedule = M::Schedule::kExpression, .formula = "0.5*sin(pi*t/T)^2"}, "newton"},
+       {.schedule = M::Schedule::kExpression, .formula = "0.5*sin(pi*t/T)^2"},
+       "newton"},
       {"tests/data/robots/planar_laws_pose.toml",
-       {.measure = M::Measure::kYoshikawa, .schedule = M::Schedule::kConstant, .p = 0.2}, "projection"},
+       {.measure = M::Measure::kYoshikawa, .schedule = M::Schedule::kConstant, .p = 0.2},
+       "projection"},
       {"robots/kuka_iiwa14.toml", {.measure = M::Measure::kYoshikawa, .p = 0.5}, "newton"},
       {"robots/kuka_iiwa14.toml", {.schedule = M::Schedule::kConstant, .p = 0.1}, "projection"},
   };

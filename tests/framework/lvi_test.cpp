@@ -39,8 +39,8 @@ bool random_feasible_point(std::mt19937& rng, const testing::RandomQp& rq, Eigen
   Eigen::VectorXd step(qp.n());
   for (int i = 0; i < qp.n(); ++i) step(i) = u(rng);
   if (qp.m_eq() > 0) {
-    const Eigen::MatrixXd P = Eigen::MatrixXd::Identity(qp.n(), qp.n()) -
-                              qp.J.transpose() * (qp.J * qp.J.transpose()).ldlt().solve(qp.J);
+    const Eigen::MatrixXd P =
+        Eigen::MatrixXd::Identity(qp.n(), qp.n()) - qp.J.transpose() * (qp.J * qp.J.transpose()).ldlt().solve(qp.J);
     step = P * step;
   }
   for (double scale = 1.0; scale > 1e-4; scale *= 0.5) {
@@ -70,9 +70,8 @@ RC_GTEST_PROP(LviProperty, EnginesSatisfyKktAndAgree, ()) {
   const Solved newton = solve_with("newton", rq.qp, settings);
   const Solved nlopt = solve_with("nlopt", rq.qp, settings);
   for (const Solved* s : {&proj, &newton, &nlopt}) {
-    RC_LOG() << s->result.info.engine << ": " << to_string(s->result.info.status) << ", "
-             << s->result.info.iterations << " iterations, residual " << s->result.info.residual << " "
-             << s->result.info.diagnosis << "\n";
+    RC_LOG() << s->result.info.engine << ": " << to_string(s->result.info.status) << ", " << s->result.info.iterations
+             << " iterations, residual " << s->result.info.residual << " " << s->result.info.diagnosis << "\n";
   }
   RC_ASSERT(proj.result.info.status == SolverStatus::kSolved);
   RC_ASSERT(newton.result.info.status == SolverStatus::kSolved);
@@ -103,38 +102,33 @@ RC_GTEST_PROP(LviProperty, EnginesSatisfyKktAndAgree, ()) {
   }
 }
 
-// The paper-like family (the paper's arm and scheme, 6 joints, 2 rows, bounds active in about 30 % of the
-// problems) at the paper's tolerance, each solved cold: newton's x equals projection's to within the tolerance's
-// effect. Eq. 15 stops on ||e(u)|| <= 1e-6, and |x - x*| <= c ||e(u)|| with an error-bound constant c of M; in
-// a few cold solves c exceeds 10, so the check is |dx| <= 1e-5 for 98 % of the problems and <= 5e-5 for all.
-// Warm-started trajectories (the real use) meet 1e-5 at every step: WarmStartTakesFewerIterations.
-TEST(Lvi, PaperFamilyEnginesAgreeAtThePapersTolerance) {
+// The paper-like family (the paper's arm and scheme, 6 joints, 2 rows, random states and desired velocities), each
+// problem solved cold: both engines agree on feasibility, newton meets the KKT conditions to 1e-10, and projection,
+// run to a tight tolerance, converges to the same (unique: W > 0) solution. Properties of every problem, not bands
+// tuned to the generator: the only counts checked are that the family exercised both active and inactive bounds.
+TEST(Lvi, PaperFamilyEnginesConvergeToTheSameSolution) {
   std::mt19937 rng(2026);
   auto step = testing::make_paper_step();
-  int active = 0, feasible = 0, over = 0;
-  double worst = 0.0;
-  for (int rep = 0; rep < 300; ++rep) {
+  SolverSettings tight;
+  tight.tolerance = 1e-11;
+  tight.max_iterations = 200000;
+  int active = 0, inactive = 0;
+  for (int rep = 0; rep < 120; ++rep) {
     testing::paper_family_qp(rng, *step);
-    const Solved proj = solve_with("projection", step->qp);
+    const Solved proj = solve_with("projection", step->qp, tight);
     const Solved newton = solve_with("newton", step->qp);
     ASSERT_EQ(proj.result.info.status, newton.result.info.status) << rep << ": " << newton.result.info.diagnosis;
     if (newton.result.info.status != SolverStatus::kSolved) continue;
-    ++feasible;
     ASSERT_EQ(newton.result.info.engine, "newton");
-    const double dx = (proj.result.x - newton.result.x).cwiseAbs().maxCoeff();
-    EXPECT_LE(dx, 5e-5) << rep;
-    over += dx > 1e-5;
-    worst = std::max(worst, dx);
     EXPECT_LE(kkt_residual(step->qp, newton.result), 1e-10) << rep;
+    EXPECT_LE((proj.result.x - newton.result.x).cwiseAbs().maxCoeff(), 1e-7) << rep;
     const Eigen::VectorXd& x = newton.result.x;
-    active += ((x - step->qp.lo).array().abs() < 1e-12).any() || ((step->qp.hi - x).array().abs() < 1e-12).any();
+    const bool on_bound =
+        ((x - step->qp.lo).array().abs() < 1e-12).any() || ((step->qp.hi - x).array().abs() < 1e-12).any();
+    (on_bound ? active : inactive) += 1;
   }
-  EXPECT_GT(feasible, 200);
-  EXPECT_LE(over, feasible / 50);
-  RecordProperty("max_dx", std::to_string(worst));
-  EXPECT_GT(active, feasible / 5);  // bounds matter in this family
-  EXPECT_LT(active, feasible / 2);
-  RecordProperty("active_fraction", std::to_string(static_cast<double>(active) / feasible));
+  EXPECT_GT(active, 0) << "no problem had an active bound";
+  EXPECT_GT(inactive, 0) << "every problem had an active bound";
 }
 
 TEST(Lvi, ProjectionDiagonalShortcutKeepsTheIterates) {

@@ -18,8 +18,8 @@ struct Cli {
 // Runs the CLI from the source tree with stderr merged into the captured output; `env` is prefixed to the command
 // (e.g. "REDRES_PLUGIN_PATH='/x' ").
 inline Cli redres_env(const std::string& env, const std::string& args) {
-  const std::string cmd = "cd '" + std::string(REDRES_SOURCE_DIR) + "' && " + env + "'" + REDRES_CLI + "' " + args +
-                          " 2>&1";
+  const std::string cmd =
+      "cd '" + std::string(REDRES_SOURCE_DIR) + "' && " + env + "'" + REDRES_CLI + "' " + args + " 2>&1";
   Cli r;
   FILE* p = popen(cmd.c_str(), "r");
   if (p == nullptr) return r;

@@ -31,7 +31,8 @@ RandomQp random_qp(std::mt19937& rng, int n, int m_e, int m_i, bool dense_w) {
     Eigen::MatrixXd B(n, m_e);
     for (int r = 0; r < m_e; ++r)
       for (int i = 0; i < n; ++i) B(i, r) = u(rng);
-    const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(B).householderQ() * Eigen::MatrixXd::Identity(n, m_e);
+    const Eigen::MatrixXd Q =
+        Eigen::HouseholderQR<Eigen::MatrixXd>(B).householderQ() * Eigen::MatrixXd::Identity(n, m_e);
     for (int r = 0; r < m_e; ++r) qp.J.row(r) = (1.0 + 0.5 * u(rng)) * Q.col(r).transpose();
   }
   qp.d = qp.J * out.feasible;
@@ -130,7 +131,8 @@ void paper_family_qp(std::mt19937& rng, PaperStep& step, double speed) {
              Eigen::Vector2d(e * std::cos(e_angle), e * std::sin(e_angle)));
 }
 
-void PaperStep::build(const Eigen::VectorXd& theta, double t, const Eigen::Vector2d& rd_dot, const Eigen::Vector2d& dr) {
+void PaperStep::build(const Eigen::VectorXd& theta, double t, const Eigen::Vector2d& rd_dot,
+                      const Eigen::Vector2d& dr) {
   compute_kinematics(*robot, theta, *kin, scheme->kinematics_level());
   ctx.t = t;
   r_d = kin->f + dr;

@@ -5,8 +5,8 @@
 namespace redres::testing {
 
 std::shared_ptr<const VelocityLimitLaw> constant_law(double limit) {
-  const std::string text = "type = \"constant\"\nlower = " + std::to_string(-limit) +
-                           "\nupper = " + std::to_string(limit) + "\n";
+  const std::string text =
+      "type = \"constant\"\nlower = " + std::to_string(-limit) + "\nupper = " + std::to_string(limit) + "\n";
   const auto file = parse_toml_string(text, "<test>");
   return velocity_limit_registry().create(TableReader::root(file));
 }

@@ -99,8 +99,8 @@ struct KeyInfo {
 /// A validity rule for a value of type T: `ok` returns true when valid; `text` says what is expected.
 template <class T>
 struct Rule {
-  std::string text;                        //!< e.g. "> 0"
-  std::function<bool(const T&)> ok;        //!< the test
+  std::string text;                  //!< e.g. "> 0"
+  std::function<bool(const T&)> ok;  //!< the test
 };
 
 // --- value codecs: reading one key, writing it back, describing its type ------------------------------------------
@@ -233,8 +233,8 @@ void read(const TableReader& r, std::string_view key, std::vector<S>& v) {
     const toml::table* t = el.as_table();
     const std::string what = std::string(key) + "[" + std::to_string(k - 1) + "]";
     if (t == nullptr) {
-      throw ConfigError(location_of(r.file(), el), r.context() + ": " + what + ": expected an inline table, got " +
-                                                       describe_type(el));
+      throw ConfigError(location_of(r.file(), el),
+                        r.context() + ": " + what + ": expected an inline table, got " + describe_type(el));
     }
     const TableReader sub(r.file_ptr(), *t, r.context() + "." + what);
     S s{};
@@ -292,10 +292,10 @@ struct Field {
   std::string type;
   Presence presence = Presence::kOptional;
   std::string group;
-  std::function<void(const TableReader&, C&)> read;            //!< reads the key (which is present)
-  std::function<void(const C&, toml::table&)> write;           //!< writes the member
-  std::function<bool(const C&)> given;                         //!< member holds a value (required keys)
-  std::function<std::optional<std::string>(const C&)> check;   //!< nullopt, or what was expected and got
+  std::function<void(const TableReader&, C&)> read;           //!< reads the key (which is present)
+  std::function<void(const C&, toml::table&)> write;          //!< writes the member
+  std::function<bool(const C&)> given;                        //!< member holds a value (required keys)
+  std::function<std::optional<std::string>(const C&)> check;  //!< nullopt, or what was expected and got
 
   /// Marks the key as required: no default; a Config built in C++ must set it.
   Field&& required() && {
@@ -387,17 +387,20 @@ std::string number_text(double bound) {
 /// value > bound (every entry, for arrays).
 template <class T = double>
 Rule<T> greater(double bound) {
-  return {"> " + detail::number_text<T>(bound), [bound](const T& v) { return detail::all_of(v, [bound](double x) { return x > bound; }); }};
+  return {"> " + detail::number_text<T>(bound),
+          [bound](const T& v) { return detail::all_of(v, [bound](double x) { return x > bound; }); }};
 }
 /// value >= bound.
 template <class T = double>
 Rule<T> at_least(double bound) {
-  return {">= " + detail::number_text<T>(bound), [bound](const T& v) { return detail::all_of(v, [bound](double x) { return x >= bound; }); }};
+  return {">= " + detail::number_text<T>(bound),
+          [bound](const T& v) { return detail::all_of(v, [bound](double x) { return x >= bound; }); }};
 }
 /// value < bound.
 template <class T = double>
 Rule<T> less(double bound) {
-  return {"< " + detail::number_text<T>(bound), [bound](const T& v) { return detail::all_of(v, [bound](double x) { return x < bound; }); }};
+  return {"< " + detail::number_text<T>(bound),
+          [bound](const T& v) { return detail::all_of(v, [bound](double x) { return x < bound; }); }};
 }
 /// lo <= value <= hi.
 template <class T = double>

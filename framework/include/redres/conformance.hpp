@@ -20,11 +20,11 @@ namespace redres {
 
 /// The outcome of one check.
 struct ConformanceResult {
-  std::string kind;     //!< "objective", "constraint", ...
-  std::string type;     //!< registry type
-  std::string check;    //!< "defaults", "round trip", ...
-  bool ok = false;      //!< passed
-  std::string detail;   //!< what failed (or what was checked)
+  std::string kind;    //!< "objective", "constraint", ...
+  std::string type;    //!< registry type
+  std::string check;   //!< "defaults", "round trip", ...
+  bool ok = false;     //!< passed
+  std::string detail;  //!< what failed (or what was checked)
 };
 
 /// Runs every check on every registered plugin (of every registry).

@@ -10,13 +10,13 @@ namespace redres {
 
 /// Everything a plugin may read at one control step. New inputs are added here, never to plugin signatures.
 struct Context {
-  double t = 0.0;    //!< time since the start of the task (s)
-  double T = 0.0;    //!< task duration (s)
-  double tau = 0.0;  //!< control step (s)
-  const RobotModel* robot = nullptr;          //!< the robot
-  const KinematicsData* kinematics = nullptr; //!< kinematics at theta (f, J, dJ, w, grad w, ...)
-  const Eigen::VectorXd* r_d = nullptr;       //!< desired task coordinates r_d(t) (m_task)
-  const Eigen::VectorXd* r_d_dot = nullptr;   //!< desired task velocity r_d_dot(t) (m_task)
+  double t = 0.0;                              //!< time since the start of the task (s)
+  double T = 0.0;                              //!< task duration (s)
+  double tau = 0.0;                            //!< control step (s)
+  const RobotModel* robot = nullptr;           //!< the robot
+  const KinematicsData* kinematics = nullptr;  //!< kinematics at theta (f, J, dJ, w, grad w, ...)
+  const Eigen::VectorXd* r_d = nullptr;        //!< desired task coordinates r_d(t) (m_task)
+  const Eigen::VectorXd* r_d_dot = nullptr;    //!< desired task velocity r_d_dot(t) (m_task)
 
   /// Joint positions theta (n).
   [[nodiscard]] const Eigen::VectorXd& theta() const { return kinematics->theta; }

@@ -28,8 +28,7 @@ class Controller {
  public:
   /// `path` may be null when the caller supplies r_d and r_d_dot itself. T is the task duration (s), tau the
   /// step (s), both visible to plugins through the Context.
-  Controller(const RobotModel& robot, const Scheme& scheme, LviEngine& engine, const Path* path, double T,
-             double tau);
+  Controller(const RobotModel& robot, const Scheme& scheme, LviEngine& engine, const Path* path, double T, double tau);
 
   /// An output sized for this controller.
   [[nodiscard]] StepOutput make_output() const;

@@ -11,9 +11,9 @@ namespace redres {
 
 /// A numeric CSV file read into columns.
 struct CsvTable {
-  std::string path;                         //!< the file
-  std::vector<std::string> names;           //!< header names
-  std::vector<std::vector<double>> columns; //!< one vector per header name
+  std::string path;                          //!< the file
+  std::vector<std::string> names;            //!< header names
+  std::vector<std::vector<double>> columns;  //!< one vector per header name
 
   /// The column called `name` (throws std::out_of_range if absent).
   [[nodiscard]] const std::vector<double>& column(const std::string& name) const;

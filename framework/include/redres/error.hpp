@@ -12,8 +12,8 @@ namespace redres {
 
 /// Where in a configuration file something was found. `line` and `column` are 1-based; 0 means unknown.
 struct SourceLocation {
-  std::string file;        //!< path of the file as it was opened
-  std::uint32_t line = 0;  //!< 1-based line, 0 if unknown
+  std::string file;          //!< path of the file as it was opened
+  std::uint32_t line = 0;    //!< 1-based line, 0 if unknown
   std::uint32_t column = 0;  //!< 1-based column, 0 if unknown
 
   /// "file:line:col" (or just "file" when the position is unknown).
@@ -43,7 +43,7 @@ class ConfigError : public std::runtime_error {
 
 /// API-misuse check: throws std::invalid_argument("<function>: <condition>") when `ok` is false. The message
 /// expression is evaluated only on failure, so a passing check costs no allocation (real-time path).
-#define REDRES_REQUIRE(ok, function, condition)                          \
-  do {                                                                   \
+#define REDRES_REQUIRE(ok, function, condition)                           \
+  do {                                                                    \
     if (!(ok)) ::redres::throw_invalid_argument((function), (condition)); \
   } while (false)

@@ -39,40 +39,38 @@ class KinematicsData {
   /// Sizes every buffer for `model`.
   explicit KinematicsData(const RobotModel& model);
 
-  Eigen::VectorXd theta;               //!< configuration the results belong to (n)
-  Eigen::VectorXd f;                   //!< task coordinates f(theta) (m): m, rad (planar phi), rotation vector
-  Eigen::Isometry3d ee_pose;           //!< end-effector pose in the base frame
-  Eigen::Matrix3Xd axes;               //!< z_j, joint axes in the base frame (3 x n)
-  Eigen::Matrix3Xd origins;            //!< p_j, points on the joint axes (3 x n), m
-  Eigen::MatrixXd J;                   //!< task Jacobian (m x n)
-  Eigen::MatrixXd dJ;                  //!< [dJ/dtheta_1, ..., dJ/dtheta_n] (m x n*n); see dJ_block()
-  double w = 0.0;                      //!< det(J J')
-  Eigen::VectorXd grad_w;              //!< q = d w / d theta (n)
-  double mu = 0.0;                     //!< Yoshikawa's sqrt(det(J J'))
-  Eigen::VectorXd grad_mu;             //!< d mu / d theta (n)
+  Eigen::VectorXd theta;      //!< configuration the results belong to (n)
+  Eigen::VectorXd f;          //!< task coordinates f(theta) (m): m, rad (planar phi), rotation vector
+  Eigen::Isometry3d ee_pose;  //!< end-effector pose in the base frame
+  Eigen::Matrix3Xd axes;      //!< z_j, joint axes in the base frame (3 x n)
+  Eigen::Matrix3Xd origins;   //!< p_j, points on the joint axes (3 x n), m
+  Eigen::MatrixXd J;          //!< task Jacobian (m x n)
+  Eigen::MatrixXd dJ;         //!< [dJ/dtheta_1, ..., dJ/dtheta_n] (m x n*n); see dJ_block()
+  double w = 0.0;             //!< det(J J')
+  Eigen::VectorXd grad_w;     //!< q = d w / d theta (n)
+  double mu = 0.0;            //!< Yoshikawa's sqrt(det(J J'))
+  Eigen::VectorXd grad_mu;    //!< d mu / d theta (n)
   KinematicsLevel level = KinematicsLevel::kPosition;  //!< what the last compute() filled in
 
   /// dJ/dtheta_i (m x n).
   [[nodiscard]] auto dJ_block(int i) { return dJ.middleCols(static_cast<Eigen::Index>(i) * J.cols(), J.cols()); }
-  [[nodiscard]] auto dJ_block(int i) const {
-    return dJ.middleCols(static_cast<Eigen::Index>(i) * J.cols(), J.cols());
-  }
+  [[nodiscard]] auto dJ_block(int i) const { return dJ.middleCols(static_cast<Eigen::Index>(i) * J.cols(), J.cols()); }
 
  private:
   friend void compute_kinematics(const RobotModel&, const Eigen::Ref<const Eigen::VectorXd>&, KinematicsData&,
                                  KinematicsLevel);
-  Eigen::MatrixXd jjt_;                                   // A = J J' (m x m)
-  Eigen::MatrixXd adj_;                                   // adj(A) (m x m)
-  Eigen::MatrixXd weighted_;                              // adj(A) J or U diag(c) V' (m x n)
-  Eigen::VectorXd products_;                              // prod_{j != k} s_j (m)
-  TaskEigenSolver eig_;                                   // for adj(A) when m > 3
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd_;                 // for mu
+  Eigen::MatrixXd jjt_;                    // A = J J' (m x m)
+  Eigen::MatrixXd adj_;                    // adj(A) (m x m)
+  Eigen::MatrixXd weighted_;               // adj(A) J or U diag(c) V' (m x n)
+  Eigen::VectorXd products_;               // prod_{j != k} s_j (m)
+  TaskEigenSolver eig_;                    // for adj(A) when m > 3
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd_;  // for mu
 };
 
 /// Evaluates the kinematics of `model` at `theta` into `data`. Throws std::invalid_argument when theta has the
 /// wrong size or is not finite. Allocation-free.
-void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
-                        KinematicsData& data, KinematicsLevel level = KinematicsLevel::kManipulability);
+void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
+                        KinematicsLevel level = KinematicsLevel::kManipulability);
 
 /// det(A) and adj(A) of a symmetric m x m matrix (m <= 6) without inverting it (cofactors for m <= 3,
 /// eigen-decomposition otherwise, using `eig` as scratch). Allocation-free when `adj` is sized.

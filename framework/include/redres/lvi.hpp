@@ -40,11 +40,11 @@ struct SolverSettings {
 
 /// Outcome of one solve.
 enum class SolverStatus {
-  kSolved,         //!< ||e(u)|| <= tolerance
-  kMaxIterations,  //!< the iteration cap was reached first
-  kInfeasible,     //!< bounds conflict, or J x = d cannot be met inside the bounds
-  kNumericalError, //!< the iteration broke down (e.g. a zero step); see the diagnosis
-  kNotRun,         //!< no solve has run yet (recorded codes 0-3 keep their meaning)
+  kSolved,          //!< ||e(u)|| <= tolerance
+  kMaxIterations,   //!< the iteration cap was reached first
+  kInfeasible,      //!< bounds conflict, or J x = d cannot be met inside the bounds
+  kNumericalError,  //!< the iteration broke down (e.g. a zero step); see the diagnosis
+  kNotRun,          //!< no solve has run yet (recorded codes 0-3 keep their meaning)
 };
 
 /// "solved", "max_iterations", "infeasible", "numerical_error", "not_run".

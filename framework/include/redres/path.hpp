@@ -35,16 +35,16 @@ namespace redres {
 struct PathSegment {
   enum class Kind { kLine, kArc, kHelix };
   Kind kind = Kind::kLine;
-  Eigen::Vector3d a = Eigen::Vector3d::Zero();   //!< line start, or arc/helix centre (m)
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();   //!< line end (m)
-  Eigen::Vector3d e1 = Eigen::Vector3d::UnitX(); //!< arc/helix plane axes (orthonormal)
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();    //!< line start, or arc/helix centre (m)
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();    //!< line end (m)
+  Eigen::Vector3d e1 = Eigen::Vector3d::UnitX();  //!< arc/helix plane axes (orthonormal)
   Eigen::Vector3d e2 = Eigen::Vector3d::UnitY();
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ(); //!< helix axis (unit)
-  double radius = 0.0;       //!< arc/helix radius (m)
-  double start_angle = 0.0;  //!< angle at the segment start (rad), measured from e1 towards e2
-  double sweep = 0.0;        //!< signed angle swept (rad); negative is clockwise about e1 x e2
-  double rise = 0.0;         //!< helix: advance along the axis over the whole segment (m)
-  double length = 0.0;       //!< arc length (m), set by line() and arc() (a helix sets it itself)
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  //!< helix axis (unit)
+  double radius = 0.0;                              //!< arc/helix radius (m)
+  double start_angle = 0.0;                         //!< angle at the segment start (rad), measured from e1 towards e2
+  double sweep = 0.0;                               //!< signed angle swept (rad); negative is clockwise about e1 x e2
+  double rise = 0.0;                                //!< helix: advance along the axis over the whole segment (m)
+  double length = 0.0;  //!< arc length (m), set by line() and arc() (a helix sets it itself)
 
   /// A line from p to q.
   static PathSegment line(const Eigen::Vector3d& p, const Eigen::Vector3d& q);
@@ -87,8 +87,8 @@ inline auto enum_names(Placement) {
 /// prefers where the scenario does not say (e.g. the letter R is upright when rotated by 180 degrees).
 struct PathGeometry {
   std::vector<std::vector<PathSegment>> strokes{};  //!< each stroke is drawn from rest to rest (per_stroke timing)
-  double rotation_deg = 0.0;                      //!< default planar rotation of the shape
-  TimingScope scope = TimingScope::kPerStroke;    //!< default timing scope of the shape
+  double rotation_deg = 0.0;                        //!< default planar rotation of the shape
+  TimingScope scope = TimingScope::kPerStroke;      //!< default timing scope of the shape
 };
 
 /// Geometry from consecutive segments: one stroke, or (`stroke_each`) one stroke per segment, each drawn from rest
@@ -123,8 +123,8 @@ class Path {
   std::vector<int> stroke_first_{};     // first segment of each stroke
   std::vector<double> stroke_start_{};  // arc length at each stroke start
   std::vector<double> stroke_length_{};
-  std::vector<double> stroke_t0_{};     // start time of each stroke
-  std::vector<double> stroke_T_{};      // duration of each stroke
+  std::vector<double> stroke_t0_{};  // start time of each stroke
+  std::vector<double> stroke_T_{};   // duration of each stroke
   int dim_;
   double duration_;
   double total_ = 0.0;
@@ -145,11 +145,11 @@ struct PathContext {
 /// The placement and timing keys that every path takes besides its own. Unset optionals take the shape's
 /// preference (PathGeometry) or, for `origin`, zero.
 struct PathPlacement {
-  Placement placement = Placement::kRelative;   //!< origin absolute, or relative to f(theta(0))
+  Placement placement = Placement::kRelative;      //!< origin absolute, or relative to f(theta(0))
   std::optional<std::vector<double>> origin{};     //!< path origin (m), 2 or 3 numbers
   std::optional<double> rotation_deg{};            //!< planar: rotation about z (deg); default: the shape's
   std::optional<std::array<double, 3>> rpy_deg{};  //!< spatial: roll, pitch, yaw (deg)
-  TimingLaw timing = TimingLaw::kCycloidal;      //!< timing law
+  TimingLaw timing = TimingLaw::kCycloidal;        //!< timing law
   std::optional<TimingScope> timing_scope{};       //!< per stroke or whole path; default: the shape's
 
   static const Schema<PathPlacement>& schema();

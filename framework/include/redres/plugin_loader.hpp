@@ -28,7 +28,8 @@ void load_plugin_library(const std::filesystem::path& library, const SourceLocat
 
 /// Resolves a library named in a file or on the command line: a path with a '/' (relative to `base_dir`), else
 /// `base_dir`/name if it exists, else the first REDRES_PLUGIN_PATH directory that holds it.
-[[nodiscard]] std::filesystem::path resolve_plugin_library(const std::string& name, const std::filesystem::path& base_dir);
+[[nodiscard]] std::filesystem::path resolve_plugin_library(const std::string& name,
+                                                           const std::filesystem::path& base_dir);
 
 /// Loads every `*.so` in the REDRES_PLUGIN_PATH directories (sorted by name); returns how many were loaded.
 int load_plugin_path();

@@ -23,22 +23,22 @@ inline constexpr double kNoBound = std::numeric_limits<double>::infinity();
 
 /// One QP (eqs. 10-12 plus inequality rows). Sized once; then filled each step.
 struct QpProblem {
-  Eigen::MatrixXd W;     //!< Hessian (n x n), symmetric positive definite
-  Eigen::VectorXd zeta;  //!< linear term (n)
-  Eigen::MatrixXd J;     //!< equality rows (m_e x n)
-  Eigen::VectorXd d;     //!< equality right-hand side (m_e)
-  Eigen::MatrixXd A;     //!< inequality rows (m_i x n)
-  Eigen::VectorXd b;     //!< inequality right-hand side (m_i)
-  Eigen::VectorXd lo;    //!< lower bounds (n); -inf where unbounded
-  Eigen::VectorXd hi;    //!< upper bounds (n); +inf where unbounded
-  bool w_diagonal = true;  //!< true while only diagonal terms were added to W
-  std::vector<int> lo_source;  //!< index of the source that set lo_i (-1: none)
-  std::vector<int> hi_source;  //!< index of the source that set hi_i (-1: none)
-  std::vector<std::string> source_names;  //!< names of the bound and row sources, indexed as above
+  Eigen::MatrixXd W;                        //!< Hessian (n x n), symmetric positive definite
+  Eigen::VectorXd zeta;                     //!< linear term (n)
+  Eigen::MatrixXd J;                        //!< equality rows (m_e x n)
+  Eigen::VectorXd d;                        //!< equality right-hand side (m_e)
+  Eigen::MatrixXd A;                        //!< inequality rows (m_i x n)
+  Eigen::VectorXd b;                        //!< inequality right-hand side (m_i)
+  Eigen::VectorXd lo;                       //!< lower bounds (n); -inf where unbounded
+  Eigen::VectorXd hi;                       //!< upper bounds (n); +inf where unbounded
+  bool w_diagonal = true;                   //!< true while only diagonal terms were added to W
+  std::vector<int> lo_source;               //!< index of the source that set lo_i (-1: none)
+  std::vector<int> hi_source;               //!< index of the source that set hi_i (-1: none)
+  std::vector<std::string> source_names;    //!< names of the bound and row sources, indexed as above
   std::vector<std::string> variable_names;  //!< joint names, for diagnoses (may be empty)
-  std::vector<int> eq_source;  //!< source of each equality row
-  std::vector<int> in_source;  //!< source of each inequality row
-  Eigen::VectorXd scratch;     //!< n-vector a plugin may use as workspace while it contributes
+  std::vector<int> eq_source;               //!< source of each equality row
+  std::vector<int> in_source;               //!< source of each inequality row
+  Eigen::VectorXd scratch;                  //!< n-vector a plugin may use as workspace while it contributes
 
   /// Sizes every buffer: n variables, m_e equality rows, m_i inequality rows.
   void resize(int n, int m_e, int m_i);
@@ -56,11 +56,11 @@ struct QpProblem {
 
 /// The conflict lo_i > hi_i of the first such joint, or index -1 when the box is consistent.
 struct BoundConflict {
-  int joint = -1;          //!< 0-based joint index, -1 if none
-  double lo = 0.0;         //!< the merged lower bound
-  double hi = 0.0;         //!< the merged upper bound
-  std::string lo_source;   //!< plugin that set lo
-  std::string hi_source;   //!< plugin that set hi
+  int joint = -1;         //!< 0-based joint index, -1 if none
+  double lo = 0.0;        //!< the merged lower bound
+  double hi = 0.0;        //!< the merged upper bound
+  std::string lo_source;  //!< plugin that set lo
+  std::string hi_source;  //!< plugin that set hi
 };
 
 /// Finds the first joint whose merged bounds conflict (lo_i > hi_i).

@@ -58,14 +58,14 @@ class Registry : public RegistryBase {
  public:
   /// A registered plugin type.
   struct Entry {
-    std::string type;                                   //!< name used as `type = "..."` in TOML
-    std::string summary;                                //!< one line
-    std::string origin;                                 //!< "built-in" or the library that registered it
-    std::vector<KeyInfo> keys;                          //!< keys with defaults, units, rules, presence
-    std::vector<std::pair<std::string, std::string>> groups;  //!< group -> what to give
-    const std::type_info* config_type = nullptr;        //!< the Config type
-    std::any defaults;                                  //!< a default Config
-    std::function<std::any(const TableReader&)> read;   //!< reads and checks a Config (does not finish())
+    std::string type;                                          //!< name used as `type = "..."` in TOML
+    std::string summary;                                       //!< one line
+    std::string origin;                                        //!< "built-in" or the library that registered it
+    std::vector<KeyInfo> keys;                                 //!< keys with defaults, units, rules, presence
+    std::vector<std::pair<std::string, std::string>> groups;   //!< group -> what to give
+    const std::type_info* config_type = nullptr;               //!< the Config type
+    std::any defaults;                                         //!< a default Config
+    std::function<std::any(const TableReader&)> read;          //!< reads and checks a Config (does not finish())
     std::function<void(const std::any&, toml::table&)> write;  //!< writes a Config's keys
     std::function<std::unique_ptr<Base>(const std::any&, Args...)> make;  //!< builds from a Config
   };
@@ -98,8 +98,8 @@ class Registry : public RegistryBase {
       return make(config, args...);
     };
     if (const auto it = entries_.find(e.type); it != entries_.end()) {
-      const std::string why = "duplicate " + kind() + " type '" + e.type + "': already registered by " +
-                              it->second.origin;
+      const std::string why =
+          "duplicate " + kind() + " type '" + e.type + "': already registered by " + it->second.origin;
       if (scope == nullptr) throw std::logic_error(why);
       scope->errors.push_back(why);
       return false;
@@ -127,7 +127,8 @@ class Registry : public RegistryBase {
   /// The entry for `type`; std::invalid_argument listing the known types when there is none.
   [[nodiscard]] const Entry& at(const std::string& type) const {
     const Entry* e = find(type);
-    if (e == nullptr) throw std::invalid_argument("unknown " + kind() + " type '" + type + "'; known types: " + names());
+    if (e == nullptr)
+      throw std::invalid_argument("unknown " + kind() + " type '" + type + "'; known types: " + names());
     return *e;
   }
 
@@ -136,7 +137,8 @@ class Registry : public RegistryBase {
   [[nodiscard]] std::unique_ptr<Base> create(const std::string& type, const std::any& config, Args... args) const {
     const Entry& e = at(type);
     if (config.type() != *e.config_type) {
-      throw std::invalid_argument(kind() + " '" + type + "': expected its own Config type, got a value of another type");
+      throw std::invalid_argument(kind() + " '" + type +
+                                  "': expected its own Config type, got a value of another type");
     }
     return e.make(config, args...);
   }

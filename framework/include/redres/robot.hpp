@@ -44,28 +44,28 @@ enum class TaskRows { kPosition, kPose };
 
 /// One joint as described in the robot file.
 struct JointSpec {
-  std::string name;                             //!< unique joint name
-  JointType type = JointType::kRevolute;        //!< revolute (rad) or prismatic (m; spatial chains only)
-  double length = 0.0;                          //!< planar link length l_j after the joint (m, > 0)
-  double a = 0.0;                               //!< DH link length (m)
-  double alpha = 0.0;                           //!< DH link twist (rad)
-  double d = 0.0;                               //!< DH link offset (m)
-  double theta_offset = 0.0;                    //!< DH joint-angle offset (rad)
-  double lower = 0.0;                           //!< position limit theta^- (rad or m)
-  double upper = 0.0;                           //!< position limit theta^+ (rad or m)
+  std::string name;                                        //!< unique joint name
+  JointType type = JointType::kRevolute;                   //!< revolute (rad) or prismatic (m; spatial chains only)
+  double length = 0.0;                                     //!< planar link length l_j after the joint (m, > 0)
+  double a = 0.0;                                          //!< DH link length (m)
+  double alpha = 0.0;                                      //!< DH link twist (rad)
+  double d = 0.0;                                          //!< DH link offset (m)
+  double theta_offset = 0.0;                               //!< DH joint-angle offset (rad)
+  double lower = 0.0;                                      //!< position limit theta^- (rad or m)
+  double upper = 0.0;                                      //!< position limit theta^+ (rad or m)
   std::shared_ptr<const VelocityLimitLaw> velocity_limit;  //!< theta_dot^-(theta), theta_dot^+(theta)
 };
 
 /// Everything needed to build a RobotModel; filled by the TOML loader or by code (tests, generators).
 struct RobotSpec {
-  std::string name;                                 //!< robot name
-  ChainKind kind = ChainKind::kPlanar;              //!< planar or spatial
-  DhConvention convention = DhConvention::kStandard;  //!< spatial only
-  TaskRows task = TaskRows::kPosition;              //!< task rows
-  std::vector<JointSpec> joints;                    //!< the chain, base to tip
+  std::string name;                                                //!< robot name
+  ChainKind kind = ChainKind::kPlanar;                             //!< planar or spatial
+  DhConvention convention = DhConvention::kStandard;               //!< spatial only
+  TaskRows task = TaskRows::kPosition;                             //!< task rows
+  std::vector<JointSpec> joints;                                   //!< the chain, base to tip
   Eigen::Isometry3d end_effector = Eigen::Isometry3d::Identity();  //!< E, in the last joint's frame
-  Eigen::VectorXd home;                             //!< home configuration (size n; empty = zeros)
-  std::string source;                               //!< file the spec came from (may be empty)
+  Eigen::VectorXd home;                                            //!< home configuration (size n; empty = zeros)
+  std::string source;                                              //!< file the spec came from (may be empty)
 };
 
 /// An immutable robot model. Construction validates the spec and throws std::invalid_argument on misuse.

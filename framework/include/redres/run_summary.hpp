@@ -19,12 +19,12 @@ struct ManipulabilityStats {
 
 /// What the solver did over the run.
 struct SolverStats {
-  std::string engine;           //!< e.g. "projection" or "newton+projection"
-  double mean_iterations = 0.0; //!< per recorded step
+  std::string engine;            //!< e.g. "projection" or "newton+projection"
+  double mean_iterations = 0.0;  //!< per recorded step
   double max_iterations = 0.0;
-  double max_residual = 0.0;    //!< largest ||e(u)||_2
-  int failures = 0;             //!< solves that were not `solved`
-  std::string first_failure;    //!< "t = ...: <status>: <diagnosis>", or empty
+  double max_residual = 0.0;  //!< largest ||e(u)||_2
+  int failures = 0;           //!< solves that were not `solved`
+  std::string first_failure;  //!< "t = ...: <status>: <diagnosis>", or empty
 };
 
 /// Facts about the robot that the plotting tools need.
@@ -43,18 +43,18 @@ struct PluginMetrics {
 
 /// The summary of one run.
 struct RunSummary {
-  std::string name;        //!< scenario name
-  std::string source;      //!< scenario file
-  int steps = 0;           //!< control steps N (N + 1 rows)
-  double tau = 0.0;        //!< step (s)
-  double duration = 0.0;   //!< T (s)
-  std::string integrator;  //!< "euler" or "heun"
-  std::string path;        //!< the path's description
-  double max_position_error = 0.0;    //!< max |r_d - f| over the position rows (m)
-  double final_position_error = 0.0;  //!< at t = T (m)
-  double initial_joint_velocity_norm = 0.0;  //!< |theta_dot(0)|
-  double final_joint_velocity_norm = 0.0;    //!< |theta_dot(T)|
-  ManipulabilityStats manipulability;        //!< w = det(JJ')
+  std::string name;                           //!< scenario name
+  std::string source;                         //!< scenario file
+  int steps = 0;                              //!< control steps N (N + 1 rows)
+  double tau = 0.0;                           //!< step (s)
+  double duration = 0.0;                      //!< T (s)
+  std::string integrator;                     //!< "euler" or "heun"
+  std::string path;                           //!< the path's description
+  double max_position_error = 0.0;            //!< max |r_d - f| over the position rows (m)
+  double final_position_error = 0.0;          //!< at t = T (m)
+  double initial_joint_velocity_norm = 0.0;   //!< |theta_dot(0)|
+  double final_joint_velocity_norm = 0.0;     //!< |theta_dot(T)|
+  ManipulabilityStats manipulability;         //!< w = det(JJ')
   double max_joint_angle_violation = 0.0;     //!< how far any theta left its limits (0 when never)
   double max_joint_velocity_violation = 0.0;  //!< how far any theta_dot left its velocity law (0 when never)
   long steps_with_active_bounds = 0;          //!< steps where some theta_dot sits on a merged bound

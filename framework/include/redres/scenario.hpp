@@ -31,17 +31,17 @@ enum class Integrator { kEuler, kHeun };
 
 /// A loaded scenario. Owns everything a run needs.
 struct Scenario {
-  std::string name;                       //!< scenario name
-  std::string source;                     //!< file it came from
-  std::unique_ptr<RobotModel> robot;      //!< the robot
-  Eigen::VectorXd theta0;                 //!< theta(0)
-  double duration = 0.0;                  //!< T (s)
-  double tau = 0.0;                       //!< step (s)
+  std::string name;                            //!< scenario name
+  std::string source;                          //!< file it came from
+  std::unique_ptr<RobotModel> robot;           //!< the robot
+  Eigen::VectorXd theta0;                      //!< theta(0)
+  double duration = 0.0;                       //!< T (s)
+  double tau = 0.0;                            //!< step (s)
   Integrator integrator = Integrator::kEuler;  //!< integrator
-  std::unique_ptr<Path> path;             //!< r_d(t)
-  std::unique_ptr<Scheme> scheme;         //!< objectives and constraints
-  std::unique_ptr<LviEngine> engine;      //!< solver
-  bool plots = false;                     //!< [output] plots
+  std::unique_ptr<Path> path;                  //!< r_d(t)
+  std::unique_ptr<Scheme> scheme;              //!< objectives and constraints
+  std::unique_ptr<LviEngine> engine;           //!< solver
+  bool plots = false;                          //!< [output] plots
 
   /// Number of control steps N = round(T / tau); the run records N + 1 rows, t = 0 .. T.
   [[nodiscard]] int steps() const;

@@ -22,8 +22,8 @@ struct VelocityBounds {
 
 /// Where a law is undefined inside a range: the angle and the reason.
 struct UndefinedAt {
-  double theta = 0.0;   //!< joint position (rad or m)
-  std::string reason;   //!< e.g. "cos(theta) = 0"
+  double theta = 0.0;  //!< joint position (rad or m)
+  std::string reason;  //!< e.g. "cos(theta) = 0"
 };
 
 /// A velocity-limit law. Immutable after construction; bounds() is allocation-free. A law is a plugin with a typed

@@ -23,7 +23,8 @@ TEST(PushRodLaw, MatchesEquation2ByHandAtSeveralAngles) {
     for (double u : {0.0, 0.25, 0.5, 0.75, 1.0}) {
       const double th = arm.lower_limits()(j) + u * (arm.upper_limits()(j) - arm.lower_limits()(j));
       const double aj = a[j - 1];
-      const double by_hand = s * sigma * std::sqrt(aj * aj + b * b + 2 * aj * b * std::sin(th)) / (aj * b * std::cos(th));
+      const double by_hand =
+          s * sigma * std::sqrt(aj * aj + b * b + 2 * aj * b * std::sin(th)) / (aj * b * std::cos(th));
       const VelocityBounds v = arm.joint(j).velocity_limit->bounds(th);
       EXPECT_NEAR(v.upper, by_hand, 1e-12) << "joint " << j + 1 << " at " << th;
       EXPECT_NEAR(v.lower, -by_hand, 1e-12) << "joint " << j + 1 << " at " << th;
@@ -34,8 +35,10 @@ TEST(PushRodLaw, MatchesEquation2ByHandAtSeveralAngles) {
 }
 
 TEST(PushRodLaw, ARangeThatReachesCosZeroIsRejectedNamingTheAngle) {
-  const auto file = parse_toml_string("type = \"push_rod\"\na = 0.25\nb = 0.08\ns = 2.5e-3\nsigma_min = -10.0\n"
-                                      "sigma_max = 10.0\n", "<law>");
+  const auto file = parse_toml_string(
+      "type = \"push_rod\"\na = 0.25\nb = 0.08\ns = 2.5e-3\nsigma_min = -10.0\n"
+      "sigma_max = 10.0\n",
+      "<law>");
   const auto law = velocity_limit_registry().create(TableReader::root(file));
   const auto bad = check_velocity_law(*law, 1.0, 2.0);
   ASSERT_TRUE(bad.has_value());
@@ -70,7 +73,8 @@ TEST(RobotCommand, PrintsTheDesignSection4ValuesOfThePaperArm) {
 }
 
 TEST(RobotCommand, JsonAndThetaFormulasAndErrors) {
-  const auto [code, out] = cli("robot robots/paper_pushrod_6dof.toml --json --theta pi/4,pi/12,pi/12,pi/12,pi/36,pi/36");
+  const auto [code, out] =
+      cli("robot robots/paper_pushrod_6dof.toml --json --theta pi/4,pi/12,pi/12,pi/12,pi/36,pi/36");
   ASSERT_EQ(code, 0) << out;
   const nlohmann::json j = nlohmann::json::parse(out);
   EXPECT_NEAR(j["manipulability"].get<double>(), 0.234131505, 1e-9);

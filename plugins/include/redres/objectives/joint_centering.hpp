@@ -11,7 +11,7 @@ namespace redres {
 
 /// The configuration of `joint_centering`.
 struct JointCenteringConfig {
-  double lambda = 1.0;                //!< gain (1/s), >= 0
+  double lambda = 1.0;                  //!< gain (1/s), >= 0
   std::optional<PerJoint> theta_ref{};  //!< reference configuration; default: the robot's home
 
   static const Schema<JointCenteringConfig>& schema();

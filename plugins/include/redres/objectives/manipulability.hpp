@@ -27,11 +27,11 @@ struct ManipulabilityConfig {
   enum class Measure { kDet, kYoshikawa };
   enum class Schedule { kConstant, kSine, kSmoothstep, kExpression };
 
-  Measure measure = Measure::kDet;        //!< det(JJ') (the paper) or sqrt(det(JJ'))
-  Schedule schedule = Schedule::kSine;    //!< p(t)
-  double p = 2.0;                         //!< coefficient magnitude
-  double ramp_fraction = 0.25;            //!< smoothstep: each ramp's share of T
-  std::optional<std::string> formula{};     //!< expression: p(t) as a formula of t and T
+  Measure measure = Measure::kDet;       //!< det(JJ') (the paper) or sqrt(det(JJ'))
+  Schedule schedule = Schedule::kSine;   //!< p(t)
+  double p = 2.0;                        //!< coefficient magnitude
+  double ramp_fraction = 0.25;           //!< smoothstep: each ramp's share of T
+  std::optional<std::string> formula{};  //!< expression: p(t) as a formula of t and T
 
   static const Schema<ManipulabilityConfig>& schema();
 };
@@ -39,11 +39,13 @@ struct ManipulabilityConfig {
 /// Names of the enums in TOML.
 inline auto enum_names(ManipulabilityConfig::Measure) {
   using M = ManipulabilityConfig::Measure;
-  return std::array{std::pair{M::kDet, std::string_view("det")}, std::pair{M::kYoshikawa, std::string_view("yoshikawa")}};
+  return std::array{std::pair{M::kDet, std::string_view("det")},
+                    std::pair{M::kYoshikawa, std::string_view("yoshikawa")}};
 }
 inline auto enum_names(ManipulabilityConfig::Schedule) {
   using S = ManipulabilityConfig::Schedule;
-  return std::array{std::pair{S::kConstant, std::string_view("constant")}, std::pair{S::kSine, std::string_view("sine")},
+  return std::array{std::pair{S::kConstant, std::string_view("constant")},
+                    std::pair{S::kSine, std::string_view("sine")},
                     std::pair{S::kSmoothstep, std::string_view("smoothstep")},
                     std::pair{S::kExpression, std::string_view("expression")}};
 }

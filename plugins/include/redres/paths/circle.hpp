@@ -14,11 +14,11 @@ namespace redres {
 /// The configuration of `circle`.
 struct CircleConfig {
   enum class Direction { kCcw, kCw };
-  double radius = 0.05;                          //!< radius (m)
-  double turns = 1.0;                            //!< number of turns
-  double start_angle_deg = 0.0;                  //!< the origin's angle on the circle (deg)
-  Direction direction = Direction::kCcw;         //!< about the normal
-  std::optional<std::array<double, 3>> normal{};   //!< plane normal (spatial tasks; default: z)
+  double radius = 0.05;                           //!< radius (m)
+  double turns = 1.0;                             //!< number of turns
+  double start_angle_deg = 0.0;                   //!< the origin's angle on the circle (deg)
+  Direction direction = Direction::kCcw;          //!< about the normal
+  std::optional<std::array<double, 3>> normal{};  //!< plane normal (spatial tasks; default: z)
 
   static const Schema<CircleConfig>& schema();
 };

@@ -25,7 +25,7 @@ struct PolylineSegment {
 /// The configuration of `polyline`.
 struct PolylineConfig {
   std::vector<PolylineSegment> segments{};  //!< required, non-empty
-  bool stop_at_corners = true;            //!< every segment drawn from rest to rest
+  bool stop_at_corners = true;              //!< every segment drawn from rest to rest
 
   static const Schema<PolylineConfig>& schema();
 };

@@ -12,8 +12,8 @@ namespace redres {
 
 /// The configuration of `waypoints`.
 struct WaypointsConfig {
-  std::filesystem::path file{};   //!< CSV file with columns x,y[,z]; required
-  bool stop_at_points = false;  //!< stop (from rest to rest) at every point
+  std::filesystem::path file{};  //!< CSV file with columns x,y[,z]; required
+  bool stop_at_points = false;   //!< stop (from rest to rest) at every point
 
   static const Schema<WaypointsConfig>& schema();
 };

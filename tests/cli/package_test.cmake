@@ -1,14 +1,9 @@
 # Installs the build in BUILD_DIR into WORK_DIR/prefix, configures SOURCE_DIR/examples against it with
-# find_package(redres), builds the examples and runs the first one; then builds and runs the out-of-tree plugin
-# example in examples/custom_plugin. Fails on any error.
+# find_package(redres), builds the examples and runs the first one; then builds the out-of-tree plugin library of
+# examples/custom_plugin, runs the installed `redres` on its scenario, and runs the conformance checks on it.
+# Fails on any error.
 file(REMOVE_RECURSE ${WORK_DIR})
-function(run)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "command failed (${rc}): ${ARGN}\n${out}\n${err}")
-  endif()
-  set(LAST_OUTPUT "${out}" PARENT_SCOPE)
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/run_checked.cmake)
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
 # Configures SOURCE_DIR/<project> against the installed package, builds it, runs <program> and checks that its
 # output matches <expected>.

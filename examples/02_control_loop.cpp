@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
     objectives.push_back(std::make_unique<MinVelocityNorm>(MinVelocityNorm::Config{}, robot));
     objectives.push_back(std::make_unique<Manipulability>(
         Manipulability::Config{
-            .measure = Manipulability::Measure::kDet, .schedule = Manipulability::Schedule::kSine, .p = 2.0},
+            .p = 2.0, .schedule = Manipulability::Schedule::kSine, .measure = Manipulability::Measure::kDet},
         robot));
     std::vector<std::unique_ptr<Constraint>> constraints;
     constraints.push_back(std::make_unique<TaskTracking>(TaskTracking::Config{.gain = 8.0}, robot));

@@ -166,6 +166,11 @@ void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
   warm_ = true;
 }
 
+void LviEngine::set_settings(const SolverSettings& s) {
+  require_valid(s, SolverSettings::schema(), "solver settings");
+  settings_ = s;
+}
+
 const Schema<SolverSettings>& SolverSettings::schema() {
   using C = SolverSettings;
   static const Schema<C> s{

@@ -10,9 +10,11 @@
 
 #include "redres/config.hpp"
 #include "redres/constraints/joint_angle_margin.hpp"
+#include "redres/engines/newton.hpp"
 #include "redres/lvi.hpp"
 #include "redres/objectives/manipulability.hpp"
 #include "redres/path.hpp"
+#include "redres/paths/letter_r.hpp"
 #include "redres/plugin.hpp"
 #include "redres/scheme.hpp"
 #include "redres/velocity_limit.hpp"
@@ -214,6 +216,16 @@ TEST(Config, ConfigsBuiltInCppAreValidatedWithTheKeyInTheMessage) {
   EXPECT_THROW((void)objective_registry().create("no_such_objective", Manipulability::Config{}, robot),
                std::invalid_argument);
   EXPECT_THROW((void)make_engine("newton", SolverSettings{.tolerance = -1.0}), std::invalid_argument);
+  EXPECT_THROW((void)engine_registry().create("newton", NewtonConfig{}, SolverSettings{.max_iterations = 0}),
+               std::invalid_argument);
+  PathContext ctx;
+  ctx.duration = 10.0;
+  try {
+    (void)make_path("letter_r", LetterRConfig{.height = -0.15}, PathPlacement{}, ctx);
+    ADD_FAILURE() << "a negative letter height was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'height': expected > 0, got -0.15"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Config, APluginBuiltInCppContributesExactlyAsTheSamePluginReadFromToml) {
@@ -226,7 +238,7 @@ TEST(Config, APluginBuiltInCppContributesExactlyAsTheSamePluginReadFromToml) {
   std::vector<std::unique_ptr<Objective>> objectives;
   objectives.push_back(objective_registry().create(
       "manipulability",
-      Manipulability::Config{.schedule = Manipulability::Schedule::kSmoothstep, .p = 1.5, .ramp_fraction = 0.2},
+      Manipulability::Config{.p = 1.5, .schedule = Manipulability::Schedule::kSmoothstep, .ramp_fraction = 0.2},
       robot));
   objectives.back()->set_weight(0.5);
   const Scheme from_cpp(robot, std::move(objectives), {});

@@ -65,10 +65,10 @@ TEST(ControllerRealTime, ThousandStepsWithEveryPerStepPluginAllocateNothing) {
        {.schedule = M::Schedule::kExpression, .formula = "0.5*sin(pi*t/T)^2"},
        "newton"},
       {"tests/data/robots/planar_laws_pose.toml",
-       {.measure = M::Measure::kYoshikawa, .schedule = M::Schedule::kConstant, .p = 0.2},
+       {.p = 0.2, .schedule = M::Schedule::kConstant, .measure = M::Measure::kYoshikawa},
        "projection"},
-      {"robots/kuka_iiwa14.toml", {.measure = M::Measure::kYoshikawa, .p = 0.5}, "newton"},
-      {"robots/kuka_iiwa14.toml", {.schedule = M::Schedule::kConstant, .p = 0.1}, "projection"},
+      {"robots/kuka_iiwa14.toml", {.p = 0.5, .measure = M::Measure::kYoshikawa}, "newton"},
+      {"robots/kuka_iiwa14.toml", {.p = 0.1, .schedule = M::Schedule::kConstant}, "projection"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(std::string(c.robot) + " with " + c.engine);

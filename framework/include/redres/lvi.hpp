@@ -89,8 +89,8 @@ class LviEngine {
   [[nodiscard]] virtual std::string_view name() const = 0;
   /// The settings.
   [[nodiscard]] const SolverSettings& settings() const noexcept { return settings_; }
-  /// Replaces the settings.
-  void set_settings(const SolverSettings& s) { settings_ = s; }
+  /// Replaces the settings; std::invalid_argument naming the key when they break SolverSettings' schema.
+  void set_settings(const SolverSettings& s);
 
  protected:
   /// Whether `result` holds a previous solution to start from.

@@ -22,14 +22,15 @@
 
 namespace redres {
 
-/// The configuration of `manipulability`.
+/// The configuration of `manipulability`. Designated initialisers follow this order, e.g.
+/// `Manipulability::Config{.p = 2.0, .schedule = Manipulability::Schedule::kSine}`.
 struct ManipulabilityConfig {
   enum class Measure { kDet, kYoshikawa };
   enum class Schedule { kConstant, kSine, kSmoothstep, kExpression };
 
-  Measure measure = Measure::kDet;       //!< det(JJ') (the paper) or sqrt(det(JJ'))
-  Schedule schedule = Schedule::kSine;   //!< p(t)
   double p = 2.0;                        //!< coefficient magnitude
+  Schedule schedule = Schedule::kSine;   //!< p(t)
+  Measure measure = Measure::kDet;       //!< det(JJ') (the paper) or sqrt(det(JJ'))
   double ramp_fraction = 0.25;           //!< smoothstep: each ramp's share of T
   std::optional<std::string> formula{};  //!< expression: p(t) as a formula of t and T
 

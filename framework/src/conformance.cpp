@@ -32,6 +32,9 @@ JointSpec joint(const std::string& name, double lower, double upper) {
   j.lower = lower;
   j.upper = upper;
   j.velocity_limit = std::make_shared<FixedLaw>();
+  ShapeSpec capsule;  // along the link
+  capsule.radius = 0.02;
+  j.collision.push_back(capsule);
   return j;
 }
 
@@ -117,7 +120,12 @@ void check_scheme_plugin(const Entry& e, const std::vector<RobotModel>& robots, 
     const std::string on = " on " + robot.name();
     std::unique_ptr<P> p;
     try {
-      p = e.make(e.defaults, robot);
+      try {
+        p = e.make(e.defaults, robot);
+      } catch (const std::exception&) {
+        if (!e.example.has_value()) throw;
+        p = e.make(e.example, robot);  // a plugin with required keys: its registered example
+      }
     } catch (const std::exception& ex) {
       // A plugin may not apply to every robot (e.g. it needs a spatial arm); it must build on at least one.
       rec("defaults", true, "not applicable" + on + ": " + ex.what());

@@ -35,6 +35,7 @@ KinematicsData::KinematicsData(const RobotModel& model)
       ee_pose(Eigen::Isometry3d::Identity()),
       axes(Eigen::Matrix3Xd::Zero(3, model.dof())),
       origins(Eigen::Matrix3Xd::Zero(3, model.dof())),
+      link_frames(static_cast<std::size_t>(model.dof()), Eigen::Isometry3d::Identity()),
       J(Eigen::MatrixXd::Zero(model.task_dim(), model.dof())),
       dJ(Eigen::MatrixXd::Zero(model.task_dim(), static_cast<Eigen::Index>(model.dof()) * model.dof())),
       grad_w(Eigen::VectorXd::Zero(model.dof())),
@@ -115,6 +116,7 @@ void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::V
     } else {
       T.translate(Eigen::Vector3d(0.0, 0.0, theta(j)));
     }
+    data.link_frames[static_cast<std::size_t>(j)] = T;
     T = T * model.after(j);
   }
   T = T * model.end_effector();

@@ -75,7 +75,12 @@ std::string diagnose_rows(const QpProblem& qp, double tolerance, bool* infeasibl
   for (Eigen::Index r = 0; r < in.size(); ++r) {
     if (in(r) > 10.0 * tolerance) {
       s << " inequality row " << r + 1 << " (from '" << source_name(qp, qp.in_source[static_cast<std::size_t>(r)])
-        << "') is exceeded by " << in(r) << " at best;";
+        << "'";
+      if (qp.in_row_description) {
+        const std::string what = qp.in_row_description(static_cast<int>(r));
+        if (!what.empty()) s << ": " << what;
+      }
+      s << ") is exceeded by " << in(r) << " at best;";
     }
   }
   s << " joints held at a bound there:";

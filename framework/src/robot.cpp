@@ -93,6 +93,33 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
       after_.push_back(revolute ? trans(0.0, 0.0, jt.d) : Isometry3d::Identity());
     }
   }
+  for (int j = 0; j < n; ++j) {
+    // The link frame of joint j is the joint's frame after its motion; the next joint's origin (or the end
+    // effector's) is after(j) * before(j + 1) in it.
+    const Isometry3d next = after_[static_cast<std::size_t>(j)] *
+                            (j + 1 < n ? before_[static_cast<std::size_t>(j + 1)] : spec_.end_effector);
+    for (std::size_t k = 0; k < joint(j).collision.size(); ++k) {
+      ShapeSpec shape = joint(j).collision[k];
+      const std::string who = "joint " + std::to_string(j + 1) + " ('" + joint(j).name + "') collision shape " +
+                              std::to_string(k + 1);
+      REDRES_REQUIRE(!shape.velocity, "RobotModel", who + " has no velocity (only obstacles move)");
+      if (shape.shape == ShapeSpec::Kind::kCapsule && !shape.from && !shape.length) {
+        const Vector3d end = next.translation();
+        shape.from = std::array<double, 3>{0.0, 0.0, 0.0};
+        shape.to = std::array<double, 3>{end.x(), end.y(), end.z()};
+      }
+      try {
+        check_config(shape, ShapeSpec::schema());
+      } catch (const FieldError& e) {
+        throw std::invalid_argument("RobotModel: " + who + ": " + e.what());
+      }
+      link_shapes_.push_back({j, shape, shape.pose()});
+    }
+  }
+  for (const auto& [a, b] : spec_.collision_exclude) {
+    REDRES_REQUIRE(a >= 0 && a < n && b >= 0 && b < n && a != b, "RobotModel",
+                   "collision_exclude pairs name two different joints of the chain");
+  }
   if (spec_.kind == ChainKind::kPlanar) {
     task_names_ = {"x", "y"};
     if (spec_.task == TaskRows::kPose) task_names_.emplace_back("phi");
@@ -113,6 +140,14 @@ void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta,
     lower(j) = b.lower;
     upper(j) = b.upper;
   }
+}
+
+bool RobotModel::self_collision_pair(int i, int j) const {
+  if (i == j || std::abs(i - j) == 1) return false;
+  for (const auto& [a, b] : spec_.collision_exclude) {
+    if ((a == i && b == j) || (a == j && b == i)) return false;
+  }
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -148,6 +183,16 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, std::set<std::str
   if (!(jt.lower < jt.upper)) {
     r.fail("limits",
            "expected [lower, upper] with lower < upper, got lower " + num(jt.lower) + " >= upper " + num(jt.upper));
+  }
+
+  if (r.has("collision")) {
+    config_io::read(r, "collision", jt.collision);
+    for (std::size_t k = 0; k < jt.collision.size(); ++k) {
+      if (jt.collision[k].velocity) {
+        throw ConfigError(r.location("collision"), "joint '" + jt.name + "': key 'collision': shape " +
+                                                       std::to_string(k + 1) + " has a velocity; only obstacles move");
+      }
+    }
   }
 
   const TableReader law_table = r.table("velocity_limit");
@@ -210,6 +255,27 @@ RobotModel load_robot(const TableReader& r) {
         r.fail("home", "expected joint '" + jt.name + "' within its limits [" + num(jt.lower) + ", " + num(jt.upper) +
                            "], got " + num(h[static_cast<std::size_t>(j)]));
       }
+    }
+  }
+  if (r.has("collision_exclude")) {
+    const toml::array* pairs = r.raw().get("collision_exclude")->as_array();
+    if (pairs == nullptr) r.fail("collision_exclude", "expected an array of joint-name pairs, e.g. [[\"j1\", \"j3\"]]");
+    for (const toml::node& p : *pairs) {
+      const toml::array* pair = p.as_array();
+      const auto index = [&](std::size_t k) {
+        const toml::node* el = pair != nullptr && pair->size() == 2 ? pair->get(k) : nullptr;
+        const auto* name = el != nullptr ? el->as_string() : nullptr;
+        if (name != nullptr) {
+          for (std::size_t j = 0; j < spec.joints.size(); ++j) {
+            if (spec.joints[j].name == name->get()) return static_cast<int>(j);
+          }
+        }
+        throw ConfigError(location_of(r.file(), p), "key 'collision_exclude': expected pairs of two joint names of "
+                                                    "this robot, e.g. [\"j1\", \"j3\"]");
+      };
+      const int a = index(0), b = index(1);
+      if (a == b) throw ConfigError(location_of(r.file(), p), "key 'collision_exclude': a pair names one joint twice");
+      spec.collision_exclude.emplace_back(a, b);
     }
   }
   r.finish();

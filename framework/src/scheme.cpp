@@ -65,6 +65,14 @@ void Scheme::setup(QpProblem& qp) const {
   for (const auto& o : objectives_) qp.source_names.push_back(o->name());
   for (const auto& c : constraints_) qp.source_names.push_back(c->name());
   const int base = static_cast<int>(objectives_.size());
+  qp.in_row_description = [this](int row) -> std::string {
+    for (std::size_t k = 0; k < constraints_.size(); ++k) {
+      if (row >= in_offset_[k] && row < in_offset_[k] + in_rows_[k]) {
+        return constraints_[k]->describe_inequality_row(row - in_offset_[k]);
+      }
+    }
+    return {};
+  };
   for (std::size_t k = 0; k < constraints_.size(); ++k) {
     for (int r = 0; r < eq_rows_[k]; ++r)
       qp.eq_source[static_cast<std::size_t>(eq_offset_[k] + r)] = base + static_cast<int>(k);

@@ -47,7 +47,23 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   const int position_rows = robot.kind() == ChainKind::kPlanar ? 2 : 3;
   const int steps = s.steps();
   RunResult run;
-  run.trajectory = Trajectory(trajectory_columns(robot), static_cast<std::size_t>(steps) + 1);
+  // The plugins' own columns (e.g. collision distances) follow the standard ones.
+  std::vector<std::string> columns = trajectory_columns(robot);
+  std::vector<std::pair<const Plugin*, std::size_t>> recorders;  // plugin, first column
+  const auto add_recorder = [&](const Plugin& p) {
+    if (!p.active()) return;
+    const std::vector<std::string> own = p.recorded_columns();
+    if (own.empty()) return;
+    recorders.emplace_back(&p, columns.size());
+    for (const auto& c : own) {
+      // Two plugins may record the same quantity (two obstacle sets): the second gets its name as a prefix.
+      const bool taken = std::find(columns.begin(), columns.end(), c) != columns.end();
+      columns.push_back(taken ? p.name() + "." + c : c);
+    }
+  };
+  for (const auto& o : s.scheme->objectives()) add_recorder(*o);
+  for (const auto& c : s.scheme->constraints()) add_recorder(*c);
+  run.trajectory = Trajectory(std::move(columns), static_cast<std::size_t>(steps) + 1);
   run.engines.reserve(4);
 
   Controller ctrl(robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
@@ -89,6 +105,7 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
     for (int j = 0; j < n; ++j) row[c++] = vlo(j);
     for (int j = 0; j < n; ++j) row[c++] = vhi(j);
     row[c++] = static_cast<double>(static_cast<int>(out.info.status));
+    for (const auto& [plugin, first] : recorders) plugin->record(row + first);
     note(out, t);
     if (progress && (k % report_every == 0 || k == steps)) progress(static_cast<double>(k) / steps, t);
     if (k == steps) break;

@@ -21,4 +21,12 @@ std::size_t Trajectory::column(const std::string& name) const {
   throw std::out_of_range("trajectory: no column '" + name + "'");
 }
 
+std::size_t own_column(const Trajectory& run, const std::string& plugin, const std::string& column) {
+  const std::string prefixed = plugin + "." + column;
+  for (std::size_t c = 0; c < run.columns().size(); ++c) {
+    if (run.columns()[c] == prefixed) return c;
+  }
+  return run.column(column);
+}
+
 }  // namespace redres

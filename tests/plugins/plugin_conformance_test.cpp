@@ -30,9 +30,16 @@ std::vector<std::unique_ptr<RobotModel>> robots() {
   return out;
 }
 
-// A plugin from its defaults: a table holding only `type`.
+// A plugin from its defaults: a table holding only `type`, plus the keys of a plugin that has required ones (a new
+// plugin with required keys must add them here).
 toml::table defaults(const std::string& type) {
-  toml::table t;
+  static const std::map<std::string, std::string> required = {
+      {"obstacle_avoidance",
+       "obstacles = [{ shape = \"sphere\", radius = 0.1, xyz = [0.6, 0.6, 0.0] }]\ninfluence_distance = 2.0\n"},
+  };
+  const auto it = required.find(type);
+  const std::string extra = it == required.end() ? "" : it->second;
+  toml::table t = toml::parse(extra);
   t.insert("type", type);
   return t;
 }

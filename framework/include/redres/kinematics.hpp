@@ -13,6 +13,8 @@
 /// - mu = prod_k s_k (singular values of J), d mu/d theta_i = sum_k (prod_{j != k} s_j) u_k' dJ/dtheta_i v_k,
 ///   which is finite at every configuration and exact wherever the singular values are distinct.
 
+#include <vector>
+
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
@@ -44,6 +46,7 @@ class KinematicsData {
   Eigen::Isometry3d ee_pose;  //!< end-effector pose in the base frame
   Eigen::Matrix3Xd axes;      //!< z_j, joint axes in the base frame (3 x n)
   Eigen::Matrix3Xd origins;   //!< p_j, points on the joint axes (3 x n), m
+  std::vector<Eigen::Isometry3d> link_frames;  //!< frame of each link: joint j's frame after its motion (n)
   Eigen::MatrixXd J;          //!< task Jacobian (m x n)
   Eigen::MatrixXd dJ;         //!< [dJ/dtheta_1, ..., dJ/dtheta_n] (m x n*n); see dJ_block()
   double w = 0.0;             //!< det(J J')

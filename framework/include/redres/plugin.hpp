@@ -61,6 +61,10 @@ class Plugin {
   [[nodiscard]] virtual KinematicsLevel kinematics_level() const { return KinematicsLevel::kPosition; }
   /// The full configuration (type, common keys and the plugin's own), readable by the same registry.
   [[nodiscard]] toml::table config() const;
+  /// Columns this plugin adds to trajectory.csv (default: none), e.g. "min_obstacle_distance".
+  [[nodiscard]] virtual std::vector<std::string> recorded_columns() const { return {}; }
+  /// Writes this step's values of recorded_columns() (called after each contribution; allocation-free).
+  virtual void record(double* values) const { (void)values; }
   /// Figures this plugin adds to the run summary, computed from the recorded run (default: none).
   virtual void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const {
     (void)robot;
@@ -122,6 +126,12 @@ class Constraint : public Plugin {
   [[nodiscard]] virtual int inequality_rows(const RobotModel& robot) const {
     (void)robot;
     return 0;
+  }
+  /// What its inequality row `row` (0-based, its own numbering) stood for at the last contribution, for the
+  /// diagnosis of a failed solve (e.g. the collision pair and its distance). Default: nothing.
+  [[nodiscard]] virtual std::string describe_inequality_row(int row) const {
+    (void)row;
+    return {};
   }
 
  protected:

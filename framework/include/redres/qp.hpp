@@ -10,6 +10,7 @@
 /// Every buffer is sized once (QpProblem::resize); building and solving allocate nothing afterwards. Each bound
 /// remembers which source (plugin) set it, so a conflict lo_i > hi_i names the plugins that caused it.
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -39,6 +40,9 @@ struct QpProblem {
   std::vector<int> eq_source;               //!< source of each equality row
   std::vector<int> in_source;               //!< source of each inequality row
   Eigen::VectorXd scratch;                  //!< n-vector a plugin may use as workspace while it contributes
+  /// What inequality row r stands for at the last build (e.g. "link 'j3' shape 1 vs obstacle 2 at 0.012 m"), for
+  /// diagnoses; may be empty. Called only when a solve fails.
+  std::function<std::string(int)> in_row_description;
 
   /// Sizes every buffer: n variables, m_e equality rows, m_i inequality rows.
   void resize(int n, int m_e, int m_i);

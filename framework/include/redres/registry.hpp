@@ -12,6 +12,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <typeinfo>
@@ -64,7 +65,8 @@ class Registry : public RegistryBase {
     std::vector<KeyInfo> keys;                                 //!< keys with defaults, units, rules, presence
     std::vector<std::pair<std::string, std::string>> groups;   //!< group -> what to give
     const std::type_info* config_type = nullptr;               //!< the Config type
-    std::any defaults;                                         //!< a default Config
+    std::any defaults;  //!< a default Config
+    std::any example;   //!< a Config for the conformance checks when the defaults cannot build (empty: none)
     std::function<std::any(const TableReader&)> read;          //!< reads and checks a Config (does not finish())
     std::function<void(const std::any&, toml::table&)> write;  //!< writes a Config's keys
     std::function<std::unique_ptr<Base>(const std::any&, Args...)> make;  //!< builds from a Config
@@ -76,7 +78,7 @@ class Registry : public RegistryBase {
   /// make(const C&, Args...) -> std::unique_ptr<Base>. A duplicate name is a std::logic_error for built-in
   /// plugins and a load error of the library being loaded. Returns whether it was added (to initialise a static).
   template <class C, class Make>
-  bool add(std::string type, std::string summary, Make make) {
+  bool add(std::string type, std::string summary, Make make, std::optional<C> example = std::nullopt) {
     Entry e;
     e.type = std::move(type);
     e.summary = std::move(summary);
@@ -86,6 +88,7 @@ class Registry : public RegistryBase {
     e.groups = C::schema().groups;
     e.config_type = &typeid(C);
     e.defaults = C{};
+    if (example) e.example = *example;
     e.read = [](const TableReader& r) -> std::any {
       C c{};
       read_config(r, C::schema(), c);
@@ -110,12 +113,14 @@ class Registry : public RegistryBase {
     return true;
   }
 
-  /// Registers plugin class P: P::kType, P::Config, and a constructor P(const P::Config&, Args...).
+  /// Registers plugin class P: P::kType, P::Config, and a constructor P(const P::Config&, Args...). `example` is a
+  /// Config the conformance checks use when the defaults cannot build (a plugin with required keys).
   template <class P>
-  bool add_plugin(std::string summary) {
-    return add<typename P::Config>(P::kType, std::move(summary), [](const typename P::Config& c, Args... args) {
-      return std::unique_ptr<Base>(std::make_unique<P>(c, args...));
-    });
+  bool add_plugin(std::string summary, std::optional<typename P::Config> example = std::nullopt) {
+    return add<typename P::Config>(
+        P::kType, std::move(summary),
+        [](const typename P::Config& c, Args... args) { return std::unique_ptr<Base>(std::make_unique<P>(c, args...)); },
+        std::move(example));
   }
 
   /// The entry for `type`, or nullptr.

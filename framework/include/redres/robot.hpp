@@ -23,11 +23,13 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "redres/collision.hpp"
 #include "redres/toml_reader.hpp"
 #include "redres/velocity_limit.hpp"
 
@@ -54,6 +56,10 @@ struct JointSpec {
   double lower = 0.0;                                      //!< position limit theta^- (rad or m)
   double upper = 0.0;                                      //!< position limit theta^+ (rad or m)
   std::shared_ptr<const VelocityLimitLaw> velocity_limit;  //!< theta_dot^-(theta), theta_dot^+(theta)
+  /// Collision shapes of the link that joint j moves, in the link frame (the joint's frame after its motion, before
+  /// the fixed transform to the next joint). A capsule with neither `length` nor `from`/`to` runs along the link:
+  /// from the joint's origin to the next joint's origin (the end effector's, for the last joint).
+  std::vector<ShapeSpec> collision;
 };
 
 /// Everything needed to build a RobotModel; filled by the TOML loader or by code (tests, generators).
@@ -66,6 +72,8 @@ struct RobotSpec {
   Eigen::Isometry3d end_effector = Eigen::Isometry3d::Identity();  //!< E, in the last joint's frame
   Eigen::VectorXd home;                                            //!< home configuration (size n; empty = zeros)
   std::string source;                                              //!< file the spec came from (may be empty)
+  /// Link pairs (joint indices, 0-based) never checked against each other, besides adjacent links, which never are.
+  std::vector<std::pair<int, int>> collision_exclude;
 };
 
 /// An immutable robot model. Construction validates the spec and throws std::invalid_argument on misuse.
@@ -107,6 +115,19 @@ class RobotModel {
   /// The spec the model was built from.
   [[nodiscard]] const RobotSpec& spec() const noexcept { return spec_; }
 
+  /// One collision shape of a link: the link (joint index) and the shape, with its pose in the link frame resolved
+  /// (a capsule along the link gets its end points here).
+  struct LinkShape {
+    int link = 0;            //!< joint index j (0-based)
+    ShapeSpec spec;          //!< the shape as FCL will see it (from/to filled in for capsules along the link)
+    Eigen::Isometry3d pose;  //!< pose of the shape in the link frame
+  };
+  /// Every collision shape of every link, in joint order.
+  [[nodiscard]] const std::vector<LinkShape>& link_shapes() const noexcept { return link_shapes_; }
+  /// Whether links i and j are checked against each other for self-collision (not equal, not adjacent, not
+  /// excluded by the robot file).
+  [[nodiscard]] bool self_collision_pair(int i, int j) const;
+
   /// Velocity limits of every joint at theta; writes into lower/upper (size n). Allocation-free.
   void velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
                        Eigen::Ref<Eigen::VectorXd> upper) const;
@@ -117,6 +138,7 @@ class RobotModel {
   std::vector<std::string> task_names_;
   Eigen::VectorXd lower_, upper_;
   std::vector<Eigen::Isometry3d> before_, after_;
+  std::vector<LinkShape> link_shapes_;
 };
 
 /// Loads a robot TOML file. Every problem is a ConfigError starting "file:line:col:".

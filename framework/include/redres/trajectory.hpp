@@ -41,4 +41,7 @@ class Trajectory {
   std::vector<double> values_;
 };
 
+/// The column a plugin recorded as `column`: "<plugin>.<column>" when another plugin took the plain name first.
+[[nodiscard]] std::size_t own_column(const Trajectory& run, const std::string& plugin, const std::string& column);
+
 }  // namespace redres

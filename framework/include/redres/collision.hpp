@@ -1,0 +1,92 @@
+#pragma once
+/// @file
+/// Collision geometry and distances. Shapes are described without FCL (ShapeSpec, with a schema so that robot and
+/// scenario files read them strictly); distances between two shapes at given world poses come from FCL (Debian's
+/// libfcl 0.7) behind DistanceQuery, whose one .cpp is the only place that includes FCL.
+///
+/// FCL 0.7 facts the implementation respects (measured on Debian's package; docs/collision.md):
+/// - an overlapping pair queried without signed distance returns -1 with zeroed points, so a query is unsigned
+///   first and repeated with signed distance (GJK/EPA, libccd solver; never the independent solver, which aborts
+///   on penetrating capsules) only when the unsigned result is <= 0; for two overlapping spheres or capsules the
+///   penetration comes from their axes instead (exact, and FCL's GJK signed distance was seen to loop forever on
+///   penetrating capsules);
+/// - the result is cleared before every query, and `min_distance` is read (not the return value);
+/// - witness points are in the world frame, and p_b - p_a flips when the shapes overlap;
+/// - Halfspace and Plane distance queries crash, so they are not offered (a wall is a thin box);
+/// - FCL throws std::logic_error from EPA in rare near-touching box configurations: caught, reported as a status.
+
+#include <array>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "redres/config.hpp"
+
+namespace redres {
+
+/// A primitive shape with a pose in its owner's frame (a link's frame, or the world for an obstacle). Capsules and
+/// cylinders have their axis along the local z axis, centred on the pose's origin; a capsule may instead be given
+/// by the two end points of its axis (`from`, `to`).
+struct ShapeSpec {
+  enum class Kind { kSphere, kCapsule, kCylinder, kBox };
+  Kind shape = Kind::kCapsule;                                   //!< which primitive
+  std::optional<double> radius{};                                //!< sphere, capsule, cylinder (m)
+  std::optional<double> length{};                                //!< capsule, cylinder: axis length (m)
+  std::optional<std::array<double, 3>> size{};                   //!< box: full side lengths (m)
+  std::array<double, 3> xyz = {0.0, 0.0, 0.0};                   //!< position in the owner's frame (m)
+  std::array<double, 3> rpy = {0.0, 0.0, 0.0};                   //!< roll, pitch, yaw in the owner's frame (rad)
+  std::optional<std::array<double, 3>> from{};                   //!< capsule: one end of the axis (m)
+  std::optional<std::array<double, 3>> to{};                     //!< capsule: the other end of the axis (m)
+  std::optional<std::array<double, 3>> velocity{};               //!< obstacles: constant linear velocity (m/s)
+
+  static const Schema<ShapeSpec>& schema();
+
+  /// The pose of the shape in its owner's frame (from xyz/rpy, or from `from`/`to` for a capsule).
+  [[nodiscard]] Eigen::Isometry3d pose() const;
+  /// The capsule's axis length (from `length`, or |to - from|).
+  [[nodiscard]] double axis_length() const;
+  /// One line, e.g. "capsule(r = 0.05 m, l = 0.3 m)".
+  [[nodiscard]] std::string describe() const;
+};
+
+inline auto enum_names(ShapeSpec::Kind) {
+  using K = ShapeSpec::Kind;
+  return std::array{std::pair{K::kSphere, std::string_view("sphere")}, std::pair{K::kCapsule, std::string_view("capsule")},
+                    std::pair{K::kCylinder, std::string_view("cylinder")}, std::pair{K::kBox, std::string_view("box")}};
+}
+
+/// The outcome of one distance query.
+struct ShapeDistance {
+  bool ok = false;          //!< false when FCL failed (see error); then the other fields are meaningless
+  double distance = 0.0;    //!< signed distance (m): > 0 apart, < 0 overlapping (minus the penetration depth)
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero();  //!< witness point on shape a (world)
+  Eigen::Vector3d point_b = Eigen::Vector3d::Zero();  //!< witness point on shape b (world)
+  const char* error = "";  //!< FCL's message when !ok (a static string or the exception's what(), copied nowhere)
+};
+
+/// Distances between a fixed set of shapes. Not thread-safe (FCL's objects are not): one per controller.
+class DistanceQuery {
+ public:
+  /// Builds one FCL geometry per shape (sizes checked: std::invalid_argument naming the shape).
+  explicit DistanceQuery(const std::vector<ShapeSpec>& shapes);
+  ~DistanceQuery();
+  DistanceQuery(const DistanceQuery&) = delete;
+  DistanceQuery& operator=(const DistanceQuery&) = delete;
+
+  /// Number of shapes.
+  [[nodiscard]] int size() const noexcept;
+  /// Signed distance between shape a at world pose Ta and shape b at world pose Tb (each pose is the shape's own,
+  /// i.e. owner pose * ShapeSpec::pose()). Allocation-free when the shapes are apart and analytic (sphere and
+  /// capsule pairs); overlapping pairs run FCL's GJK/EPA, which allocates.
+  [[nodiscard]] ShapeDistance distance(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace redres

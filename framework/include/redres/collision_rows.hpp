@@ -1,0 +1,50 @@
+#pragma once
+/// @file
+/// The pieces of a collision-avoidance row, shared by `obstacle_avoidance`, `self_collision` and plugins of one's
+/// own: the Jacobian of a point attached to a link, the normal between two witness points (with FCL's sign flip on
+/// penetration and the planar projection), and the velocity damper.
+///
+/// The row (Faverjon and Tournassoud's velocity damper): for a pair at signed distance d <= d_i,
+///   n' (J_a - J_b) x >= -xi (d - d_s) / (d_i - d_s) + n' v_b,
+/// where n is the unit normal from body b's witness point to body a's (a is a link; b an obstacle with velocity
+/// v_b and J_b = 0, or another link with v_b = 0), so that n' (J_a - J_b) x is the rate of change of d. For
+/// d_s < d <= d_i the distance may shrink at most at xi (d - d_s) / (d_i - d_s) (m/s): xi at the influence
+/// distance, zero at the safety distance. For d < d_s the bound turns positive: the pair must separate at
+/// xi (d_s - d) / (d_i - d_s), a speed bounded by the penetration; the arm is pushed out, not held.
+
+#include <Eigen/Core>
+
+#include "redres/collision.hpp"
+#include "redres/kinematics.hpp"
+
+namespace redres {
+
+/// The damper's parameters.
+struct Damper {
+  double influence_distance = 0.1;  //!< d_i (m): rows are written for pairs closer than this
+  double safety_distance = 0.02;    //!< d_s (m): the distance the damper holds
+  double gain = 0.1;                //!< xi (m/s): the largest approach speed, at d_i
+
+  /// The lower bound on d_dot at distance d: -xi (d - d_s) / (d_i - d_s).
+  [[nodiscard]] double min_rate(double d) const { return -gain * (d - safety_distance) / (influence_distance - safety_distance); }
+};
+
+/// Writes the row of the damper as `A_row x <= b` for a pair at distance d with normal n (from b to a), the rate
+/// Jacobian D = J_a - J_b (3 x n) and b's velocity v_b: A_row = -n' D, b = -min_rate(d) - n' v_b. A pair farther
+/// than d_i gets a slack row (A_row = 0, b = 1).
+void damper_row(const Damper& damper, double d, const Eigen::Vector3d& n, const Eigen::Matrix3Xd& D,
+                const Eigen::Vector3d& v_b, Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> A_row, double& b);
+
+/// Writes the 3 x n Jacobian of the world point `p` moving with link `link` (columns of later joints are zero):
+/// revolute joint k: z_k x (p - o_k); prismatic: z_k. `kin` must hold the configuration's joint axes and origins.
+void point_jacobian(const RobotModel& robot, const KinematicsData& kin, int link, const Eigen::Vector3d& p,
+                    Eigen::Ref<Eigen::Matrix3Xd> J);
+
+/// The unit normal from witness point `on_b` to `on_a` for signed distance d (FCL's points swap sides when the
+/// shapes overlap, so the direction is sign(d) (on_a - on_b)). For a planar robot the normal is projected into the
+/// plane z = 0. When it is undefined (touching points, or a projection that vanishes, as for two crossing planar
+/// capsules) `fallback` (from b's centre to a's, say) is used, projected the same way. Returns false when that
+/// too is degenerate; then `n` is zero.
+bool witness_normal(const ShapeDistance& d, bool planar, const Eigen::Vector3d& fallback, Eigen::Vector3d& n);
+
+}  // namespace redres

@@ -1,0 +1,134 @@
+#include "redres/constraints/self_collision.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "redres/trajectory.hpp"
+
+namespace redres {
+
+const Schema<SelfCollisionConfig>& SelfCollisionConfig::schema() {
+  using C = SelfCollisionConfig;
+  static const Schema<C> s{
+      {field("influence_distance", &C::influence_distance, "m", "d_i: rows for pairs closer than this"),
+       field("safety_distance", &C::safety_distance, "m", "d_s: the distance the damper holds"),
+       field("xi", &C::xi, "m/s", "damper gain: the largest approach speed, at d_i", greater(0.0))},
+      [](const C& c) {
+        if (!(c.safety_distance >= 0.0)) throw FieldError("safety_distance", "expected a safety distance >= 0 m");
+        if (!(c.influence_distance > c.safety_distance)) {
+          throw FieldError("influence_distance", "expected an influence distance > the safety distance (" +
+                                                     std::to_string(c.safety_distance) + " m)");
+        }
+      },
+      {}};
+  return s;
+}
+
+SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
+    : Configured(kType, config),
+      robot_(&robot),
+      damper_{config.influence_distance, config.safety_distance, config.xi} {
+  const auto& links = robot.link_shapes();
+  std::vector<ShapeSpec> shapes;
+  for (const auto& l : links) shapes.push_back(l.spec);
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    for (std::size_t j = i + 1; j < links.size(); ++j) {
+      if (robot.self_collision_pair(links[i].link, links[j].link)) {
+        pairs_.emplace_back(static_cast<int>(i), static_cast<int>(j));
+      }
+    }
+  }
+  query_ = std::make_unique<DistanceQuery>(shapes);
+  ja_.setZero(3, robot.dof());
+  jb_.setZero(3, robot.dof());
+  distance_.assign(pairs_.size(), std::numeric_limits<double>::infinity());
+}
+
+SelfCollision::~SelfCollision() = default;
+
+int SelfCollision::inequality_rows(const RobotModel& /*robot*/) const { return static_cast<int>(pairs_.size()); }
+
+void SelfCollision::add_to(const Context& ctx, QpBuilder& builder) const {
+  const KinematicsData& kin = *ctx.kinematics;
+  const bool planar = robot_->kind() == ChainKind::kPlanar;
+  auto A = builder.inequality_matrix();
+  auto b = builder.inequality_rhs();
+  const auto& links = robot_->link_shapes();
+  for (std::size_t row = 0; row < pairs_.size(); ++row) {
+    const auto& sa = links[static_cast<std::size_t>(pairs_[row].first)];
+    const auto& sb = links[static_cast<std::size_t>(pairs_[row].second)];
+    const Eigen::Isometry3d Ta = kin.link_frames[static_cast<std::size_t>(sa.link)] * sa.pose;
+    const Eigen::Isometry3d Tb = kin.link_frames[static_cast<std::size_t>(sb.link)] * sb.pose;
+    const ShapeDistance d = query_->distance(pairs_[row].first, Ta, pairs_[row].second, Tb);
+    const auto r = static_cast<Eigen::Index>(row);
+    if (!d.ok) {
+      ++failures_;
+      distance_[row] = std::numeric_limits<double>::quiet_NaN();
+      A.row(r).setZero();
+      b(r) = 1.0;
+      continue;
+    }
+    distance_[row] = d.distance;
+    Eigen::Vector3d n;
+    if (d.distance > damper_.influence_distance ||
+        !witness_normal(d, planar, Ta.translation() - Tb.translation(), n)) {
+      A.row(r).setZero();
+      b(r) = 1.0;
+      continue;
+    }
+    point_jacobian(*robot_, kin, sa.link, d.point_a, ja_);
+    point_jacobian(*robot_, kin, sb.link, d.point_b, jb_);
+    ja_ -= jb_;
+    damper_row(damper_, d.distance, n, ja_, Eigen::Vector3d::Zero(), A.row(r), b(r));
+  }
+}
+
+std::string SelfCollision::describe_inequality_row(int row) const {
+  if (row < 0 || row >= static_cast<int>(pairs_.size())) return {};
+  const auto& links = robot_->link_shapes();
+  const auto& sa = links[static_cast<std::size_t>(pairs_[static_cast<std::size_t>(row)].first)];
+  const auto& sb = links[static_cast<std::size_t>(pairs_[static_cast<std::size_t>(row)].second)];
+  std::ostringstream s;
+  s.precision(4);
+  s << "link '" << robot_->joint(sa.link).name << "' " << sa.spec.describe() << " vs link '"
+    << robot_->joint(sb.link).name << "' " << sb.spec.describe() << " at distance "
+    << distance_[static_cast<std::size_t>(row)] << " m";
+  return s.str();
+}
+
+std::vector<std::string> SelfCollision::recorded_columns() const { return {"min_self_distance", "self_rows_active"}; }
+
+void SelfCollision::record(double* values) const {
+  double low = std::numeric_limits<double>::infinity();
+  int active = 0;
+  for (double d : distance_) {
+    if (std::isnan(d)) continue;
+    low = std::min(low, d);
+    active += d <= damper_.influence_distance ? 1 : 0;
+  }
+  values[0] = low;
+  values[1] = active;
+}
+
+void SelfCollision::summarise(const RobotModel& /*robot*/, const Trajectory& run, std::vector<Metric>& out) const {
+  const std::size_t cd = own_column(run, name(), "min_self_distance");
+  const std::size_t ca = own_column(run, name(), "self_rows_active");
+  double low = std::numeric_limits<double>::infinity();
+  double steps = 0.0;
+  for (std::size_t r = 0; r < run.size(); ++r) {
+    low = std::min(low, run(r, cd));
+    steps += run(r, ca) > 0.0 ? 1.0 : 0.0;
+  }
+  out.push_back({"min_self_distance", {low}, "m"});
+  out.push_back({"steps_with_active_rows", {steps}, ""});
+  out.push_back({"fcl_failures", {static_cast<double>(failures_)}, ""});
+}
+
+namespace {
+const bool kRegistered = constraint_registry().add_plugin<SelfCollision>(
+    "n' (J_a - J_b) x >= -xi (d - d_s)/(d_i - d_s): links kept away from each other (FCL distances)");
+}  // namespace
+
+}  // namespace redres

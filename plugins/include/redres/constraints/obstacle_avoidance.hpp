@@ -1,0 +1,60 @@
+#pragma once
+/// @file
+/// `obstacle_avoidance`: keeps the robot's collision shapes (the `collision` shapes of its joints in the robot
+/// file) away from obstacles, one inequality row per (link shape, obstacle) pair, the velocity damper of
+/// collision_rows.hpp:
+///   n' J_p x >= -xi (d - d_s) / (d_i - d_s) + n' v_obstacle     for d <= d_i (slack otherwise),
+/// with d the signed distance (FCL), n the unit normal from the obstacle's witness point to the link's, and J_p
+/// the translational Jacobian of the link's witness point. Below d_s the bound pushes the link out at a speed
+/// proportional to the penetration. Obstacles are spheres, capsules, cylinders or boxes with a pose in the world
+/// (base) frame, optionally moving at a constant velocity; for a planar robot they lie in the plane z = 0.
+/// Records per step `min_obstacle_distance` (m) and `obstacle_rows_active`; reports `min_obstacle_distance` and
+/// `steps_with_active_rows` to the run summary.
+
+#include <vector>
+
+#include "redres/collision.hpp"
+#include "redres/collision_rows.hpp"
+#include "redres/plugin.hpp"
+
+namespace redres {
+
+/// The configuration of `obstacle_avoidance`.
+struct ObstacleAvoidanceConfig {
+  std::vector<ShapeSpec> obstacles{};  //!< required: the obstacles, in the world frame
+  double influence_distance = 0.10;    //!< d_i (m)
+  double safety_distance = 0.02;       //!< d_s (m)
+  double xi = 0.1;                     //!< damper gain (m/s): the largest approach speed, at d_i
+
+  static const Schema<ObstacleAvoidanceConfig>& schema();
+};
+
+/// The obstacle-avoidance constraint.
+class ObstacleAvoidance final : public Configured<Constraint, ObstacleAvoidanceConfig> {
+ public:
+  static constexpr const char* kType = "obstacle_avoidance";
+  ObstacleAvoidance(const Config& config, const RobotModel& robot);
+  ~ObstacleAvoidance() override;
+
+  [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
+  [[nodiscard]] std::string describe_inequality_row(int row) const override;
+  [[nodiscard]] std::vector<std::string> recorded_columns() const override;
+  void record(double* values) const override;
+  void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const override;
+
+  /// The obstacle's world pose at time t (its pose moved by velocity * t).
+  [[nodiscard]] Eigen::Isometry3d obstacle_pose(int k, double t) const;
+
+ private:
+  void add_to(const Context& ctx, QpBuilder& builder) const override;
+
+  const RobotModel* robot_;
+  std::unique_ptr<DistanceQuery> query_;  // link shapes first, then the obstacles
+  int links_ = 0, obstacles_ = 0;
+  Damper damper_;
+  mutable Eigen::Matrix3Xd jacobian_;
+  mutable std::vector<double> distance_;  // per row, at the last contribution
+  mutable int failures_ = 0;              // FCL failures (their rows were left slack)
+};
+
+}  // namespace redres

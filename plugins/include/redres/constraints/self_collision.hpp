@@ -1,0 +1,56 @@
+#pragma once
+/// @file
+/// `self_collision`: keeps the robot's links away from each other: one inequality row per pair of collision
+/// shapes on links that may touch (not the same link, not adjacent links, not a pair the robot file's
+/// `collision_exclude` lists), the velocity damper of collision_rows.hpp with both bodies moving:
+///   n' (J_a - J_b) x >= -xi (d - d_s) / (d_i - d_s)     for d <= d_i (slack otherwise),
+/// with n the unit normal from link b's witness point to link a's. Below d_s the bound pushes the links apart.
+/// Records per step `min_self_distance` (m) and `self_rows_active`; reports `min_self_distance` and
+/// `steps_with_active_rows` to the run summary.
+
+#include <utility>
+#include <vector>
+
+#include "redres/collision.hpp"
+#include "redres/collision_rows.hpp"
+#include "redres/plugin.hpp"
+
+namespace redres {
+
+/// The configuration of `self_collision`.
+struct SelfCollisionConfig {
+  double influence_distance = 0.05;  //!< d_i (m)
+  double safety_distance = 0.01;     //!< d_s (m)
+  double xi = 0.1;                   //!< damper gain (m/s)
+
+  static const Schema<SelfCollisionConfig>& schema();
+};
+
+/// The self-collision constraint.
+class SelfCollision final : public Configured<Constraint, SelfCollisionConfig> {
+ public:
+  static constexpr const char* kType = "self_collision";
+  SelfCollision(const Config& config, const RobotModel& robot);
+  ~SelfCollision() override;
+
+  [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
+  [[nodiscard]] std::string describe_inequality_row(int row) const override;
+  [[nodiscard]] std::vector<std::string> recorded_columns() const override;
+  void record(double* values) const override;
+  void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const override;
+  /// The checked pairs (indices into RobotModel::link_shapes()).
+  [[nodiscard]] const std::vector<std::pair<int, int>>& pairs() const noexcept { return pairs_; }
+
+ private:
+  void add_to(const Context& ctx, QpBuilder& builder) const override;
+
+  const RobotModel* robot_;
+  std::unique_ptr<DistanceQuery> query_;
+  std::vector<std::pair<int, int>> pairs_;
+  Damper damper_;
+  mutable Eigen::Matrix3Xd ja_, jb_;
+  mutable std::vector<double> distance_;
+  mutable int failures_ = 0;
+};
+
+}  // namespace redres

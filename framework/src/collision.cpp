@@ -11,6 +11,7 @@
 #include <fcl/geometry/shape/capsule.h>
 #include <fcl/geometry/shape/cylinder.h>
 #include <fcl/geometry/shape/sphere.h>
+#include <fcl/narrowphase/collision_object.h>
 #include <fcl/narrowphase/distance.h>
 #include <fcl/narrowphase/distance_request.h>
 #include <fcl/narrowphase/distance_result.h>
@@ -152,6 +153,9 @@ struct DistanceQuery::Impl {
   };
   std::vector<Round> round;
   std::vector<std::shared_ptr<fcl::CollisionGeometryd>> geometry;
+  // One CollisionObject per shape: FCL's object overload of distance() allocates nothing for analytic pairs, while
+  // its geometry-and-transform overload allocates once per call (measured: one per query).
+  std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
   fcl::DistanceRequestd unsigned_request;
   fcl::DistanceRequestd signed_request;
   mutable fcl::DistanceResultd result;
@@ -187,6 +191,7 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
         break;
     }
   }
+  for (const auto& g : impl_->geometry) impl_->objects.push_back(std::make_unique<fcl::CollisionObjectd>(g));
   // Both requests use the libccd solver: signed distance with the independent solver aborts on penetration.
   impl_->unsigned_request = fcl::DistanceRequestd(true, false, 0.0, 0.0, 1e-8, fcl::GST_LIBCCD);
   impl_->signed_request = fcl::DistanceRequestd(true, true, 0.0, 0.0, 1e-8, fcl::GST_LIBCCD);
@@ -203,13 +208,14 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
     out.error = "shape index out of range";
     return out;
   }
-  const fcl::Transform3d tfa(Ta.matrix()), tfb(Tb.matrix());
-  const fcl::CollisionGeometryd* ga = impl_->geometry[static_cast<std::size_t>(a)].get();
-  const fcl::CollisionGeometryd* gb = impl_->geometry[static_cast<std::size_t>(b)].get();
+  fcl::CollisionObjectd* oa = impl_->objects[static_cast<std::size_t>(a)].get();
+  fcl::CollisionObjectd* ob = impl_->objects[static_cast<std::size_t>(b)].get();
+  oa->setTransform(fcl::Transform3d(Ta.matrix()));
+  ob->setTransform(fcl::Transform3d(Tb.matrix()));
   fcl::DistanceResultd& r = impl_->result;
   try {
     r.clear();  // a stale negative result would be kept: FCL only lowers min_distance
-    fcl::distance(ga, tfa, gb, tfb, impl_->unsigned_request, r);
+    fcl::distance(oa, ob, impl_->unsigned_request, r);
     if (!(r.min_distance > 0.0)) {
       const Impl::Round& ra = impl_->round[static_cast<std::size_t>(a)];
       const Impl::Round& rb = impl_->round[static_cast<std::size_t>(b)];
@@ -231,7 +237,7 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
         return out;
       }
       r.clear();
-      fcl::distance(ga, tfa, gb, tfb, impl_->signed_request, r);
+      fcl::distance(oa, ob, impl_->signed_request, r);
     }
   } catch (const std::exception&) {
     out.error = "FCL failed on this pair (GJK/EPA)";

@@ -24,7 +24,8 @@ void damper_row(const Damper& damper, double d, const Eigen::Vector3d& n, const 
     b = 1.0;
     return;
   }
-  A_row.noalias() = -(n.transpose() * D);
+  // Column by column: a product expression here would go through a temporary (an allocation per row).
+  for (Eigen::Index c = 0; c < D.cols(); ++c) A_row(c) = -n.dot(D.col(c));
   b = -damper.min_rate(d) - n.dot(v_b);
 }
 

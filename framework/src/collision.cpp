@@ -62,8 +62,8 @@ const Schema<ShapeSpec>& ShapeSpec::schema() {
           throw FieldError(spec.from ? "to" : "from", "give both `from` and `to`");
         }
         if (spec.from && spec.shape != Kind::kCapsule) throw FieldError("from", "`from`/`to` describe a capsule only");
-        if (spec.from && (spec.length || spec.xyz != std::array<double, 3>{0, 0, 0} ||
-                          spec.rpy != std::array<double, 3>{0, 0, 0})) {
+        if (spec.from &&
+            (spec.length || spec.xyz != std::array<double, 3>{0, 0, 0} || spec.rpy != std::array<double, 3>{0, 0, 0})) {
           throw FieldError("from", "a capsule is given either by `from`/`to` or by `xyz`, `rpy` and `length`");
         }
         const bool axial = spec.shape == Kind::kCapsule || spec.shape == Kind::kCylinder;
@@ -81,7 +81,8 @@ Eigen::Isometry3d ShapeSpec::pose() const {
     const Eigen::Vector3d a = vec(*from), b = vec(*to);
     T.translation() = 0.5 * (a + b);
     const Eigen::Vector3d axis = b - a;
-    if (axis.norm() > 0.0) T.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix();
+    if (axis.norm() > 0.0)
+      T.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix();
     return T;
   }
   T.translation() = vec(xyz);
@@ -146,8 +147,8 @@ void closest_on_segments(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, c
 }  // namespace
 
 struct DistanceQuery::Impl {
-  struct Round {            // a sphere or capsule: a segment (local z axis) swept by a radius
-    bool round = false;     // sphere or capsule
+  struct Round {         // a sphere or capsule: a segment (local z axis) swept by a radius
+    bool round = false;  // sphere or capsule
     double radius = 0.0;
     double half_length = 0.0;
   };
@@ -171,8 +172,8 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
     }
     const bool round = s.shape == ShapeSpec::Kind::kSphere || s.shape == ShapeSpec::Kind::kCapsule;
     const double radius = s.radius.value_or(0.0);
-    impl_->round.push_back({round, round ? radius : 0.0,
-                            s.shape == ShapeSpec::Kind::kCapsule ? 0.5 * s.axis_length() : 0.0});
+    impl_->round.push_back(
+        {round, round ? radius : 0.0, s.shape == ShapeSpec::Kind::kCapsule ? 0.5 * s.axis_length() : 0.0});
     switch (s.shape) {
       case ShapeSpec::Kind::kSphere: impl_->geometry.push_back(std::make_shared<fcl::Sphered>(radius)); break;
       case ShapeSpec::Kind::kCapsule:

@@ -100,8 +100,8 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
                             (j + 1 < n ? before_[static_cast<std::size_t>(j + 1)] : spec_.end_effector);
     for (std::size_t k = 0; k < joint(j).collision.size(); ++k) {
       ShapeSpec shape = joint(j).collision[k];
-      const std::string who = "joint " + std::to_string(j + 1) + " ('" + joint(j).name + "') collision shape " +
-                              std::to_string(k + 1);
+      const std::string who =
+          "joint " + std::to_string(j + 1) + " ('" + joint(j).name + "') collision shape " + std::to_string(k + 1);
       REDRES_REQUIRE(!shape.velocity, "RobotModel", who + " has no velocity (only obstacles move)");
       if (shape.shape == ShapeSpec::Kind::kCapsule && !shape.from && !shape.length) {
         const Vector3d end = next.translation();
@@ -270,8 +270,9 @@ RobotModel load_robot(const TableReader& r) {
             if (spec.joints[j].name == name->get()) return static_cast<int>(j);
           }
         }
-        throw ConfigError(location_of(r.file(), p), "key 'collision_exclude': expected pairs of two joint names of "
-                                                    "this robot, e.g. [\"j1\", \"j3\"]");
+        throw ConfigError(location_of(r.file(), p),
+                          "key 'collision_exclude': expected pairs of two joint names of "
+                          "this robot, e.g. [\"j1\", \"j3\"]");
       };
       const int a = index(0), b = index(1);
       if (a == b) throw ConfigError(location_of(r.file(), p), "key 'collision_exclude': a pair names one joint twice");

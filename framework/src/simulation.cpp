@@ -82,6 +82,18 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
       run.first_failure = msg.str();
     }
   };
+  // A state a constraint finds violated (e.g. bodies that overlap) is a failed step too, whatever the solver said.
+  const auto check_violations = [&run, &s](double t) {
+    for (const auto& c : s.scheme->constraints()) {
+      if (!c->active() || !c->violated()) continue;
+      if (run.failures++ == 0) {
+        std::ostringstream msg;
+        msg << "t = " << t << " s: constraint '" << c->name() << "': " << c->describe_violation();
+        run.first_failure = msg.str();
+      }
+      return;
+    }
+  };
 
   for (int k = 0; k <= steps; ++k) {
     const double t = k == steps ? s.duration : k * s.tau;
@@ -106,7 +118,9 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
     for (int j = 0; j < n; ++j) row[c++] = vhi(j);
     row[c++] = static_cast<double>(static_cast<int>(out.info.status));
     for (const auto& [plugin, first] : recorders) plugin->record(row + first);
+    const int failures_before = run.failures;
     note(out, t);
+    if (run.failures == failures_before) check_violations(t);  // one failure per step at most
     if (progress && (k % report_every == 0 || k == steps)) progress(static_cast<double>(k) / steps, t);
     if (k == steps) break;
     if (s.integrator == Integrator::kEuler) {

@@ -47,13 +47,12 @@ const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
 }
 
 ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& robot)
-    : Configured(kType, config),
-      robot_(&robot),
-      damper_{config.influence_distance, config.safety_distance, config.xi} {
+    : Configured(kType, config), robot_(&robot), damper_{config.influence_distance, config.safety_distance, config.xi} {
   const auto& links = robot.link_shapes();
   if (links.empty()) {
-    throw FieldError("obstacles", "robot '" + robot.name() +
-                                      "' has no collision shapes: give its joints `collision` shapes (docs/collision.md)");
+    throw FieldError(
+        "obstacles",
+        "robot '" + robot.name() + "' has no collision shapes: give its joints `collision` shapes (docs/collision.md)");
   }
   const bool planar = robot.kind() == ChainKind::kPlanar;
   std::vector<ShapeSpec> shapes;
@@ -135,6 +134,21 @@ std::string ObstacleAvoidance::describe_inequality_row(int row) const {
   return s.str();
 }
 
+bool ObstacleAvoidance::violated() const {
+  for (double d : distance_) {
+    if (d < 0.0) return true;
+  }
+  return false;
+}
+
+std::string ObstacleAvoidance::describe_violation() const {
+  std::size_t worst = 0;
+  for (std::size_t r = 1; r < distance_.size(); ++r) {
+    if (distance_[r] < distance_[worst]) worst = r;
+  }
+  return "in collision: " + describe_inequality_row(static_cast<int>(worst));
+}
+
 std::vector<std::string> ObstacleAvoidance::recorded_columns() const {
   return {"min_obstacle_distance", "obstacle_rows_active"};
 }
@@ -179,8 +193,7 @@ ObstacleAvoidanceConfig example() {
 }
 
 const bool kRegistered = constraint_registry().add_plugin<ObstacleAvoidance>(
-    "n' J_p x >= -xi (d - d_s)/(d_i - d_s) + n' v_obstacle: links kept away from obstacles (FCL distances)",
-    example());
+    "n' J_p x >= -xi (d - d_s)/(d_i - d_s) + n' v_obstacle: links kept away from obstacles (FCL distances)", example());
 }  // namespace
 
 }  // namespace redres

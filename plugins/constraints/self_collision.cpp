@@ -27,9 +27,7 @@ const Schema<SelfCollisionConfig>& SelfCollisionConfig::schema() {
 }
 
 SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
-    : Configured(kType, config),
-      robot_(&robot),
-      damper_{config.influence_distance, config.safety_distance, config.xi} {
+    : Configured(kType, config), robot_(&robot), damper_{config.influence_distance, config.safety_distance, config.xi} {
   const auto& links = robot.link_shapes();
   std::vector<ShapeSpec> shapes;
   for (const auto& l : links) shapes.push_back(l.spec);
@@ -72,8 +70,7 @@ void SelfCollision::add_to(const Context& ctx, QpBuilder& builder) const {
     }
     distance_[row] = d.distance;
     Eigen::Vector3d n;
-    if (d.distance > damper_.influence_distance ||
-        !witness_normal(d, planar, Ta.translation() - Tb.translation(), n)) {
+    if (d.distance > damper_.influence_distance || !witness_normal(d, planar, Ta.translation() - Tb.translation(), n)) {
       A.row(r).setZero();
       b(r) = 1.0;
       continue;
@@ -96,6 +93,21 @@ std::string SelfCollision::describe_inequality_row(int row) const {
     << robot_->joint(sb.link).name << "' " << sb.spec.describe() << " at distance "
     << distance_[static_cast<std::size_t>(row)] << " m";
   return s.str();
+}
+
+bool SelfCollision::violated() const {
+  for (double d : distance_) {
+    if (d < 0.0) return true;
+  }
+  return false;
+}
+
+std::string SelfCollision::describe_violation() const {
+  std::size_t worst = 0;
+  for (std::size_t r = 1; r < distance_.size(); ++r) {
+    if (distance_[r] < distance_[worst]) worst = r;
+  }
+  return "in collision: " + describe_inequality_row(static_cast<int>(worst));
 }
 
 std::vector<std::string> SelfCollision::recorded_columns() const { return {"min_self_distance", "self_rows_active"}; }

@@ -33,15 +33,15 @@ namespace redres {
 /// by the two end points of its axis (`from`, `to`).
 struct ShapeSpec {
   enum class Kind { kSphere, kCapsule, kCylinder, kBox };
-  Kind shape = Kind::kCapsule;                                   //!< which primitive
-  std::optional<double> radius{};                                //!< sphere, capsule, cylinder (m)
-  std::optional<double> length{};                                //!< capsule, cylinder: axis length (m)
-  std::optional<std::array<double, 3>> size{};                   //!< box: full side lengths (m)
-  std::array<double, 3> xyz = {0.0, 0.0, 0.0};                   //!< position in the owner's frame (m)
-  std::array<double, 3> rpy = {0.0, 0.0, 0.0};                   //!< roll, pitch, yaw in the owner's frame (rad)
-  std::optional<std::array<double, 3>> from{};                   //!< capsule: one end of the axis (m)
-  std::optional<std::array<double, 3>> to{};                     //!< capsule: the other end of the axis (m)
-  std::optional<std::array<double, 3>> velocity{};               //!< obstacles: constant linear velocity (m/s)
+  Kind shape = Kind::kCapsule;                      //!< which primitive
+  std::optional<double> radius{};                   //!< sphere, capsule, cylinder (m)
+  std::optional<double> length{};                   //!< capsule, cylinder: axis length (m)
+  std::optional<std::array<double, 3>> size{};      //!< box: full side lengths (m)
+  std::array<double, 3> xyz = {0.0, 0.0, 0.0};      //!< position in the owner's frame (m)
+  std::array<double, 3> rpy = {0.0, 0.0, 0.0};      //!< roll, pitch, yaw in the owner's frame (rad)
+  std::optional<std::array<double, 3>> from{};      //!< capsule: one end of the axis (m)
+  std::optional<std::array<double, 3>> to{};        //!< capsule: the other end of the axis (m)
+  std::optional<std::array<double, 3>> velocity{};  //!< obstacles: constant linear velocity (m/s)
 
   static const Schema<ShapeSpec>& schema();
 
@@ -55,14 +55,15 @@ struct ShapeSpec {
 
 inline auto enum_names(ShapeSpec::Kind) {
   using K = ShapeSpec::Kind;
-  return std::array{std::pair{K::kSphere, std::string_view("sphere")}, std::pair{K::kCapsule, std::string_view("capsule")},
+  return std::array{std::pair{K::kSphere, std::string_view("sphere")},
+                    std::pair{K::kCapsule, std::string_view("capsule")},
                     std::pair{K::kCylinder, std::string_view("cylinder")}, std::pair{K::kBox, std::string_view("box")}};
 }
 
 /// The outcome of one distance query.
 struct ShapeDistance {
-  bool ok = false;          //!< false when FCL failed (see error); then the other fields are meaningless
-  double distance = 0.0;    //!< signed distance (m): > 0 apart, < 0 overlapping (minus the penetration depth)
+  bool ok = false;        //!< false when FCL failed (see error); then the other fields are meaningless
+  double distance = 0.0;  //!< signed distance (m): > 0 apart, < 0 overlapping (minus the penetration depth)
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero();  //!< witness point on shape a (world)
   Eigen::Vector3d point_b = Eigen::Vector3d::Zero();  //!< witness point on shape b (world)
   const char* error = "";  //!< FCL's message when !ok (a static string or the exception's what(), copied nowhere)

@@ -26,7 +26,9 @@ struct Damper {
   double gain = 0.1;                //!< xi (m/s): the largest approach speed, at d_i
 
   /// The lower bound on d_dot at distance d: -xi (d - d_s) / (d_i - d_s).
-  [[nodiscard]] double min_rate(double d) const { return -gain * (d - safety_distance) / (influence_distance - safety_distance); }
+  [[nodiscard]] double min_rate(double d) const {
+    return -gain * (d - safety_distance) / (influence_distance - safety_distance);
+  }
 };
 
 /// Writes the row of the damper as `A_row x <= b` for a pair at distance d with normal n (from b to a), the rate

@@ -61,6 +61,11 @@ class Plugin {
   [[nodiscard]] virtual KinematicsLevel kinematics_level() const { return KinematicsLevel::kPosition; }
   /// The full configuration (type, common keys and the plugin's own), readable by the same registry.
   [[nodiscard]] toml::table config() const;
+  /// Whether the state at the last contribution breaks what this plugin guards (e.g. two bodies overlap). The
+  /// simulation counts such a step as failed, with describe_violation() in its diagnosis. Allocation-free.
+  [[nodiscard]] virtual bool violated() const { return false; }
+  /// What is violated, e.g. "link 'j3' ... vs obstacle 1 overlap by 0.004 m" (called only when violated()).
+  [[nodiscard]] virtual std::string describe_violation() const { return {}; }
   /// Columns this plugin adds to trajectory.csv (default: none), e.g. "min_obstacle_distance".
   [[nodiscard]] virtual std::vector<std::string> recorded_columns() const { return {}; }
   /// Writes this step's values of recorded_columns() (called after each contribution; allocation-free).

@@ -59,14 +59,14 @@ class Registry : public RegistryBase {
  public:
   /// A registered plugin type.
   struct Entry {
-    std::string type;                                          //!< name used as `type = "..."` in TOML
-    std::string summary;                                       //!< one line
-    std::string origin;                                        //!< "built-in" or the library that registered it
-    std::vector<KeyInfo> keys;                                 //!< keys with defaults, units, rules, presence
-    std::vector<std::pair<std::string, std::string>> groups;   //!< group -> what to give
-    const std::type_info* config_type = nullptr;               //!< the Config type
-    std::any defaults;  //!< a default Config
-    std::any example;   //!< a Config for the conformance checks when the defaults cannot build (empty: none)
+    std::string type;                                         //!< name used as `type = "..."` in TOML
+    std::string summary;                                      //!< one line
+    std::string origin;                                       //!< "built-in" or the library that registered it
+    std::vector<KeyInfo> keys;                                //!< keys with defaults, units, rules, presence
+    std::vector<std::pair<std::string, std::string>> groups;  //!< group -> what to give
+    const std::type_info* config_type = nullptr;              //!< the Config type
+    std::any defaults;                                        //!< a default Config
+    std::any example;  //!< a Config for the conformance checks when the defaults cannot build (empty: none)
     std::function<std::any(const TableReader&)> read;          //!< reads and checks a Config (does not finish())
     std::function<void(const std::any&, toml::table&)> write;  //!< writes a Config's keys
     std::function<std::unique_ptr<Base>(const std::any&, Args...)> make;  //!< builds from a Config
@@ -119,7 +119,9 @@ class Registry : public RegistryBase {
   bool add_plugin(std::string summary, std::optional<typename P::Config> example = std::nullopt) {
     return add<typename P::Config>(
         P::kType, std::move(summary),
-        [](const typename P::Config& c, Args... args) { return std::unique_ptr<Base>(std::make_unique<P>(c, args...)); },
+        [](const typename P::Config& c, Args... args) {
+          return std::unique_ptr<Base>(std::make_unique<P>(c, args...));
+        },
         std::move(example));
   }
 

@@ -15,8 +15,9 @@ namespace redres {
 
 /// A finished run: the recorded trajectory and what the loop saw.
 struct RunResult {
-  Trajectory trajectory;                  //!< one row per step, t = 0 .. T
-  int failures = 0;                       //!< solves whose status was not `solved` (both Heun stages count)
+  Trajectory trajectory;  //!< one row per step, t = 0 .. T
+  int failures = 0;       //!< steps whose solve was not `solved` (both Heun stages count) or whose state a constraint
+                          //!< found violated (Constraint::violated(), e.g. bodies in collision)
   std::string first_failure;              //!< "t = ...: <status>: <diagnosis>" of the first failed solve
   double wall_time_s = 0.0;               //!< time spent in the loop (s)
   std::vector<std::string_view> engines;  //!< engines that ran, in order of first use (a fallback adds one)

@@ -59,7 +59,8 @@ struct Independent {
     compute_kinematics(robot, theta, k, KinematicsLevel::kPosition);
     const auto& s = robot.link_shapes()[static_cast<std::size_t>(l)];
     Eigen::Isometry3d To = obstacles[static_cast<std::size_t>(o)].pose();
-    if (const auto& v = obstacles[static_cast<std::size_t>(o)].velocity) To.translation() += t * Eigen::Vector3d((*v)[0], (*v)[1], (*v)[2]);
+    if (const auto& v = obstacles[static_cast<std::size_t>(o)].velocity)
+      To.translation() += t * Eigen::Vector3d((*v)[0], (*v)[1], (*v)[2]);
     const int L = static_cast<int>(robot.link_shapes().size());
     return query.distance(l, k.link_frames[static_cast<std::size_t>(s.link)] * s.pose, L + o, To).distance;
   }
@@ -100,7 +101,8 @@ TEST_P(CollisionRows, ObstacleRowsAreTheRateOfTheDistance) {
       obstacle(ShapeSpec::Kind::kCapsule, {-0.3, 0.6, z}),
       obstacle(ShapeSpec::Kind::kBox, {0.2, 0.8, z}),
   };
-  ObstacleAvoidance::Config config{.obstacles = obstacles, .influence_distance = 5.0, .safety_distance = 0.01, .xi = 0.3};
+  ObstacleAvoidance::Config config{
+      .obstacles = obstacles, .influence_distance = 5.0, .safety_distance = 0.01, .xi = 0.3};
   Built b = build(robot, std::make_unique<ObstacleAvoidance>(config, robot));
   const Independent ind(robot, obstacles);
   const Damper damper{5.0, 0.01, 0.3};
@@ -127,12 +129,12 @@ TEST_P(CollisionRows, ObstacleRowsAreTheRateOfTheDistance) {
         // to 0.2 % there (a sign, frame or column error is off by far more).
         const bool gjk = obstacles[static_cast<std::size_t>(o)].shape == ShapeSpec::Kind::kBox;
         const double h = gjk ? 1e-4 : 1e-6;
-        const double fd = (ind.link_obstacle(theta + h * x, l, o, t + h) - ind.link_obstacle(theta - h * x, l, o, t - h)) /
-                          (2.0 * h);
+        const double fd =
+            (ind.link_obstacle(theta + h * x, l, o, t + h) - ind.link_obstacle(theta - h * x, l, o, t - h)) / (2.0 * h);
         // The row is -n'J x <= -min_rate(d) - n'v: the constrained rate n'J x - n'v is -A x + b + min_rate(d).
         const double rate = -b.qp.A.row(row).dot(x) + b.qp.b(row) + damper.min_rate(d);
-        EXPECT_NEAR(rate, fd, (gjk ? 2e-3 : 1e-6) * (1.0 + std::abs(fd))) << "row " << row << " (link shape " << l << ", obstacle "
-                                                             << o << ") at d = " << d;
+        EXPECT_NEAR(rate, fd, (gjk ? 2e-3 : 1e-6) * (1.0 + std::abs(fd)))
+            << "row " << row << " (link shape " << l << ", obstacle " << o << ") at d = " << d;
         ++checked;
       }
     }
@@ -188,7 +190,8 @@ TEST(CollisionRows, PairsBeyondTheInfluenceDistanceGetSlackRowsAndTheDamperBound
   const RobotModel robot = load_robot(source_path("robots/paper_pushrod_6dof.toml"));
   const std::vector<ShapeSpec> obstacles = {obstacle(ShapeSpec::Kind::kSphere, {5.0, 5.0, 0.0}),
                                             obstacle(ShapeSpec::Kind::kSphere, {0.3, 0.2, 0.0})};
-  ObstacleAvoidance::Config config{.obstacles = obstacles, .influence_distance = 0.5, .safety_distance = 0.05, .xi = 0.2};
+  ObstacleAvoidance::Config config{
+      .obstacles = obstacles, .influence_distance = 0.5, .safety_distance = 0.05, .xi = 0.2};
   Built b = build(robot, std::make_unique<ObstacleAvoidance>(config, robot));
   KinematicsData kin(robot);
   compute_kinematics(robot, paper_theta0(), kin, KinematicsLevel::kJacobian);

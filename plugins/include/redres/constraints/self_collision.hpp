@@ -35,6 +35,9 @@ class SelfCollision final : public Configured<Constraint, SelfCollisionConfig> {
 
   [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
   [[nodiscard]] std::string describe_inequality_row(int row) const override;
+  /// A pair overlaps (signed distance < 0) at the last contribution.
+  [[nodiscard]] bool violated() const override;
+  [[nodiscard]] std::string describe_violation() const override;
   [[nodiscard]] std::vector<std::string> recorded_columns() const override;
   void record(double* values) const override;
   void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const override;

@@ -188,9 +188,14 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, std::set<std::str
   if (r.has("collision")) {
     config_io::read(r, "collision", jt.collision);
     for (std::size_t k = 0; k < jt.collision.size(); ++k) {
-      if (jt.collision[k].velocity) {
-        throw ConfigError(r.location("collision"), "joint '" + jt.name + "': key 'collision': shape " +
-                                                       std::to_string(k + 1) + " has a velocity; only obstacles move");
+      const ShapeSpec& c = jt.collision[k];
+      const std::string which = "joint '" + jt.name + "': key 'collision': shape " + std::to_string(k + 1);
+      if (c.velocity) throw ConfigError(r.location("collision"), which + " has a velocity; only obstacles move");
+      const bool placed = c.xyz != std::array<double, 3>{0, 0, 0} || c.rpy != std::array<double, 3>{0, 0, 0};
+      if (c.shape == ShapeSpec::Kind::kCapsule && !c.length && !c.from && placed) {
+        throw ConfigError(r.location("collision"), which +
+                                                       ": a capsule with `xyz` or `rpy` needs its `length` (or give "
+                                                       "`from` and `to`, or none of these to run along the link)");
       }
     }
   }

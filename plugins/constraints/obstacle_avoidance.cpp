@@ -143,8 +143,8 @@ bool ObstacleAvoidance::violated() const {
 
 std::string ObstacleAvoidance::describe_violation() const {
   std::size_t worst = 0;
-  for (std::size_t r = 1; r < distance_.size(); ++r) {
-    if (distance_[r] < distance_[worst]) worst = r;
+  for (std::size_t r = 0; r < distance_.size(); ++r) {
+    if (std::isnan(distance_[worst]) || distance_[r] < distance_[worst]) worst = r;  // NaN: an FCL failure
   }
   return "in collision: " + describe_inequality_row(static_cast<int>(worst));
 }

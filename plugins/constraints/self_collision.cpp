@@ -29,6 +29,10 @@ const Schema<SelfCollisionConfig>& SelfCollisionConfig::schema() {
 SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
     : Configured(kType, config), robot_(&robot), damper_{config.influence_distance, config.safety_distance, config.xi} {
   const auto& links = robot.link_shapes();
+  if (links.empty()) {
+    throw FieldError("", "robot '" + robot.name() +
+                             "' has no collision shapes: give its joints `collision` shapes (docs/collision.md)");
+  }
   std::vector<ShapeSpec> shapes;
   for (const auto& l : links) shapes.push_back(l.spec);
   for (std::size_t i = 0; i < links.size(); ++i) {
@@ -104,8 +108,8 @@ bool SelfCollision::violated() const {
 
 std::string SelfCollision::describe_violation() const {
   std::size_t worst = 0;
-  for (std::size_t r = 1; r < distance_.size(); ++r) {
-    if (distance_[r] < distance_[worst]) worst = r;
+  for (std::size_t r = 0; r < distance_.size(); ++r) {
+    if (std::isnan(distance_[worst]) || distance_[r] < distance_[worst]) worst = r;  // NaN: an FCL failure
   }
   return "in collision: " + describe_inequality_row(static_cast<int>(worst));
 }

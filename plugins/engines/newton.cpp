@@ -308,8 +308,22 @@ class Newton final : public LviEngine {
     y_ = result.y;
   }
 
+  static bool slack_rows_only(const QpProblem& qp) {
+    for (int r = 0; r < qp.m_in(); ++r) {
+      if (!(qp.b(r) >= 0.0)) return false;
+    }
+    const double* a = qp.A.data();
+    const Eigen::Index size = qp.A.size();
+    for (Eigen::Index k = 0; k < size; ++k) {
+      if (a[k] != 0.0) return false;
+    }
+    return true;
+  }
+
   void do_solve(const QpProblem& qp, SolverResult& result) override {
-    bool applicable = qp.w_diagonal && qp.m_in() == 0;
+    // Inequality rows that are all zero with b >= 0 (the slack rows collision constraints leave for pairs out of
+    // range) hold for every x with z = 0, so they do not stop the exact path.
+    bool applicable = qp.w_diagonal && slack_rows_only(qp);
     if (applicable) {
       // W rarely changes between steps (W = I in the paper): reuse 1 / W_ii when it has not.
       const int n = qp.n();

@@ -75,7 +75,8 @@ TEST(ObstacleScenario, AStartInCollisionIsAFailedStepNamingThePair) {
     SCOPED_TRACE(at);
     Scenario s = load_scenario(source_path("configs/paper_r_obstacle.toml"),
                                {"duration=0.1", std::string("constraints.3.obstacles=[{ shape = \"sphere\", radius = "
-                                                            "0.02, xyz = ") + at + " }]"});
+                                                            "0.02, xyz = ") +
+                                                    at + " }]"});
     const RunResult run = simulate(s);
     ASSERT_GT(run.failures, 0);
     EXPECT_EQ(run.first_failure.rfind("t = 0 s: ", 0), 0u) << run.first_failure;

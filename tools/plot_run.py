@@ -10,6 +10,8 @@ Per run:
   fig6_joint_angles.png     each theta with its limits and its safety region
   fig7_joint_velocities.png each theta_dot with its velocity limits and the merged bounds
   fig9b_position_error.png  the position error over time
+  fig_collision_distances.png  (runs with obstacle_avoidance or self_collision) the smallest distances over time,
+                            with each plugin's safety and influence distances
 Uses matplotlib and numpy (Debian: python3-matplotlib, python3-numpy). Exit codes: 0 figures written, 3 matplotlib
 or numpy cannot be imported (with a message saying what to install), 1 or 2 any other failure.
 """
@@ -35,7 +37,8 @@ except ImportError as e:
 
 
 def load(run_dir):
-    data = np.genfromtxt(os.path.join(run_dir, "trajectory.csv"), delimiter=",", names=True)
+    # deletechars="": keep column names as written ("<plugin>.<column>" for a second plugin recording a quantity).
+    data = np.genfromtxt(os.path.join(run_dir, "trajectory.csv"), delimiter=",", names=True, deletechars="")
     with open(os.path.join(run_dir, "summary.json")) as f:
         summary = json.load(f)
     return data, summary
@@ -194,6 +197,36 @@ def fig_error(run_dir, data, name):
     plt.close(fig)
 
 
+def fig_distances(run_dir, data, summary, name):
+    """The smallest obstacle and self distances per step, with d_s and d_i of the plugin that recorded them."""
+    names = data.dtype.names
+    columns = [c for c in names if c.split(".")[-1] in ("min_obstacle_distance", "min_self_distance")]
+    if not columns:
+        return
+    fig, ax = plt.subplots(figsize=(8, 4))
+    metrics = summary.get("metrics", {})
+    colours = ["b", "g", "m", "c"]
+    for k, c in enumerate(columns):
+        colour = colours[k % len(colours)]
+        ax.plot(data["t"], data[c], colour, label=c)
+        kind = "obstacle_avoidance" if c.endswith("min_obstacle_distance") else "self_collision"
+        plugin = c.split(".")[0] if "." in c else kind
+        figures = metrics.get(plugin, {})
+        if "safety_distance" in figures:
+            ax.axhline(figures["safety_distance"], color=colour, ls="--", lw=1, label=f"$d_s$ ({plugin})")
+        if "influence_distance" in figures:
+            ax.axhline(figures["influence_distance"], color=colour, ls=":", lw=1, label=f"$d_i$ ({plugin})")
+    ax.axhline(0.0, color="r", lw=1, label="contact")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("distance (m)")
+    ax.set_title(f"{name}: smallest collision distances")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(run_dir, "fig_collision_distances.png"), dpi=110)
+    plt.close(fig)
+
+
 def fig_profiles(run_dir, data, n, name):
     fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4))
     profiles(a, b, data, n)
@@ -214,6 +247,7 @@ def plot_run(run_dir, quiet):
     fig_angles(run_dir, data, summary, n, name)
     fig_velocities(run_dir, data, n, name)
     fig_error(run_dir, data, name)
+    fig_distances(run_dir, data, summary, name)
     if not quiet:
         print(f"figures written to {run_dir}")
 

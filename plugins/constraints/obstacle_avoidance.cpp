@@ -177,6 +177,8 @@ void ObstacleAvoidance::summarise(const RobotModel& /*robot*/, const Trajectory&
   out.push_back({"min_obstacle_distance", {low}, "m"});
   out.push_back({"steps_with_active_rows", {steps}, ""});
   out.push_back({"fcl_failures", {static_cast<double>(failures_)}, ""});
+  out.push_back({"safety_distance", {damper_.safety_distance}, "m"});
+  out.push_back({"influence_distance", {damper_.influence_distance}, "m"});
 }
 
 namespace {

@@ -140,6 +140,8 @@ void SelfCollision::summarise(const RobotModel& /*robot*/, const Trajectory& run
   out.push_back({"min_self_distance", {low}, "m"});
   out.push_back({"steps_with_active_rows", {steps}, ""});
   out.push_back({"fcl_failures", {static_cast<double>(failures_)}, ""});
+  out.push_back({"safety_distance", {damper_.safety_distance}, "m"});
+  out.push_back({"influence_distance", {damper_.influence_distance}, "m"});
 }
 
 namespace {

@@ -1,6 +1,11 @@
 #include "redres/collision_rows.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "redres/plugin.hpp"
+#include "redres/trajectory.hpp"
 
 namespace redres {
 
@@ -15,6 +20,59 @@ void point_jacobian(const RobotModel& robot, const KinematicsData& kin, int link
       J.col(k) = z;
     }
   }
+}
+
+PairDistances::PairDistances(int pairs, Damper damper, std::string minimum, std::string active)
+    : distance_(static_cast<std::size_t>(pairs), std::numeric_limits<double>::infinity()),
+      damper_(damper),
+      minimum_(std::move(minimum)),
+      active_(std::move(active)) {}
+
+void PairDistances::set(int row, double distance) {
+  distance_[static_cast<std::size_t>(row)] = distance;
+  failures_ += std::isnan(distance) ? 1 : 0;
+}
+
+bool PairDistances::violated() const {
+  for (double d : distance_) {
+    if (d < 0.0) return true;
+  }
+  return false;
+}
+
+int PairDistances::worst() const {
+  std::size_t w = 0;
+  for (std::size_t r = 0; r < distance_.size(); ++r) {
+    if (std::isnan(distance_[w]) || distance_[r] < distance_[w]) w = r;  // NaN: an FCL failure
+  }
+  return static_cast<int>(w);
+}
+
+void PairDistances::record(double* values) const {
+  double low = std::numeric_limits<double>::infinity();
+  int active = 0;
+  for (double d : distance_) {
+    if (std::isnan(d)) continue;
+    low = std::min(low, d);
+    active += d <= damper_.influence_distance ? 1 : 0;
+  }
+  values[0] = low;
+  values[1] = active;
+}
+
+void PairDistances::summarise(const Trajectory& run, const std::string& plugin, std::vector<Metric>& out) const {
+  const std::size_t cd = own_column(run, plugin, minimum_), ca = own_column(run, plugin, active_);
+  double low = std::numeric_limits<double>::infinity();
+  double steps = 0.0;
+  for (std::size_t r = 0; r < run.size(); ++r) {
+    low = std::min(low, run(r, cd));
+    steps += run(r, ca) > 0.0 ? 1.0 : 0.0;
+  }
+  out.push_back({minimum_, {low}, "m"});
+  out.push_back({"steps_with_active_rows", {steps}, ""});
+  out.push_back({"fcl_failures", {static_cast<double>(failures_)}, ""});
+  out.push_back({"safety_distance", {damper_.safety_distance}, "m"});
+  out.push_back({"influence_distance", {damper_.influence_distance}, "m"});
 }
 
 void damper_row(const Damper& damper, double d, const Eigen::Vector3d& n, const Eigen::Matrix3Xd& D,

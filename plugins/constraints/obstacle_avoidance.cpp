@@ -70,7 +70,7 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
   obstacles_ = static_cast<int>(config_.obstacles.size());
   query_ = std::make_unique<DistanceQuery>(shapes);
   jacobian_.setZero(3, robot.dof());
-  distance_.assign(static_cast<std::size_t>(links_ * obstacles_), std::numeric_limits<double>::infinity());
+  distances_ = PairDistances(links_ * obstacles_, damper_, "min_obstacle_distance", "obstacle_rows_active");
 }
 
 ObstacleAvoidance::~ObstacleAvoidance() = default;
@@ -102,13 +102,12 @@ void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder) const {
       double& rhs = b(row);
       if (!d.ok) {
         // FCL failed on this pair (rare; near-touching boxes): leave the row slack and count it.
-        ++failures_;
-        distance_[static_cast<std::size_t>(row)] = std::numeric_limits<double>::quiet_NaN();
+        distances_.set(row, std::numeric_limits<double>::quiet_NaN());
         A.row(row).setZero();
         rhs = 1.0;
         continue;
       }
-      distance_[static_cast<std::size_t>(row)] = d.distance;
+      distances_.set(row, d.distance);
       Eigen::Vector3d n;
       if (d.distance > damper_.influence_distance ||
           !witness_normal(d, planar, Tl.translation() - To.translation(), n)) {
@@ -129,56 +128,22 @@ std::string ObstacleAvoidance::describe_inequality_row(int row) const {
   std::ostringstream s;
   s.precision(4);
   s << "link '" << robot_->joint(shape.link).name << "' " << shape.spec.describe() << " vs obstacle " << o + 1 << " "
-    << config_.obstacles[static_cast<std::size_t>(o)].describe() << " at distance "
-    << distance_[static_cast<std::size_t>(row)] << " m";
+    << config_.obstacles[static_cast<std::size_t>(o)].describe() << " at distance " << distances_[row] << " m";
   return s.str();
 }
 
-bool ObstacleAvoidance::violated() const {
-  for (double d : distance_) {
-    if (d < 0.0) return true;
-  }
-  return false;
-}
+bool ObstacleAvoidance::violated() const { return distances_.violated(); }
 
 std::string ObstacleAvoidance::describe_violation() const {
-  std::size_t worst = 0;
-  for (std::size_t r = 0; r < distance_.size(); ++r) {
-    if (std::isnan(distance_[worst]) || distance_[r] < distance_[worst]) worst = r;  // NaN: an FCL failure
-  }
-  return "in collision: " + describe_inequality_row(static_cast<int>(worst));
+  return "in collision: " + describe_inequality_row(distances_.worst());
 }
 
-std::vector<std::string> ObstacleAvoidance::recorded_columns() const {
-  return {"min_obstacle_distance", "obstacle_rows_active"};
-}
+std::vector<std::string> ObstacleAvoidance::recorded_columns() const { return distances_.columns(); }
 
-void ObstacleAvoidance::record(double* values) const {
-  double low = std::numeric_limits<double>::infinity();
-  int active = 0;
-  for (double d : distance_) {
-    if (std::isnan(d)) continue;
-    low = std::min(low, d);
-    active += d <= damper_.influence_distance ? 1 : 0;
-  }
-  values[0] = low;
-  values[1] = active;
-}
+void ObstacleAvoidance::record(double* values) const { distances_.record(values); }
 
 void ObstacleAvoidance::summarise(const RobotModel& /*robot*/, const Trajectory& run, std::vector<Metric>& out) const {
-  const std::size_t cd = own_column(run, name(), "min_obstacle_distance");
-  const std::size_t ca = own_column(run, name(), "obstacle_rows_active");
-  double low = std::numeric_limits<double>::infinity();
-  double steps = 0.0;
-  for (std::size_t r = 0; r < run.size(); ++r) {
-    low = std::min(low, run(r, cd));
-    steps += run(r, ca) > 0.0 ? 1.0 : 0.0;
-  }
-  out.push_back({"min_obstacle_distance", {low}, "m"});
-  out.push_back({"steps_with_active_rows", {steps}, ""});
-  out.push_back({"fcl_failures", {static_cast<double>(failures_)}, ""});
-  out.push_back({"safety_distance", {damper_.safety_distance}, "m"});
-  out.push_back({"influence_distance", {damper_.influence_distance}, "m"});
+  distances_.summarise(run, name(), out);
 }
 
 namespace {

@@ -45,7 +45,7 @@ SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
   query_ = std::make_unique<DistanceQuery>(shapes);
   ja_.setZero(3, robot.dof());
   jb_.setZero(3, robot.dof());
-  distance_.assign(pairs_.size(), std::numeric_limits<double>::infinity());
+  distances_ = PairDistances(static_cast<int>(pairs_.size()), damper_, "min_self_distance", "self_rows_active");
 }
 
 SelfCollision::~SelfCollision() = default;
@@ -66,13 +66,12 @@ void SelfCollision::add_to(const Context& ctx, QpBuilder& builder) const {
     const ShapeDistance d = query_->distance(pairs_[row].first, Ta, pairs_[row].second, Tb);
     const auto r = static_cast<Eigen::Index>(row);
     if (!d.ok) {
-      ++failures_;
-      distance_[row] = std::numeric_limits<double>::quiet_NaN();
+      distances_.set(static_cast<int>(row), std::numeric_limits<double>::quiet_NaN());
       A.row(r).setZero();
       b(r) = 1.0;
       continue;
     }
-    distance_[row] = d.distance;
+    distances_.set(static_cast<int>(row), d.distance);
     Eigen::Vector3d n;
     if (d.distance > damper_.influence_distance || !witness_normal(d, planar, Ta.translation() - Tb.translation(), n)) {
       A.row(r).setZero();
@@ -94,54 +93,22 @@ std::string SelfCollision::describe_inequality_row(int row) const {
   std::ostringstream s;
   s.precision(4);
   s << "link '" << robot_->joint(sa.link).name << "' " << sa.spec.describe() << " vs link '"
-    << robot_->joint(sb.link).name << "' " << sb.spec.describe() << " at distance "
-    << distance_[static_cast<std::size_t>(row)] << " m";
+    << robot_->joint(sb.link).name << "' " << sb.spec.describe() << " at distance " << distances_[row] << " m";
   return s.str();
 }
 
-bool SelfCollision::violated() const {
-  for (double d : distance_) {
-    if (d < 0.0) return true;
-  }
-  return false;
-}
+bool SelfCollision::violated() const { return distances_.violated(); }
 
 std::string SelfCollision::describe_violation() const {
-  std::size_t worst = 0;
-  for (std::size_t r = 0; r < distance_.size(); ++r) {
-    if (std::isnan(distance_[worst]) || distance_[r] < distance_[worst]) worst = r;  // NaN: an FCL failure
-  }
-  return "in collision: " + describe_inequality_row(static_cast<int>(worst));
+  return "in collision: " + describe_inequality_row(distances_.worst());
 }
 
-std::vector<std::string> SelfCollision::recorded_columns() const { return {"min_self_distance", "self_rows_active"}; }
+std::vector<std::string> SelfCollision::recorded_columns() const { return distances_.columns(); }
 
-void SelfCollision::record(double* values) const {
-  double low = std::numeric_limits<double>::infinity();
-  int active = 0;
-  for (double d : distance_) {
-    if (std::isnan(d)) continue;
-    low = std::min(low, d);
-    active += d <= damper_.influence_distance ? 1 : 0;
-  }
-  values[0] = low;
-  values[1] = active;
-}
+void SelfCollision::record(double* values) const { distances_.record(values); }
 
 void SelfCollision::summarise(const RobotModel& /*robot*/, const Trajectory& run, std::vector<Metric>& out) const {
-  const std::size_t cd = own_column(run, name(), "min_self_distance");
-  const std::size_t ca = own_column(run, name(), "self_rows_active");
-  double low = std::numeric_limits<double>::infinity();
-  double steps = 0.0;
-  for (std::size_t r = 0; r < run.size(); ++r) {
-    low = std::min(low, run(r, cd));
-    steps += run(r, ca) > 0.0 ? 1.0 : 0.0;
-  }
-  out.push_back({"min_self_distance", {low}, "m"});
-  out.push_back({"steps_with_active_rows", {steps}, ""});
-  out.push_back({"fcl_failures", {static_cast<double>(failures_)}, ""});
-  out.push_back({"safety_distance", {damper_.safety_distance}, "m"});
-  out.push_back({"influence_distance", {damper_.influence_distance}, "m"});
+  distances_.summarise(run, name(), out);
 }
 
 namespace {

@@ -12,6 +12,9 @@
 /// distance, zero at the safety distance. For d < d_s the bound turns positive: the pair must separate at
 /// xi (d_s - d) / (d_i - d_s), a speed bounded by the penetration; the arm is pushed out, not held.
 
+#include <string>
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "redres/collision.hpp"
@@ -29,6 +32,38 @@ struct Damper {
   [[nodiscard]] double min_rate(double d) const {
     return -gain * (d - safety_distance) / (influence_distance - safety_distance);
   }
+};
+
+class Trajectory;
+struct Metric;
+
+/// The distances of a collision constraint's pairs at its last contribution, and what both collision constraints
+/// derive from them: the per-step columns, the violation (a pair that overlaps) and the run summary's figures.
+class PairDistances {
+ public:
+  /// `pairs` rows; `minimum` and `active` name the recorded columns (e.g. "min_obstacle_distance").
+  PairDistances(int pairs, Damper damper, std::string minimum, std::string active);
+
+  /// Sets pair `row`'s distance (NaN when FCL failed on it, which is counted).
+  void set(int row, double distance);
+  /// Pair `row`'s distance at the last contribution.
+  [[nodiscard]] double operator[](int row) const { return distance_[static_cast<std::size_t>(row)]; }
+  /// A pair overlaps.
+  [[nodiscard]] bool violated() const;
+  /// The pair with the smallest distance (FCL failures skipped).
+  [[nodiscard]] int worst() const;
+  /// The recorded columns: {minimum, active}.
+  [[nodiscard]] std::vector<std::string> columns() const { return {minimum_, active_}; }
+  /// Writes the smallest distance and the number of pairs within d_i.
+  void record(double* values) const;
+  /// min distance, steps with active rows, FCL failures, d_s and d_i, from plugin `plugin`'s recorded columns.
+  void summarise(const Trajectory& run, const std::string& plugin, std::vector<Metric>& out) const;
+
+ private:
+  std::vector<double> distance_;
+  Damper damper_;
+  std::string minimum_, active_;
+  int failures_ = 0;
 };
 
 /// Writes the row of the damper as `A_row x <= b` for a pair at distance d with normal n (from b to a), the rate

@@ -56,8 +56,7 @@ class ObstacleAvoidance final : public Configured<Constraint, ObstacleAvoidanceC
   int links_ = 0, obstacles_ = 0;
   Damper damper_;
   mutable Eigen::Matrix3Xd jacobian_;
-  mutable std::vector<double> distance_;  // per row, at the last contribution
-  mutable int failures_ = 0;              // FCL failures (their rows were left slack)
+  mutable PairDistances distances_{0, {}, "", ""};  // per row, at the last contribution
 };
 
 }  // namespace redres

@@ -52,8 +52,7 @@ class SelfCollision final : public Configured<Constraint, SelfCollisionConfig> {
   std::vector<std::pair<int, int>> pairs_;
   Damper damper_;
   mutable Eigen::Matrix3Xd ja_, jb_;
-  mutable std::vector<double> distance_;
-  mutable int failures_ = 0;
+  mutable PairDistances distances_{0, {}, "", ""};
 };
 
 }  // namespace redres

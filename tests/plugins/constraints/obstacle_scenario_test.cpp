@@ -67,6 +67,21 @@ TEST(ObstacleScenario, LinksKeepTheSafetyDistanceAndTheTaskIsMet) {
   EXPECT_LT(min_distance(off, free_run.trajectory, config.obstacles), config.safety_distance);
 }
 
+// The exact engine solves the live collision rows itself (its general path), on every step, and ends where the
+// paper's projection algorithm ends.
+TEST(ObstacleScenario, NewtonSolvesTheCollisionRowsItself) {
+  Scenario proj = load_scenario(source_path("configs/paper_r_obstacle.toml"));
+  Scenario newton = load_scenario(source_path("configs/paper_r_obstacle.toml"), {"solver.engine=newton"});
+  const RunResult a = simulate(proj), b = simulate(newton);
+  EXPECT_EQ(b.engine(), "newton") << "a step fell back to projection";
+  EXPECT_EQ(b.failures, 0) << b.first_failure;
+  const RunSummary sa = summarise(proj, a), sb = summarise(newton, b);
+  for (std::size_t j = 0; j < sa.final_theta.size(); ++j) EXPECT_NEAR(sb.final_theta[j], sa.final_theta[j], 1e-5);
+  const double d = min_distance(newton, b.trajectory, plugin_of(newton).settings().obstacles);
+  EXPECT_GE(d, plugin_of(newton).settings().safety_distance - 1e-6);
+  EXPECT_LT(sb.solver.mean_iterations, 3.0);
+}
+
 TEST(ObstacleScenario, AStartInCollisionIsAFailedStepNamingThePair) {
   // A sphere overlapping the second link by 5 mm at t = 0: the damper can push the link out, so the solve succeeds,
   // and the step fails on the violation; then a sphere deep on the link, where the step cannot be solved: the

@@ -1,0 +1,124 @@
+// Collision avoidance: the cost of one distance query (FCL, per pair), of one collision step (every pair of a
+// 7-joint arm against two obstacles plus its self-collision pairs, rows written), and of solving QPs with 0, 4 and
+// 16 inequality rows with each engine (cold solves of the random feasible family of the tests, 7 joints, 3 rows).
+// Compare within one run, as ratios: the machine is noisy.
+
+#include <random>
+
+#include <benchmark/benchmark.h>
+
+#include "qp_util.hpp"
+#include "redres/collision.hpp"
+#include "redres/constraints/obstacle_avoidance.hpp"
+#include "redres/constraints/self_collision.hpp"
+#include "redres/lvi.hpp"
+#include "redres/scheme.hpp"
+#include "redres/simulation.hpp"
+#include "test_util.hpp"
+
+namespace {
+
+redres::ShapeSpec shape(redres::ShapeSpec::Kind kind) {
+  redres::ShapeSpec s;
+  s.shape = kind;
+  if (kind == redres::ShapeSpec::Kind::kBox) {
+    s.size = std::array<double, 3>{0.2, 0.3, 0.4};
+  } else {
+    s.radius = 0.05;
+  }
+  if (kind == redres::ShapeSpec::Kind::kCapsule) s.length = 0.3;
+  return s;
+}
+
+// One query between a capsule and a sphere (analytic in FCL) or a box (GJK), apart.
+void BM_DistancePair(benchmark::State& state) {
+  const auto other = static_cast<redres::ShapeSpec::Kind>(state.range(0));
+  const redres::DistanceQuery q({shape(redres::ShapeSpec::Kind::kCapsule), shape(other)});
+  Eigen::Isometry3d Ta = Eigen::Isometry3d::Identity(), Tb = Eigen::Isometry3d::Identity();
+  Tb.translation() << 0.4, 0.1, 0.05;
+  double x = 0.0;
+  for (auto _ : state) {
+    Ta.translation().x() = 1e-9 * (x += 1.0);  // a new pose every query
+    benchmark::DoNotOptimize(q.distance(0, Ta, 1, Tb).distance);
+  }
+  state.SetLabel(other == redres::ShapeSpec::Kind::kSphere ? "capsule-sphere" : "capsule-box");
+}
+BENCHMARK(BM_DistancePair)->Arg(static_cast<int>(redres::ShapeSpec::Kind::kSphere))
+    ->Arg(static_cast<int>(redres::ShapeSpec::Kind::kBox));
+
+// One collision step of the Panda: 7 link capsules against 2 obstacles (14 rows) and its 10 self-collision pairs,
+// distances, normals, Jacobians and rows (every pair within the influence distance, so every row is written).
+void BM_CollisionStep(benchmark::State& state) {
+  const redres::RobotModel robot = redres::load_robot(redres::source_path("robots/franka_panda.toml"));
+  redres::ShapeSpec sphere = shape(redres::ShapeSpec::Kind::kSphere), box = shape(redres::ShapeSpec::Kind::kBox);
+  sphere.xyz = {0.6, 0.2, 0.5};
+  box.xyz = {-0.5, 0.4, 0.3};
+  std::vector<std::unique_ptr<redres::Constraint>> constraints;
+  constraints.push_back(std::make_unique<redres::ObstacleAvoidance>(
+      redres::ObstacleAvoidance::Config{.obstacles = {sphere, box}, .influence_distance = 2.0}, robot));
+  constraints.push_back(
+      std::make_unique<redres::SelfCollision>(redres::SelfCollision::Config{.influence_distance = 2.0}, robot));
+  const redres::Scheme scheme(robot, {}, std::move(constraints));
+  redres::QpProblem qp;
+  scheme.setup(qp);
+  redres::KinematicsData kin(robot);
+  Eigen::VectorXd theta = robot.home();
+  redres::compute_kinematics(robot, theta, kin, redres::KinematicsLevel::kJacobian);
+  redres::Context ctx{0.0, 10.0, 0.01, &robot, &kin, nullptr, nullptr};
+  for (auto _ : state) {
+    scheme.build(ctx, qp);
+    benchmark::DoNotOptimize(qp.b.data());
+  }
+  state.counters["pairs"] = qp.m_in();
+  state.counters["per_pair_ns"] = benchmark::Counter(static_cast<double>(qp.m_in()),
+                                                     benchmark::Counter::kIsIterationInvariantRate |
+                                                         benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_CollisionStep);
+
+// Cold solves of 64 random feasible QPs (7 joints, 3 equality rows, `rows` inequality rows) with one engine.
+void BM_SolveWithRows(benchmark::State& state, const char* engine_name) {
+  const int rows = static_cast<int>(state.range(0));
+  std::mt19937 rng(777);
+  std::vector<redres::QpProblem> family;
+  for (int k = 0; k < 64; ++k) family.push_back(redres::testing::random_qp(rng, 7, 3, rows).qp);
+  redres::SolverSettings settings;
+  settings.tolerance = 1e-8;
+  settings.max_iterations = 200000;
+  auto engine = redres::make_engine(engine_name, settings);
+  redres::SolverResult r;
+  engine->setup(7, 3, rows, r);
+  std::size_t k = 0;
+  int exact = 0, solves = 0;
+  for (auto _ : state) {
+    engine->reset();
+    engine->solve(family[k], r);
+    k = (k + 1) % family.size();
+    exact += r.info.engine == engine_name ? 1 : 0;
+    ++solves;
+  }
+  state.counters["own_engine_share"] = static_cast<double>(exact) / std::max(solves, 1);
+}
+BENCHMARK_CAPTURE(BM_SolveWithRows, newton, "newton")->Arg(0)->Arg(4)->Arg(16);
+BENCHMARK_CAPTURE(BM_SolveWithRows, projection, "projection")->Arg(0)->Arg(4)->Arg(16);
+BENCHMARK_CAPTURE(BM_SolveWithRows, nlopt, "nlopt")->Arg(0)->Arg(4)->Arg(16);
+
+// The whole 40 s run of configs/paper_r_obstacle.toml (4001 warm-started steps, one obstacle row live in about half
+// of them) with one engine: the control-loop case, where newton's general path settles in about one iteration.
+void BM_ObstacleScenario(benchmark::State& state, const char* engine_name) {
+  std::string engine_of_run;
+  for (auto _ : state) {
+    state.PauseTiming();
+    redres::Scenario s = redres::load_scenario(redres::source_path("configs/paper_r_obstacle.toml"),
+                                               {std::string("solver.engine=") + engine_name});
+    state.ResumeTiming();
+    const redres::RunResult run = redres::simulate(s);
+    engine_of_run = run.engine();
+    benchmark::DoNotOptimize(run.trajectory.values().data());
+  }
+  state.SetLabel(engine_of_run);
+}
+BENCHMARK_CAPTURE(BM_ObstacleScenario, newton, "newton")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ObstacleScenario, projection, "projection")->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace

@@ -43,7 +43,8 @@ void BM_DistancePair(benchmark::State& state) {
   }
   state.SetLabel(other == redres::ShapeSpec::Kind::kSphere ? "capsule-sphere" : "capsule-box");
 }
-BENCHMARK(BM_DistancePair)->Arg(static_cast<int>(redres::ShapeSpec::Kind::kSphere))
+BENCHMARK(BM_DistancePair)
+    ->Arg(static_cast<int>(redres::ShapeSpec::Kind::kSphere))
     ->Arg(static_cast<int>(redres::ShapeSpec::Kind::kBox));
 
 // One collision step of the Panda: 7 link capsules against 2 obstacles (14 rows) and its 10 self-collision pairs,
@@ -70,9 +71,8 @@ void BM_CollisionStep(benchmark::State& state) {
     benchmark::DoNotOptimize(qp.b.data());
   }
   state.counters["pairs"] = qp.m_in();
-  state.counters["per_pair_ns"] = benchmark::Counter(static_cast<double>(qp.m_in()),
-                                                     benchmark::Counter::kIsIterationInvariantRate |
-                                                         benchmark::Counter::kInvert);
+  state.counters["per_pair_ns"] = benchmark::Counter(
+      static_cast<double>(qp.m_in()), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_CollisionStep);
 

@@ -353,7 +353,12 @@ class Newton final : public LviEngine {
       u_.segment(n, me) = result.y;
       u_.tail(mi) = result.z;
     } else {
+      // Cold: x at the minimiser of x'Wx/2 + zeta'x on the box (for W's diagonal), duals zero.
       u_.setZero();
+      for (int i = 0; i < n; ++i) {
+        const double w = qp.W(i, i);
+        u_(i) = box(w > 0.0 ? -qp.zeta(i) / w : 0.0, qp.lo(i), qp.hi(i));
+      }
     }
     const double scale =
         1.0 + std::max({qp.zeta.lpNorm<Eigen::Infinity>(), me > 0 ? qp.d.lpNorm<Eigen::Infinity>() : 0.0,

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "redres/config.hpp"
 #include "redres/plugin.hpp"
 #include "redres/trajectory.hpp"
 
@@ -28,9 +29,20 @@ PairDistances::PairDistances(int pairs, Damper damper, std::string minimum, std:
       minimum_(std::move(minimum)),
       active_(std::move(active)) {}
 
-void PairDistances::set(int row, double distance) {
+bool PairDistances::take(int row, const ShapeDistance& d, bool planar, const Eigen::Vector3d& fallback,
+                         Eigen::Vector3d& n) {
+  const double distance = d.ok ? d.distance : std::numeric_limits<double>::quiet_NaN();
   distance_[static_cast<std::size_t>(row)] = distance;
-  failures_ += std::isnan(distance) ? 1 : 0;
+  failures_ += d.ok ? 0 : 1;  // FCL failed on this pair (rare; near-touching boxes): its row stays slack
+  return d.ok && distance <= damper_.influence_distance && witness_normal(d, planar, fallback, n);
+}
+
+void check_damper(double influence_distance, double safety_distance) {
+  if (!(safety_distance >= 0.0)) throw FieldError("safety_distance", "expected a safety distance >= 0 m");
+  if (!(influence_distance > safety_distance)) {
+    throw FieldError("influence_distance", "expected an influence distance > the safety distance (" +
+                                               std::to_string(safety_distance) + " m)");
+  }
 }
 
 bool PairDistances::violated() const {
@@ -78,8 +90,7 @@ void PairDistances::summarise(const Trajectory& run, const std::string& plugin, 
 void damper_row(const Damper& damper, double d, const Eigen::Vector3d& n, const Eigen::Matrix3Xd& D,
                 const Eigen::Vector3d& v_b, Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> A_row, double& b) {
   if (d > damper.influence_distance) {
-    A_row.setZero();
-    b = 1.0;
+    slack_row(A_row, b);
     return;
   }
   // Column by column: a product expression here would go through a temporary (an allocation per row).

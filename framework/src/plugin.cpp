@@ -125,17 +125,25 @@ const std::vector<KeyInfo>& constraint_common_keys() {
   return keys;
 }
 
+namespace {
+// The common keys every plugin has: its instance name (when given) and whether it is active.
+template <class Common>
+void apply_common(const TableReader& config, const Common& common, Plugin& p) {
+  if (common.name) {
+    if (common.name->empty()) config.fail("name", "expected a non-empty name");
+    p.set_name(*common.name);
+  }
+  p.set_active(common.active);
+}
+}  // namespace
+
 std::unique_ptr<Objective> make_objective(const TableReader& config, const RobotModel& robot) {
   ObjectiveCommon common;
   read_config(config, ObjectiveCommon::schema(), common);
   auto p = objective_registry().create(config, robot);
   config.finish();
-  if (common.name) {
-    if (common.name->empty()) config.fail("name", "expected a non-empty name");
-    p->set_name(*common.name);
-  }
+  apply_common(config, common, *p);
   p->set_weight(common.weight);
-  p->set_active(common.active);
   return p;
 }
 
@@ -147,11 +155,7 @@ std::unique_ptr<Constraint> make_constraint(const TableReader& config, const Rob
   read_config(config, ConstraintCommon::schema(), common);
   auto p = constraint_registry().create(config, robot);
   config.finish();
-  if (common.name) {
-    if (common.name->empty()) config.fail("name", "expected a non-empty name");
-    p->set_name(*common.name);
-  }
-  p->set_active(common.active);
+  apply_common(config, common, *p);
   return p;
 }
 

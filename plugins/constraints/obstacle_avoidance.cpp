@@ -11,16 +11,6 @@ namespace redres {
 
 namespace {
 
-// The rules both collision constraints share: d_i > d_s >= 0, xi > 0.
-template <class C>
-void check_damper(const C& c) {
-  if (!(c.safety_distance >= 0.0)) throw FieldError("safety_distance", "expected a safety distance >= 0 m");
-  if (!(c.influence_distance > c.safety_distance)) {
-    throw FieldError("influence_distance", "expected an influence distance > the safety distance (" +
-                                               std::to_string(c.safety_distance) + " m)");
-  }
-}
-
 Eigen::Vector3d vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
 }  // namespace
@@ -33,7 +23,7 @@ const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
        field("safety_distance", &C::safety_distance, "m", "d_s: the distance the damper holds"),
        field("xi", &C::xi, "m/s", "damper gain: the largest approach speed, at d_i", greater(0.0))},
       [](const C& c) {
-        check_damper(c);
+        check_damper(c.influence_distance, c.safety_distance);
         for (std::size_t k = 0; k < c.obstacles.size(); ++k) {
           const ShapeSpec& o = c.obstacles[k];
           if (o.shape == ShapeSpec::Kind::kCapsule && !o.from && !o.length) {
@@ -47,7 +37,7 @@ const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
 }
 
 ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& robot)
-    : Configured(kType, config), robot_(&robot), damper_{config.influence_distance, config.safety_distance, config.xi} {
+    : Configured(kType, config), robot_(&robot) {
   const auto& links = robot.link_shapes();
   if (links.empty()) {
     throw FieldError(
@@ -70,7 +60,8 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
   obstacles_ = static_cast<int>(config_.obstacles.size());
   query_ = std::make_unique<DistanceQuery>(shapes);
   jacobian_.setZero(3, robot.dof());
-  distances_ = PairDistances(links_ * obstacles_, damper_, "min_obstacle_distance", "obstacle_rows_active");
+  distances_ = PairDistances(links_ * obstacles_, {config.influence_distance, config.safety_distance, config.xi},
+                             "min_obstacle_distance", "obstacle_rows_active");
 }
 
 ObstacleAvoidance::~ObstacleAvoidance() = default;
@@ -99,24 +90,13 @@ void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder) const {
       const auto& shape = links[static_cast<std::size_t>(l)];
       const Eigen::Isometry3d Tl = kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose;
       const ShapeDistance d = query_->distance(l, Tl, links_ + o, To);
-      double& rhs = b(row);
-      if (!d.ok) {
-        // FCL failed on this pair (rare; near-touching boxes): leave the row slack and count it.
-        distances_.set(row, std::numeric_limits<double>::quiet_NaN());
-        A.row(row).setZero();
-        rhs = 1.0;
-        continue;
-      }
-      distances_.set(row, d.distance);
       Eigen::Vector3d n;
-      if (d.distance > damper_.influence_distance ||
-          !witness_normal(d, planar, Tl.translation() - To.translation(), n)) {
-        A.row(row).setZero();
-        rhs = 1.0;
+      if (!distances_.take(row, d, planar, Tl.translation() - To.translation(), n)) {
+        slack_row(A.row(row), b(row));
         continue;
       }
       point_jacobian(*robot_, kin, shape.link, d.point_a, jacobian_);
-      damper_row(damper_, d.distance, n, jacobian_, v_b, A.row(row), rhs);
+      damper_row(distances_.damper(), d.distance, n, jacobian_, v_b, A.row(row), b(row));
     }
   }
 }

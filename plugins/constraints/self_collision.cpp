@@ -15,19 +15,13 @@ const Schema<SelfCollisionConfig>& SelfCollisionConfig::schema() {
       {field("influence_distance", &C::influence_distance, "m", "d_i: rows for pairs closer than this"),
        field("safety_distance", &C::safety_distance, "m", "d_s: the distance the damper holds"),
        field("xi", &C::xi, "m/s", "damper gain: the largest approach speed, at d_i", greater(0.0))},
-      [](const C& c) {
-        if (!(c.safety_distance >= 0.0)) throw FieldError("safety_distance", "expected a safety distance >= 0 m");
-        if (!(c.influence_distance > c.safety_distance)) {
-          throw FieldError("influence_distance", "expected an influence distance > the safety distance (" +
-                                                     std::to_string(c.safety_distance) + " m)");
-        }
-      },
+      [](const C& c) { check_damper(c.influence_distance, c.safety_distance); },
       {}};
   return s;
 }
 
 SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
-    : Configured(kType, config), robot_(&robot), damper_{config.influence_distance, config.safety_distance, config.xi} {
+    : Configured(kType, config), robot_(&robot) {
   const auto& links = robot.link_shapes();
   if (links.empty()) {
     throw FieldError("", "robot '" + robot.name() +
@@ -45,7 +39,9 @@ SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
   query_ = std::make_unique<DistanceQuery>(shapes);
   ja_.setZero(3, robot.dof());
   jb_.setZero(3, robot.dof());
-  distances_ = PairDistances(static_cast<int>(pairs_.size()), damper_, "min_self_distance", "self_rows_active");
+  distances_ =
+      PairDistances(static_cast<int>(pairs_.size()), {config.influence_distance, config.safety_distance, config.xi},
+                    "min_self_distance", "self_rows_active");
 }
 
 SelfCollision::~SelfCollision() = default;
@@ -65,23 +61,15 @@ void SelfCollision::add_to(const Context& ctx, QpBuilder& builder) const {
     const Eigen::Isometry3d Tb = kin.link_frames[static_cast<std::size_t>(sb.link)] * sb.pose;
     const ShapeDistance d = query_->distance(pairs_[row].first, Ta, pairs_[row].second, Tb);
     const auto r = static_cast<Eigen::Index>(row);
-    if (!d.ok) {
-      distances_.set(static_cast<int>(row), std::numeric_limits<double>::quiet_NaN());
-      A.row(r).setZero();
-      b(r) = 1.0;
-      continue;
-    }
-    distances_.set(static_cast<int>(row), d.distance);
     Eigen::Vector3d n;
-    if (d.distance > damper_.influence_distance || !witness_normal(d, planar, Ta.translation() - Tb.translation(), n)) {
-      A.row(r).setZero();
-      b(r) = 1.0;
+    if (!distances_.take(static_cast<int>(row), d, planar, Ta.translation() - Tb.translation(), n)) {
+      slack_row(A.row(r), b(r));
       continue;
     }
     point_jacobian(*robot_, kin, sa.link, d.point_a, ja_);
     point_jacobian(*robot_, kin, sb.link, d.point_b, jb_);
     ja_ -= jb_;
-    damper_row(damper_, d.distance, n, ja_, Eigen::Vector3d::Zero(), A.row(r), b(r));
+    damper_row(distances_.damper(), d.distance, n, ja_, Eigen::Vector3d::Zero(), A.row(r), b(r));
   }
 }
 

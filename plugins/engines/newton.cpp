@@ -365,17 +365,8 @@ class Newton final : public LviEngine {
                         mi > 0 ? qp.b.lpNorm<Eigen::Infinity>() : 0.0});
     const double target = std::min(settings().tolerance, 1e-12 * scale);
     const auto N = static_cast<Eigen::Index>(n + me + mi);
+    double e2 = natural_residual2(qp, u_);
     for (int k = 0; k <= kMaxGeneralIterations; ++k) {
-      mu_.noalias() = M_ * u_;
-      mu_.head(n) += qp.zeta;
-      mu_.segment(n, me) -= qp.d;
-      mu_.tail(mi) += qp.b;
-      double e2 = 0.0;
-      for (Eigen::Index i = 0; i < N; ++i) {
-        const double v = u_(i) - mu_(i);
-        e_(i) = u_(i) - box(v, lo_u_(i), hi_u_(i));
-        e2 += e_(i) * e_(i);
-      }
       if (std::sqrt(e2) <= target) {
         result.x = u_.head(n).cwiseMax(qp.lo).cwiseMin(qp.hi);
         result.y = u_.segment(n, me);
@@ -403,18 +394,20 @@ class Newton final : public LviEngine {
       if (!du_.allFinite()) return false;
       // The full step is exact once the active set is right; before that it may overshoot, so halve it until the
       // natural residual decreases (the merit ||e||^2 is piecewise quadratic along du).
-      double t = 1.0;
+      double t = 1.0, trial = 0.0;
       for (int halvings = 0;; ++halvings) {
         rhs_ = u_ + t * du_;  // the trial point (rhs_ is free until the next Newton system)
-        if (natural_residual2(qp, rhs_) < (1.0 - 1e-4 * t) * e2 || halvings == 30) break;
+        trial = natural_residual2(qp, rhs_);
+        if (trial < (1.0 - 1e-4 * t) * e2 || halvings == 30) break;
         t *= 0.5;
       }
-      u_ = rhs_;
+      u_ = rhs_;  // mu_ and e_ already hold its values: the last trial was this point
+      e2 = trial;
     }
     return false;
   }
 
-  // ||e(w)||^2 at a trial point w, using mu_ as scratch.
+  // ||e(w)||^2 of the natural map at w; leaves M w + g in mu_ and e(w) in e_.
   double natural_residual2(const QpProblem& qp, const Eigen::VectorXd& w) {
     const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
     mu_.noalias() = M_ * w;
@@ -423,8 +416,8 @@ class Newton final : public LviEngine {
     mu_.tail(mi) += qp.b;
     double e2 = 0.0;
     for (Eigen::Index i = 0; i < w.size(); ++i) {
-      const double ei = w(i) - box(w(i) - mu_(i), lo_u_(i), hi_u_(i));
-      e2 += ei * ei;
+      e_(i) = w(i) - box(w(i) - mu_(i), lo_u_(i), hi_u_(i));
+      e2 += e_(i) * e_(i);
     }
     return e2;
   }

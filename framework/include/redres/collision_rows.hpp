@@ -44,8 +44,12 @@ class PairDistances {
   /// `pairs` rows; `minimum` and `active` name the recorded columns (e.g. "min_obstacle_distance").
   PairDistances(int pairs, Damper damper, std::string minimum, std::string active);
 
-  /// Sets pair `row`'s distance (NaN when FCL failed on it, which is counted).
-  void set(int row, double distance);
+  /// Records pair `row`'s query (an FCL failure as NaN, counted) and finds its normal (witness_normal(), with
+  /// `fallback`). Returns whether the pair gets a damper row: the query worked, the pair is within d_i and the normal
+  /// is defined; otherwise the caller writes a slack row.
+  bool take(int row, const ShapeDistance& d, bool planar, const Eigen::Vector3d& fallback, Eigen::Vector3d& n);
+  /// The damper the pairs are held by.
+  [[nodiscard]] const Damper& damper() const noexcept { return damper_; }
   /// Pair `row`'s distance at the last contribution.
   [[nodiscard]] double operator[](int row) const { return distance_[static_cast<std::size_t>(row)]; }
   /// A pair overlaps.
@@ -65,6 +69,15 @@ class PairDistances {
   std::string minimum_, active_;
   int failures_ = 0;
 };
+
+/// Checks the damper's keys of a collision constraint's Config: d_s >= 0 and d_i > d_s (FieldError naming the key).
+void check_damper(double influence_distance, double safety_distance);
+
+/// A row that every x meets and that leaves the duals alone: A_row = 0, b = 1.
+inline void slack_row(Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> A_row, double& b) {
+  A_row.setZero();
+  b = 1.0;
+}
 
 /// Writes the row of the damper as `A_row x <= b` for a pair at distance d with normal n (from b to a), the rate
 /// Jacobian D = J_a - J_b (3 x n) and b's velocity v_b: A_row = -n' D, b = -min_rate(d) - n' v_b. A pair farther

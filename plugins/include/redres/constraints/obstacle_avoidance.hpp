@@ -54,7 +54,6 @@ class ObstacleAvoidance final : public Configured<Constraint, ObstacleAvoidanceC
   const RobotModel* robot_;
   std::unique_ptr<DistanceQuery> query_;  // link shapes first, then the obstacles
   int links_ = 0, obstacles_ = 0;
-  Damper damper_;
   mutable Eigen::Matrix3Xd jacobian_;
   mutable PairDistances distances_{0, {}, "", ""};  // per row, at the last contribution
 };

@@ -50,7 +50,6 @@ class SelfCollision final : public Configured<Constraint, SelfCollisionConfig> {
   const RobotModel* robot_;
   std::unique_ptr<DistanceQuery> query_;
   std::vector<std::pair<int, int>> pairs_;
-  Damper damper_;
   mutable Eigen::Matrix3Xd ja_, jb_;
   mutable PairDistances distances_{0, {}, "", ""};
 };

@@ -1,6 +1,6 @@
 // Collision avoidance: the cost of one distance query (FCL, per pair), of one collision step (every pair of a
 // 7-joint arm against two obstacles plus its self-collision pairs, rows written), and of solving QPs with 0, 4 and
-// 16 inequality rows with each engine (cold solves of the random feasible family of the tests, 7 joints, 3 rows).
+// 16 live inequality rows with each engine (cold solves of random feasible QPs, 7 joints, 3 equality rows).
 // Compare within one run, as ratios: the machine is noisy.
 
 #include <random>
@@ -76,12 +76,52 @@ void BM_CollisionStep(benchmark::State& state) {
 }
 BENCHMARK(BM_CollisionStep);
 
-// Cold solves of 64 random feasible QPs (7 joints, 3 equality rows, `rows` inequality rows) with one engine.
+// 64 random feasible QPs (7 joints, 3 equality rows, `rows` inequality rows) whose rows are live: each one cuts off
+// the minimiser without rows (random direction, turned against it), while the known feasible point keeps them
+// feasible; several bind at the answer, as when an arm presses against obstacles.
+std::vector<redres::QpProblem> live_row_family(int rows) {
+  std::mt19937 rng(777);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), frac(0.1, 0.9);
+  std::vector<redres::QpProblem> family;
+  auto exact = redres::make_engine("newton");
+  for (int k = 0; k < 64; ++k) {
+    const redres::testing::RandomQp base = redres::testing::random_qp(rng, 7, 3, 0);
+    redres::SolverResult free;
+    exact->setup(7, 3, 0, free);
+    exact->reset();
+    exact->solve(base.qp, free);
+    redres::QpProblem qp = base.qp;
+    qp.resize(7, 3, rows);
+    qp.W = base.qp.W;
+    qp.zeta = base.qp.zeta;
+    qp.J = base.qp.J;
+    qp.d = base.qp.d;
+    qp.lo = base.qp.lo;
+    qp.hi = base.qp.hi;
+    qp.lo_source = base.qp.lo_source;
+    qp.hi_source = base.qp.hi_source;
+    qp.source_names = base.qp.source_names;
+    qp.eq_source = base.qp.eq_source;
+    qp.in_source.assign(static_cast<std::size_t>(rows), 0);
+    const Eigen::VectorXd away = free.x - base.feasible;
+    for (int r = 0; r < rows; ++r) {
+      Eigen::VectorXd a(7);
+      for (int i = 0; i < 7; ++i) a(i) = u(rng);
+      if (a.dot(away) < 0.0) a = -a;
+      qp.A.row(r) = a.normalized().transpose();
+      // Between the feasible point (a'f) and the minimiser without rows (a'x0 > a'f): x0 violates the row.
+      qp.b(r) = qp.A.row(r).dot(base.feasible) + frac(rng) * qp.A.row(r).dot(away);
+    }
+    family.push_back(std::move(qp));
+  }
+  return family;
+}
+
+// Cold solves of live_row_family(rows) with one engine; counters: the share solved by the engine itself (not a
+// fallback) and the rows active at the answer (z > 0) per solve.
 void BM_SolveWithRows(benchmark::State& state, const char* engine_name) {
   const int rows = static_cast<int>(state.range(0));
-  std::mt19937 rng(777);
-  std::vector<redres::QpProblem> family;
-  for (int k = 0; k < 64; ++k) family.push_back(redres::testing::random_qp(rng, 7, 3, rows).qp);
+  const std::vector<redres::QpProblem> family = live_row_family(rows);
   redres::SolverSettings settings;
   settings.tolerance = 1e-8;
   settings.max_iterations = 200000;
@@ -90,14 +130,19 @@ void BM_SolveWithRows(benchmark::State& state, const char* engine_name) {
   engine->setup(7, 3, rows, r);
   std::size_t k = 0;
   int exact = 0, solves = 0;
+  long active = 0, iterations = 0;
   for (auto _ : state) {
     engine->reset();
     engine->solve(family[k], r);
     k = (k + 1) % family.size();
     exact += r.info.engine == engine_name ? 1 : 0;
+    for (int i = 0; i < rows; ++i) active += r.z(i) > 1e-9 ? 1 : 0;
+    iterations += r.info.iterations;
     ++solves;
   }
+  state.counters["iterations"] = static_cast<double>(iterations) / std::max(solves, 1);
   state.counters["own_engine_share"] = static_cast<double>(exact) / std::max(solves, 1);
+  state.counters["active_rows"] = static_cast<double>(active) / std::max(solves, 1);
 }
 BENCHMARK_CAPTURE(BM_SolveWithRows, newton, "newton")->Arg(0)->Arg(4)->Arg(16);
 BENCHMARK_CAPTURE(BM_SolveWithRows, projection, "projection")->Arg(0)->Arg(4)->Arg(16);
@@ -120,5 +165,6 @@ void BM_ObstacleScenario(benchmark::State& state, const char* engine_name) {
 }
 BENCHMARK_CAPTURE(BM_ObstacleScenario, newton, "newton")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ObstacleScenario, projection, "projection")->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK_CAPTURE(BM_ObstacleScenario, nlopt, "nlopt")->Unit(benchmark::kMillisecond);
 
 }  // namespace

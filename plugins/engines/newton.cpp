@@ -16,18 +16,19 @@
 /// infeasibility), or y leaves [-varpi, varpi]; either way the solve is reported `infeasible`.
 ///
 /// General path: with live inequality rows or a non-diagonal W (still symmetric positive definite), semismooth
-/// Newton on the natural map of the whole LVI, u = [x; y; z] (see general_solve()); exact once its active set is
-/// right, typically one to three steps warm.
+/// Newton on the natural map of the whole LVI, u = [x; y; z], exact once its active set is right (one step warm),
+/// globalised by the method of multipliers with an exact semismooth Newton inner solve (see general_solve()).
 ///
-/// Fallback: where neither path settles (a step without ascent, 100 iterations on the reduced path, 50 on the
-/// general one, or a singular Newton matrix), the step is solved by `projection` (eq. 15) instead, and the info's
-/// `engine` says so.
+/// Fallback: where neither path settles (on the reduced path a step without ascent or 100 iterations; on the
+/// general one multipliers past varpi, i.e. an infeasible step, or 50 outer iterations), the step is solved by
+/// `projection` (eq. 15) instead, and the info's `engine` says so.
 /// No engine-specific TOML keys.
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
 #include "redres/engines/newton.hpp"
@@ -39,7 +40,8 @@ namespace {
 inline double box(double v, double lo, double hi) { return std::min(std::max(v, lo), hi); }
 
 constexpr int kMaxNewtonIterations = 100;
-constexpr int kMaxGeneralIterations = 100;
+constexpr int kMaxOuterIterations = 50;   // the general path's method of multipliers
+constexpr int kMaxInnerIterations = 100;  // Newton steps per augmented Lagrangian minimisation
 
 class Newton final : public LviEngine {
  public:
@@ -76,6 +78,23 @@ class Newton final : public LviEngine {
     du_.setZero(N);
     lo_u_.setZero(N);
     hi_u_.setZero(N);
+    trial_.setZero(N);
+    const int R = m_e + m_i + n;
+    Ct_.setZero(n, R);
+    row_lo_.setZero(R);
+    row_hi_.setZero(R);
+    rho_.setZero(R);
+    lambda_.setZero(R);
+    s_.setZero(R);
+    delta_r_.setZero(R);
+    breaks_ab_.assign(2 * static_cast<std::size_t>(R), 0.0);
+    xa_.setZero(n);
+    ga_.setZero(n);
+    dxa_.setZero(n);
+    wx_.setZero(n);
+    wdx_.setZero(n);
+    ha_.setZero(n, n);
+    llt_ = Eigen::LLT<Eigen::MatrixXd>(n);
     fallback_ = make_engine("projection", settings());
     fallback_result_.x.resize(0);
     fallback_->setup(n, m_e, m_i, fallback_result_);
@@ -327,12 +346,23 @@ class Newton final : public LviEngine {
     y_ = result.y;
   }
 
-  // The general path, for inequality rows and any symmetric positive definite W: semismooth Newton on the natural
-  // map of the whole LVI, e(u) = u - P_Omega(u - (M u + g)). With D the components where u - (M u + g) lies strictly
-  // inside Omega, the Newton step solves (I - D + D M) du = -e: a component on a bound moves to it, a free one makes
-  // its row of M u + g vanish. e is piecewise linear, so once the active set is right the step is exact. Returns
-  // false (and the caller falls back to projection) when the iteration does not settle within its cap, the Newton
-  // matrix is singular, or the step is not finite.
+  // The general path, for inequality rows and any symmetric positive definite W, on the whole LVI u = [x; y; z].
+  //  1. The exact step, on the natural map e(u) = u - P_Omega(u - (M u + g)): with D the components where
+  //     u - (M u + g) lies strictly inside Omega, (I - D + D M) du = -e moves a component on a bound to it and makes
+  //     a free one's row of M u + g vanish. e is piecewise linear, so once the active set is right this step lands
+  //     on the solution (exact_step_lands()). Warm starts usually land at once.
+  //  2. Where it does not land, the active set is found by the method of multipliers (augmented_lagrangian()):
+  //     every constraint, the bounds included, becomes a row c_r x in [l_r, h_r] with a multiplier lambda_r, and
+  //     each outer iteration minimises the augmented Lagrangian
+  //       L(x) = x'Wx/2 + zeta'x + sum_r rho_r/2 dist(c_r x + lambda_r / rho_r, [l_r, h_r])^2,
+  //     a strictly convex, continuously differentiable, piecewise quadratic function, by semismooth Newton with an
+  //     exact line search (its Hessian W + sum over rows outside their interval of rho_r c_r c_r' is positive
+  //     definite, and the minimiser along a direction is found by walking the breakpoints). That inner iteration
+  //     ends exactly, when a full Newton step keeps every row's side; then lambda_r <- rho_r (s_r - P(s_r)). The
+  //     method converges for every convex QP with a solution (no constraint qualification needed), and after each
+  //     outer iteration step 1 is tried from u = [x; -lambda_J; lambda_A], so the answer is exact.
+  // Returns false (and the caller falls back to projection) when the multipliers grow past varpi (no solution:
+  // the rows cannot be met inside the bounds) or the iteration caps are reached.
   bool general_solve(const QpProblem& qp, SolverResult& result) {
     const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
     const double varpi = settings().varpi;
@@ -348,61 +378,216 @@ class Newton final : public LviEngine {
     hi_u_.segment(n, me).setConstant(varpi);
     lo_u_.tail(mi).setZero();
     hi_u_.tail(mi).setConstant(varpi);
+    int iterations = 0;
     if (warm()) {
       u_.head(n) = result.x;
       u_.segment(n, me) = result.y;
       u_.tail(mi) = result.z;
     } else {
-      // Cold: x at the minimiser of x'Wx/2 + zeta'x on the box (for W's diagonal), duals zero.
-      u_.setZero();
+      // Cold: the reduced path's solution for W's diagonal, without the inequality rows (exact when W is
+      // diagonal and the rows are slack), as the start: it puts the duals of J x = d near their values.
       for (int i = 0; i < n; ++i) {
-        const double w = qp.W(i, i);
-        u_(i) = box(w > 0.0 ? -qp.zeta(i) / w : 0.0, qp.lo(i), qp.hi(i));
+        w_diag_(i) = qp.W(i, i);
+        inv_w_(i) = 1.0 / w_diag_(i);
       }
+      y_.setZero();
+      double f2 = 0.0;
+      (void)reduced_iterate<0>(qp, iterations, f2);
+      u_.setZero();
+      u_.head(n) = x_;
+      u_.segment(n, me) = y_;
     }
     const double scale =
         1.0 + std::max({qp.zeta.lpNorm<Eigen::Infinity>(), me > 0 ? qp.d.lpNorm<Eigen::Infinity>() : 0.0,
                         mi > 0 ? qp.b.lpNorm<Eigen::Infinity>() : 0.0});
     const double target = std::min(settings().tolerance, 1e-12 * scale);
-    const auto N = static_cast<Eigen::Index>(n + me + mi);
+    const auto solved = [&](double e2) {
+      result.x = u_.head(n).cwiseMax(qp.lo).cwiseMin(qp.hi);
+      result.y = u_.segment(n, me);
+      result.z = u_.tail(mi);
+      result.info.status = SolverStatus::kSolved;
+      result.info.iterations = iterations;
+      result.info.residual = std::sqrt(e2);
+      return true;
+    };
     double e2 = natural_residual2(qp, u_);
-    for (int k = 0; k <= kMaxGeneralIterations; ++k) {
-      if (std::sqrt(e2) <= target) {
-        result.x = u_.head(n).cwiseMax(qp.lo).cwiseMin(qp.hi);
-        result.y = u_.segment(n, me);
-        result.z = u_.tail(mi);
-        result.info.status = SolverStatus::kSolved;
-        result.info.iterations = k;
-        result.info.residual = std::sqrt(e2);
-        return true;
+    if (std::sqrt(e2) <= target) return solved(e2);
+    ++iterations;
+    if (exact_step_lands(qp, target, e2)) return solved(e2);
+    return augmented_lagrangian(qp, target, iterations) && (e2 = natural_residual2(qp, u_), solved(e2));
+  }
+
+  // Step 1 of general_solve() from u_ (natural_residual2(u_) just computed, so mu_ and e_ hold its values): on
+  // landing (||e|| <= target at u_ + du), moves u_ there, leaves ||e||^2 in e2 and returns true.
+  bool exact_step_lands(const QpProblem& qp, double target, double& e2) {
+    const Eigen::Index N = u_.size();
+    for (Eigen::Index i = 0; i < N; ++i) {
+      const double v = u_(i) - mu_(i);
+      if (v > lo_u_(i) && v < hi_u_(i)) {
+        K_.row(i) = M_.row(i);
+        rhs_(i) = -mu_(i);
+      } else {
+        K_.row(i).setZero();
+        K_(i, i) = 1.0;
+        rhs_(i) = -e_(i);
       }
-      if (k == kMaxGeneralIterations) break;
-      for (Eigen::Index i = 0; i < N; ++i) {
-        const double v = u_(i) - mu_(i);
-        if (v > lo_u_(i) && v < hi_u_(i)) {
-          K_.row(i) = M_.row(i);
-          rhs_(i) = -mu_(i);
-        } else {
-          K_.row(i).setZero();
-          K_(i, i) = 1.0;
-          rhs_(i) = -e_(i);
+    }
+    lu_.compute(K_);
+    if (!(std::abs(lu_.matrixLU().diagonal().prod()) > 0.0)) return false;  // singular: no step
+    du_.noalias() = lu_.solve(rhs_);
+    if (!du_.allFinite()) return false;
+    trial_ = u_ + du_;
+    const double landed = natural_residual2(qp, trial_);
+    if (!(std::sqrt(landed) <= target)) return false;
+    u_.swap(trial_);
+    e2 = landed;
+    return true;
+  }
+
+  // s_r - P_[l_r, h_r](s_r): how far s_r lies outside its interval (signed).
+  double excess(int r, double s) const { return s - box(s, row_lo_(r), row_hi_(r)); }
+
+  // Step 2 of general_solve(): the method of multipliers from u_, trying step 1 after each outer iteration.
+  // Rows r: J (m_e, l = h = d), A (m_i, l = -inf, h = b), then the bounds (n, the identity).
+  bool augmented_lagrangian(const QpProblem& qp, double target, int& iterations) {
+    const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in(), R = me + mi + n;
+    Ct_.leftCols(me) = qp.J.transpose();
+    Ct_.middleCols(me, mi) = qp.A.transpose();
+    Ct_.rightCols(n).setIdentity();
+    row_lo_.head(me) = qp.d;
+    row_hi_.head(me) = qp.d;
+    row_lo_.segment(me, mi).setConstant(-std::numeric_limits<double>::infinity());
+    row_hi_.segment(me, mi) = qp.b;
+    row_lo_.tail(n) = qp.lo;
+    row_hi_.tail(n) = qp.hi;
+    // rho_r = rho / |c_r|^2, rho a large multiple of W's scale: the outer iteration contracts the multipliers'
+    // error by about 1 / (1 + rho sigma), and the inner Hessian's conditioning stays far from double precision.
+    const double rho = 1e4 * qp.W.diagonal().cwiseAbs().maxCoeff();
+    for (int r = 0; r < R; ++r) {
+      const double c2 = Ct_.col(r).squaredNorm();
+      rho_(r) = c2 > 0.0 ? rho / c2 : 0.0;
+    }
+    rho_scale_ = 1.0;
+    // Multipliers from u_: lambda_J = -y, lambda_A = z, and the bounds' from stationarity, on a finite side only.
+    xa_ = u_.head(n);
+    lambda_.head(me) = -u_.segment(n, me);
+    lambda_.segment(me, mi) = u_.tail(mi);
+    ga_.noalias() = qp.W * xa_;
+    ga_ += qp.zeta;
+    ga_.noalias() -= qp.J.transpose() * u_.segment(n, me);
+    ga_.noalias() += qp.A.transpose() * u_.tail(mi);
+    for (int i = 0; i < n; ++i) {
+      const double l = -ga_(i);
+      lambda_(me + mi + i) = (l > 0.0 && std::isfinite(qp.hi(i))) || (l < 0.0 && std::isfinite(qp.lo(i))) ? l : 0.0;
+    }
+    const double varpi = settings().varpi;
+    double last_violation = std::numeric_limits<double>::infinity();
+    for (int outer = 0; outer < kMaxOuterIterations; ++outer) {
+      if (!minimise_augmented_lagrangian(qp, iterations)) return false;
+      // lambda_r <- rho_r (s_r - P(s_r)) at the minimiser.
+      double violation = 0.0;
+      for (int r = 0; r < R; ++r) {
+        const double cx = Ct_.col(r).dot(xa_);
+        violation = std::max(violation, std::abs(excess(r, cx)));
+        lambda_(r) = rho_(r) * excess(r, cx + (rho_(r) > 0.0 ? lambda_(r) / rho_(r) : 0.0));
+        if (!(std::abs(lambda_(r)) <= varpi)) return false;  // runaway multipliers: the rows cannot be met
+      }
+      // Where the violation does not shrink fast (large multipliers at a nearly degenerate solution, which the
+      // update approaches by rho * violation per iteration), raise the penalties tenfold (up to 1e8 times).
+      if (violation > 0.25 * last_violation && rho_scale_ < 1e8) {
+        rho_ *= 10.0;
+        rho_scale_ *= 10.0;
+      }
+      last_violation = violation;
+      u_.head(n) = xa_;
+      u_.segment(n, me) = -lambda_.head(me);
+      u_.tail(mi) = lambda_.segment(me, mi);
+      double e2 = natural_residual2(qp, u_);
+      if (std::sqrt(e2) <= target) return true;
+      ++iterations;
+      if (exact_step_lands(qp, target, e2)) return true;
+    }
+    return false;
+  }
+
+  // Minimises the augmented Lagrangian over x from xa_ (semismooth Newton, exact line search); true when a full
+  // step kept every row on its side, i.e. xa_ is the exact minimiser.
+  bool minimise_augmented_lagrangian(const QpProblem& qp, int& iterations) {
+    const int R = static_cast<int>(rho_.size());
+    for (int inner = 0; inner < kMaxInnerIterations; ++inner, ++iterations) {
+      // Gradient W x + zeta + sum_r c_r rho_r excess_r and Hessian W + sum_{r outside} rho_r c_r c_r'.
+      ga_.noalias() = qp.W * xa_;
+      ga_ += qp.zeta;
+      ha_ = qp.W;
+      for (int r = 0; r < R; ++r) {
+        const double s = Ct_.col(r).dot(xa_) + (rho_(r) > 0.0 ? lambda_(r) / rho_(r) : 0.0);
+        s_(r) = s;
+        const double ex = excess(r, s);
+        if (ex != 0.0) {
+          ga_.noalias() += (rho_(r) * ex) * Ct_.col(r);
+          ha_.selfadjointView<Eigen::Lower>().rankUpdate(Ct_.col(r), rho_(r));  // LLT reads the lower triangle
         }
       }
-      lu_.compute(K_);
-      if (!(std::abs(lu_.matrixLU().diagonal().prod()) > 0.0)) return false;  // singular: no Newton step
-      du_.noalias() = lu_.solve(rhs_);
-      if (!du_.allFinite()) return false;
-      // The full step is exact once the active set is right; before that it may overshoot, so halve it until the
-      // natural residual decreases (the merit ||e||^2 is piecewise quadratic along du).
-      double t = 1.0, trial = 0.0;
-      for (int halvings = 0;; ++halvings) {
-        rhs_ = u_ + t * du_;  // the trial point (rhs_ is free until the next Newton system)
-        trial = natural_residual2(qp, rhs_);
-        if (trial < (1.0 - 1e-4 * t) * e2 || halvings == 30) break;
-        t *= 0.5;
+      llt_.compute(ha_);
+      if (llt_.info() != Eigen::Success) return false;
+      dxa_.noalias() = llt_.solve(ga_);
+      dxa_ = -dxa_;
+      if (!dxa_.allFinite()) return false;
+      // phi'(t) along x + t dx: a0 + t q + sum_r rho_r delta_r excess_r(s_r + t delta_r), increasing and
+      // piecewise linear, with breakpoints where some s_r + t delta_r crosses l_r or h_r.
+      wx_.noalias() = qp.W * xa_;
+      wdx_.noalias() = qp.W * dxa_;
+      const double a0 = dxa_.dot(wx_) + dxa_.dot(qp.zeta);
+      const double q = dxa_.dot(wdx_);
+      bool same_side = true;
+      int count = 0;
+      for (int r = 0; r < R; ++r) {
+        const double delta = Ct_.col(r).dot(dxa_);
+        delta_r_(r) = delta;
+        const double s0 = s_(r), s1 = s0 + delta;
+        const int side0 = static_cast<int>(s0 > row_hi_(r)) - static_cast<int>(s0 < row_lo_(r));
+        const int side1 = static_cast<int>(s1 > row_hi_(r)) - static_cast<int>(s1 < row_lo_(r));
+        same_side &= side0 == side1;
+        if (delta != 0.0 && rho_(r) > 0.0) {
+          for (const double bound : {row_lo_(r), row_hi_(r)}) {
+            const double t = (bound - s0) / delta;
+            if (std::isfinite(t) && t > 0.0) breaks_ab_[static_cast<std::size_t>(count++)] = t;
+          }
+        }
       }
-      u_ = rhs_;  // mu_ and e_ already hold its values: the last trial was this point
-      e2 = trial;
+      const auto slope = [&](double t) {
+        double v = a0 + t * q;
+        for (int r = 0; r < R; ++r) {
+          if (delta_r_(r) != 0.0) v += rho_(r) * delta_r_(r) * excess(r, s_(r) + t * delta_r_(r));
+        }
+        return v;
+      };
+      if (same_side) {
+        // The quadratic model is exact on [0, 1]: the full step reaches the minimiser.
+        xa_ += dxa_;
+        ++iterations;
+        return true;
+      }
+      std::sort(breaks_ab_.begin(), breaks_ab_.begin() + count);
+      double t0 = 0.0, g0 = slope(0.0), t = 0.0;
+      for (int k = 0;; ++k) {
+        // Past the last breakpoint phi' is linear for ever, with a positive slope (>= q > 0).
+        const double t1 = k < count ? breaks_ab_[static_cast<std::size_t>(k)] : t0 + std::max(1.0, t0);
+        if (t1 <= t0) continue;
+        const double g1 = slope(t1);
+        if (g1 >= 0.0) {
+          t = g1 > g0 ? t0 + (t1 - t0) * (-g0) / (g1 - g0) : t1;
+          break;
+        }
+        if (k >= count) {
+          t = t1 + (t1 - t0) * (-g1) / (g1 - g0);
+          break;
+        }
+        t0 = t1;
+        g0 = g1;
+      }
+      if (!(t > 0.0) || !std::isfinite(t)) return false;
+      xa_ += t * dxa_;
     }
     return false;
   }
@@ -469,33 +654,49 @@ class Newton final : public LviEngine {
 
   template <int kRows>
   void run(const QpProblem& qp, SolverResult& result) {
-    SolverInfo& info = result.info;
+    if (!warm()) y_.setZero();
+    int k = 0;
+    double f2 = 0.0;
+    switch (reduced_iterate<kRows>(qp, k, f2)) {
+      case Reduced::kConverged: finish(result, SolverStatus::kSolved, k, f2); return;
+      case Reduced::kInfeasible: finish(result, SolverStatus::kInfeasible, k, f2); return;
+      case Reduced::kStalled:
+        result.info.diagnosis = "newton did not converge in " + std::to_string(k) + " iterations (residual " +
+                                std::to_string(std::sqrt(f2)) + "); fell back to projection";
+        run_fallback(qp, result);
+        return;
+    }
+  }
+
+  enum class Reduced { kConverged, kInfeasible, kStalled };
+
+  // The reduced path's iteration from y_ (inv_w_ holds 1 / W_ii): leaves x(y), y and |F|^2 in x_, y_ and f2, the
+  // iterations taken in k. kInfeasible: the dual is unbounded along a step, or y left [-varpi, varpi] (then
+  // clamped back); kStalled: no ascent, a Newton system that cannot be solved, or the iteration cap.
+  template <int kRows>
+  Reduced reduced_iterate(const QpProblem& qp, int& k, double& f2) {
     const int me = rows<kRows>(qp);
     double d_max = 0.0;
     for (int r = 0; r < me; ++r) d_max = std::max(d_max, std::abs(qp.d(r)));
-    if (!warm()) y_.setZero();
     const double varpi = settings().varpi;
     const double target = std::min(settings().tolerance, 1e-12 * (1.0 + d_max));
 
-    double f2 = evaluate<kRows>(qp);
-    int k = 0;
-    bool converged = false;
-    for (;; ++k) {
-      if (f2 <= target * target) {
-        converged = true;
-        break;
-      }
-      if (k >= kMaxNewtonIterations) break;
+    f2 = evaluate<kRows>(qp);
+    for (k = 0;; ++k) {
+      if (f2 <= target * target) return Reduced::kConverged;
+      if (k >= kMaxNewtonIterations) return Reduced::kStalled;
       // Where the free joints do not span the rows (a degenerate solution, where some v_i sits on its bound),
       // G is singular: regularise it proximally with |F| (Levenberg-Marquardt), which vanishes at the solution.
-      if (!solve_newton_system<kRows>(qp, 0.0) && !solve_newton_system<kRows>(qp, std::sqrt(f2))) break;
+      if (!solve_newton_system<kRows>(qp, 0.0) && !solve_newton_system<kRows>(qp, std::sqrt(f2))) {
+        return Reduced::kStalled;
+      }
       const double step = exact_step<kRows>(qp);
       if (std::isinf(step)) {
         // phi grows linearly for ever along delta: the dual is unbounded, so J x = d cannot be met.
-        finish(result, SolverStatus::kInfeasible, k + 1, f2);
-        return;
+        ++k;
+        return Reduced::kInfeasible;
       }
-      if (!(step > 0.0)) break;  // no ascent: leave it to the fallback
+      if (!(step > 0.0)) return Reduced::kStalled;  // no ascent: leave it to the fallback
       bool outside = false;
       for (int r = 0; r < me; ++r) {
         y_(r) += step * delta_(r);
@@ -514,17 +715,10 @@ class Newton final : public LviEngine {
       if (outside) {
         // The duals left the LVI's box: J x = d cannot be met inside the bounds.
         y_ = y_.cwiseMax(-varpi).cwiseMin(varpi);
-        finish(result, SolverStatus::kInfeasible, k + 1, f2);
-        return;
+        ++k;
+        return Reduced::kInfeasible;
       }
     }
-    if (!converged) {
-      info.diagnosis = "newton did not converge in " + std::to_string(k) + " iterations (residual " +
-                       std::to_string(std::sqrt(f2)) + "); fell back to projection";
-      run_fallback(qp, result);
-      return;
-    }
-    finish(result, SolverStatus::kSolved, k, f2);
   }
 
   void finish(SolverResult& result, SolverStatus status, int iterations, double f2) const {
@@ -546,12 +740,21 @@ class Newton final : public LviEngine {
   Eigen::MatrixXd M_, K_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   Eigen::VectorXd u_, mu_, e_, rhs_, du_, lo_u_, hi_u_;
+  Eigen::VectorXd trial_;
+  // The method of multipliers: rows C (as C'), their intervals, penalties, multipliers, s = C x + lambda / rho, C dx;
+  // x, the gradient, the Newton step and the Hessian of the augmented Lagrangian, and its Cholesky factor.
+  Eigen::MatrixXd Ct_;  // the rows c_r as columns
+  Eigen::VectorXd row_lo_, row_hi_, rho_, lambda_, s_, delta_r_, xa_, ga_, dxa_, wx_, wdx_;
+  std::vector<double> breaks_ab_;
+  double rho_scale_ = 1.0;
+  Eigen::MatrixXd ha_;
+  Eigen::LLT<Eigen::MatrixXd> llt_;
   std::unique_ptr<LviEngine> fallback_;
   SolverResult fallback_result_;
 };
 
 const bool kRegistered = engine_registry().add<NewtonConfig>(
-    "newton", "semismooth Newton on the reduced eq. 14 (exact; diagonal W, equality rows and bounds; else projection)",
+    "newton", "semismooth Newton on eq. 14 (exact; equality and inequality rows, bounds, any W > 0)",
     [](const NewtonConfig& /*config*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
       return std::make_unique<Newton>(s);
     });

@@ -10,7 +10,7 @@
 ///
 /// Engines (selected by `engine` in the scenario's [solver] table):
 /// - `projection`: the paper's eq. 15, u <- u - (||e||^2 / ||phi||^2) phi with phi = (M' + I) e;
-/// - `newton`: semismooth Newton on the reduced eq. 14 (exact and fast; see newton.cpp for its fallback);
+/// - `newton`: semismooth Newton on eq. 14 (exact and fast, with inequality rows and dense W too; see newton.cpp);
 /// - `nlopt`: NLopt's SLSQP on the QP itself, an independent cross-check.
 ///
 /// Outcomes are statuses, never exceptions: a bound conflict lo_i > hi_i, or equality rows that cannot be met

@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// `newton`: semismooth Newton on the reduced eq. 14 (exact; diagonal W, equality rows and bounds; otherwise it
-/// falls back to projection). Build it with engine_registry().create("newton", NewtonConfig{}, settings).
+/// `newton`: semismooth Newton on eq. 14, exact: on the reduced dual for diagonal W with equality rows and bounds,
+/// on the whole LVI (globalised by the method of multipliers) with inequality rows or a dense W; an infeasible step
+/// falls back to projection. Build it with engine_registry().create("newton", NewtonConfig{}, settings).
 
 #include "redres/lvi.hpp"
 

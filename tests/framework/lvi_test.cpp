@@ -329,6 +329,36 @@ TEST(LviRealTime, ProjectionAndNewtonSolvesAllocateNothing) {
   }
 }
 
+// newton's general path, cold (so the method of multipliers runs, not only the exact step): 16 inequality rows and
+// a dense W, solved by newton itself without allocating.
+TEST(LviRealTime, NewtonGeneralPathAllocatesNothing) {
+  if (!testing::allocation_counting_available()) {
+    GTEST_SKIP() << "AddressSanitizer owns malloc here; the release build runs this check";
+  }
+  std::mt19937 rng(99);
+  std::vector<testing::RandomQp> family;
+  for (int k = 0; k < 20; ++k) family.push_back(random_qp(rng, 7, 3, 16, k % 2 == 0));
+  auto engine = make_engine("newton", SolverSettings{.warm_start = false});
+  SolverResult r;
+  engine->setup(7, 3, 16, r);
+  engine->solve(family[0].qp, r);  // warm-up
+  long count = 0;
+  int general_iterations = 0;
+  {
+    const testing::AllocationCounter counter;
+    for (const testing::RandomQp& rq : family) {
+      engine->solve(rq.qp, r);
+      if (r.info.status != SolverStatus::kSolved || r.info.engine != "newton") break;
+      general_iterations += r.info.iterations;
+    }
+    count = counter.count();
+  }
+  ASSERT_EQ(r.info.status, SolverStatus::kSolved) << r.info.diagnosis;
+  ASSERT_EQ(r.info.engine, "newton");
+  EXPECT_GT(general_iterations, 2 * static_cast<int>(family.size()));  // more than the exact step alone
+  EXPECT_EQ(count, 0);
+}
+
 // NLopt's SLSQP mallocs its work array inside every nlopt_optimize() (it has no caller-provided workspace), so the
 // `nlopt` engine cannot be allocation-free; everything redres adds around it must be. The count per solve is
 // pinned to what a bare nlopt_optimize() of the same size allocates, measured here.

@@ -76,6 +76,45 @@ void BM_CollisionStep(benchmark::State& state) {
 }
 BENCHMARK(BM_CollisionStep);
 
+// One obstacle_avoidance step of the Panda (9 link shapes) among `obstacles` static obstacles (spheres, capsules and
+// boxes scattered around it, d_i = 0.15 m), brute force (arg 1 = 0) or with FCL's AABB tree (arg 1 = 1).
+void BM_ClutterStep(benchmark::State& state) {
+  const int count = static_cast<int>(state.range(0));
+  const bool tree = state.range(1) != 0;
+  const redres::RobotModel robot = redres::load_robot(redres::source_path("robots/franka_panda.toml"));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> pos(-0.9, 0.9), up(0.0, 1.2);
+  const redres::ShapeSpec::Kind kinds[] = {redres::ShapeSpec::Kind::kSphere, redres::ShapeSpec::Kind::kCapsule,
+                                           redres::ShapeSpec::Kind::kBox};
+  std::vector<redres::ShapeSpec> obstacles;
+  for (int k = 0; k < count; ++k) {
+    redres::ShapeSpec s = shape(kinds[k % 3]);
+    s.xyz = {pos(rng), pos(rng), up(rng)};
+    obstacles.push_back(s);
+  }
+  using B = redres::ObstacleAvoidance::Config::Broadphase;
+  std::vector<std::unique_ptr<redres::Constraint>> constraints;
+  constraints.push_back(std::make_unique<redres::ObstacleAvoidance>(
+      redres::ObstacleAvoidance::Config{
+          .obstacles = obstacles, .influence_distance = 0.15, .broadphase = tree ? B::kAlways : B::kNever},
+      robot));
+  const redres::Scheme scheme(robot, {}, std::move(constraints));
+  redres::QpProblem qp;
+  scheme.setup(qp);
+  redres::KinematicsData kin(robot);
+  Eigen::VectorXd theta = robot.home();
+  redres::Context ctx{0.0, 10.0, 0.01, &robot, &kin, nullptr, nullptr};
+  for (auto _ : state) {
+    theta(0) += 1e-4;
+    redres::compute_kinematics(robot, theta, kin, redres::KinematicsLevel::kJacobian);
+    scheme.build(ctx, qp);
+    benchmark::DoNotOptimize(qp.b.data());
+  }
+  state.counters["pairs"] = qp.m_in();
+  state.SetLabel(tree ? "aabb-tree" : "brute-force");
+}
+BENCHMARK(BM_ClutterStep)->ArgsProduct({{10, 40, 160}, {0, 1}});
+
 // 64 random feasible QPs (7 joints, 3 equality rows, `rows` inequality rows) whose rows are live: each one cuts off
 // the minimiser without rows (random direction, turned against it), while the known feasible point keeps them
 // feasible; several bind at the answer, as when an arm presses against obstacles.

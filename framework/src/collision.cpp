@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <stdexcept>
 
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
 #include <fcl/geometry/shape/cylinder.h>
@@ -144,6 +146,74 @@ void closest_on_segments(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, c
   }
 }
 
+// Signed distance from point q (box frame) to the box with half sides h, and the nearest point on its surface with
+// the outward unit direction u (from that point towards q when q is outside; the nearest face's normal inside).
+double box_point(const Eigen::Vector3d& q, const Eigen::Vector3d& h, Eigen::Vector3d& on_box, Eigen::Vector3d& u) {
+  const Eigen::Vector3d excess = q.cwiseAbs() - h;
+  if ((excess.array() > 0.0).any()) {
+    on_box = q.cwiseMax(-h).cwiseMin(h);
+    const Eigen::Vector3d diff = q - on_box;
+    const double d = diff.norm();
+    u = diff / d;
+    return d;
+  }
+  Eigen::Index k = 0;
+  const double d = excess.maxCoeff(&k);  // <= 0: the nearest face is the one along axis k
+  const double side = q(k) < 0.0 ? -1.0 : 1.0;
+  on_box = q;
+  on_box(k) = side * h(k);
+  u = Eigen::Vector3d::Zero();
+  u(k) = side;
+  return d;
+}
+
+// Signed distance between a sphere or capsule (axis [p0, p1] in the world, radius r) and a box (pose Tb, half sides
+// h), exact also when they overlap: the signed distance to a box is convex, so its minimum along the axis is found
+// by golden-section search. Witness points: on the round shape and on the box, with round - box = d u.
+void round_box(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double r, const Eigen::Isometry3d& Tb,
+               const Eigen::Vector3d& h, double& d, Eigen::Vector3d& on_round, Eigen::Vector3d& on_box) {
+  const Eigen::Isometry3d to_box = Tb.inverse();
+  const Eigen::Vector3d q0 = to_box * p0, q1 = to_box * p1;
+  Eigen::Vector3d c, u;
+  const auto f = [&](double s) { return box_point(q0 + s * (q1 - q0), h, c, u); };
+  double lo = 0.0, hi = 1.0;
+  if ((q1 - q0).squaredNorm() > 0.0) {
+    constexpr double g = 0.6180339887498949;  // (sqrt 5 - 1) / 2
+    double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
+    for (int it = 0; it < 80 && hi - lo > 1e-12; ++it) {
+      if (f1 <= f2) {
+        hi = x2;
+        x2 = x1;
+        f2 = f1;
+        x1 = hi - g * (hi - lo);
+        f1 = f(x1);
+      } else {
+        lo = x1;
+        x1 = x2;
+        f1 = f2;
+        x2 = lo + g * (hi - lo);
+        f2 = f(x2);
+      }
+    }
+  }
+  const double s = 0.5 * (lo + hi);
+  // The ends too: the minimum of a convex function on [0, 1] may sit there.
+  double best_s = s, best = f(s);
+  for (const double e : {0.0, 1.0}) {
+    const double v = f(e);
+    if (v < best) {
+      best = v;
+      best_s = e;
+    }
+  }
+  const Eigen::Vector3d q = q0 + best_s * (q1 - q0);
+  best = box_point(q, h, c, u);
+  d = best - r;
+  const Eigen::Vector3d u_world = Tb.linear() * u;
+  on_box = Tb * c;
+  on_round = Tb * q - r * u_world;
+}
+
 }  // namespace
 
 struct DistanceQuery::Impl {
@@ -153,14 +223,42 @@ struct DistanceQuery::Impl {
     double half_length = 0.0;
   };
   std::vector<Round> round;
+  std::vector<std::optional<Eigen::Vector3d>> box_half;  // a box's half sides
   std::vector<std::shared_ptr<fcl::CollisionGeometryd>> geometry;
   // One CollisionObject per shape: FCL's object overload of distance() allocates nothing for analytic pairs, while
   // its geometry-and-transform overload allocates once per call (measured: one per query).
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
   fcl::DistanceRequestd unsigned_request;
-  fcl::DistanceRequestd signed_request;
   mutable fcl::DistanceResultd result;
+  // The broadphase over the group [group_first, group_first + group_count): its objects carry their shape index as
+  // user data.
+  std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> tree;
+  int group_first = 0, group_count = 0;
 };
+
+namespace {
+
+// What near()'s callback collects: group objects whose bounding box is closer than `within` to the query's.
+struct NearData {
+  const fcl::AABBd* query = nullptr;
+  double within = 0.0;
+  int* out = nullptr;
+  int count = 0;
+};
+
+// FCL's tree calls this for each leaf whose box is closer to the query's than `dist` (leaves reached before the
+// first call are not filtered, hence the test here). Keeping dist at `within` makes the tree return every such leaf
+// rather than only the nearest (its own callbacks lower dist to the smallest distance found).
+bool near_callback(fcl::CollisionObjectd* group_object, fcl::CollisionObjectd* /*query*/, void* data, double& dist) {
+  auto& d = *static_cast<NearData*>(data);
+  if (group_object->getAABB().distance(*d.query) < d.within) {
+    d.out[d.count++] = static_cast<int>(reinterpret_cast<std::intptr_t>(group_object->getUserData()));
+  }
+  dist = d.within;
+  return false;  // never stop early
+}
+
+}  // namespace
 
 DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::make_unique<Impl>()) {
   for (std::size_t i = 0; i < shapes.size(); ++i) {
@@ -174,6 +272,8 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
     const double radius = s.radius.value_or(0.0);
     impl_->round.push_back(
         {round, round ? radius : 0.0, s.shape == ShapeSpec::Kind::kCapsule ? 0.5 * s.axis_length() : 0.0});
+    impl_->box_half.push_back(s.shape == ShapeSpec::Kind::kBox ? std::optional<Eigen::Vector3d>(0.5 * vec(*s.size))
+                                                               : std::nullopt);
     switch (s.shape) {
       case ShapeSpec::Kind::kSphere: impl_->geometry.push_back(std::make_shared<fcl::Sphered>(radius)); break;
       case ShapeSpec::Kind::kCapsule:
@@ -195,7 +295,6 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
   for (const auto& g : impl_->geometry) impl_->objects.push_back(std::make_unique<fcl::CollisionObjectd>(g));
   // Both requests use the libccd solver: signed distance with the independent solver aborts on penetration.
   impl_->unsigned_request = fcl::DistanceRequestd(true, false, 0.0, 0.0, 1e-8, fcl::GST_LIBCCD);
-  impl_->signed_request = fcl::DistanceRequestd(true, true, 0.0, 0.0, 1e-8, fcl::GST_LIBCCD);
 }
 
 DistanceQuery::~DistanceQuery() = default;
@@ -213,6 +312,28 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
   fcl::CollisionObjectd* ob = impl_->objects[static_cast<std::size_t>(b)].get();
   oa->setTransform(fcl::Transform3d(Ta.matrix()));
   ob->setTransform(fcl::Transform3d(Tb.matrix()));
+  {
+    const Impl::Round& ra = impl_->round[static_cast<std::size_t>(a)];
+    const Impl::Round& rb = impl_->round[static_cast<std::size_t>(b)];
+    const bool box_a = impl_->box_half[static_cast<std::size_t>(a)].has_value();
+    const bool box_b = impl_->box_half[static_cast<std::size_t>(b)].has_value();
+    if ((ra.round && box_b) || (box_a && rb.round)) {
+      // A sphere or capsule against a box (a link and a table, say), apart or overlapping: exact, without FCL,
+      // whose GJK allocates on every such query and whose EPA (for an overlap) can abort the process in 0.7 (a live
+      // assert in Debian's build).
+      const bool a_round = ra.round;
+      const Impl::Round& rr = a_round ? ra : rb;
+      const Eigen::Isometry3d& Tr = a_round ? Ta : Tb;
+      const Eigen::Vector3d z = Tr.linear().col(2) * rr.half_length;
+      Eigen::Vector3d on_round, on_box;
+      round_box(Tr.translation() - z, Tr.translation() + z, rr.radius, a_round ? Tb : Ta,
+                *impl_->box_half[static_cast<std::size_t>(a_round ? b : a)], out.distance, on_round, on_box);
+      out.ok = true;
+      out.point_a = a_round ? on_round : on_box;
+      out.point_b = a_round ? on_box : on_round;
+      return out;
+    }
+  }
   fcl::DistanceResultd& r = impl_->result;
   try {
     r.clear();  // a stale negative result would be kept: FCL only lowers min_distance
@@ -237,8 +358,10 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
         out.point_b = cb + rb.radius * u;
         return out;
       }
-      r.clear();
-      fcl::distance(oa, ob, impl_->signed_request, r);
+      // Other overlapping pairs (a cylinder, or two boxes) would need FCL's EPA, which loops or aborts on such
+      // pairs in 0.7: the pair is reported as not measured rather than risk the process.
+      out.error = "the shapes overlap, and FCL 0.7 cannot measure the depth of a cylinder or box-box overlap reliably";
+      return out;
     }
   } catch (const std::exception&) {
     out.error = "FCL failed on this pair (GJK/EPA)";
@@ -253,6 +376,46 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
   out.point_a = r.nearest_points[0];
   out.point_b = r.nearest_points[1];
   return out;
+}
+
+void DistanceQuery::build_broadphase(int first, int count) {
+  if (first < 0 || count < 0 || first + count > size()) {
+    throw std::invalid_argument("DistanceQuery::build_broadphase: shapes [" + std::to_string(first) + ", " +
+                                std::to_string(first + count) + ") are not within the " + std::to_string(size()) +
+                                " shapes");
+  }
+  impl_->tree = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
+  impl_->group_first = first;
+  impl_->group_count = count;
+  std::vector<fcl::CollisionObjectd*> group;
+  for (int k = 0; k < count; ++k) {
+    fcl::CollisionObjectd* o = impl_->objects[static_cast<std::size_t>(first + k)].get();
+    o->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(first + k)));
+    o->computeAABB();
+    group.push_back(o);
+  }
+  impl_->tree->registerObjects(group);
+  impl_->tree->setup();
+}
+
+void DistanceQuery::move_group(const Eigen::Isometry3d* poses) {
+  if (!impl_->tree) return;
+  for (int k = 0; k < impl_->group_count; ++k) {
+    fcl::CollisionObjectd* o = impl_->objects[static_cast<std::size_t>(impl_->group_first + k)].get();
+    o->setTransform(fcl::Transform3d(poses[k].matrix()));
+    o->computeAABB();
+  }
+  impl_->tree->update();
+}
+
+int DistanceQuery::near(int a, const Eigen::Isometry3d& Ta, double within, int* out) const {
+  if (!impl_->tree || a < 0 || a >= size()) return 0;
+  fcl::CollisionObjectd* q = impl_->objects[static_cast<std::size_t>(a)].get();
+  q->setTransform(fcl::Transform3d(Ta.matrix()));
+  q->computeAABB();
+  NearData data{&q->getAABB(), within, out, 0};
+  impl_->tree->distance(q, &data, near_callback);
+  return data.count;
 }
 
 }  // namespace redres

@@ -47,9 +47,21 @@ void check_damper(double influence_distance, double safety_distance) {
 
 bool PairDistances::violated() const {
   for (double d : distance_) {
-    if (d < 0.0) return true;
+    if (d < 0.0 || std::isnan(d)) return true;  // NaN: not measured, so it may overlap
   }
   return false;
+}
+
+std::string PairDistances::describe_violation(const std::function<std::string(int)>& describe_row) const {
+  const int w = worst();
+  if (distance_[static_cast<std::size_t>(w)] < 0.0) return "in collision: " + describe_row(w);
+  for (std::size_t r = 0; r < distance_.size(); ++r) {
+    if (std::isnan(distance_[r])) {
+      return "cannot measure the distance (the shapes may overlap; FCL failed on the pair): " +
+             describe_row(static_cast<int>(r));
+    }
+  }
+  return {};
 }
 
 int PairDistances::worst() const {

@@ -21,7 +21,9 @@ const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
       {field("obstacles", &C::obstacles, "", "the obstacles (world frame)").required(),
        field("influence_distance", &C::influence_distance, "m", "d_i: rows for pairs closer than this"),
        field("safety_distance", &C::safety_distance, "m", "d_s: the distance the damper holds"),
-       field("xi", &C::xi, "m/s", "damper gain: the largest approach speed, at d_i", greater(0.0))},
+       field("xi", &C::xi, "m/s", "damper gain: the largest approach speed, at d_i", greater(0.0)),
+       field("broadphase", &C::broadphase, "",
+             "how pairs are found: auto (FCL's AABB tree above 256 pairs), always, never (brute force)")},
       [](const C& c) {
         check_damper(c.influence_distance, c.safety_distance);
         for (std::size_t k = 0; k < c.obstacles.size(); ++k) {
@@ -62,6 +64,15 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
   jacobian_.setZero(3, robot.dof());
   distances_ = PairDistances(links_ * obstacles_, {config.influence_distance, config.safety_distance, config.xi},
                              "min_obstacle_distance", "obstacle_rows_active");
+  using B = Config::Broadphase;
+  broadphase_ =
+      config_.broadphase == B::kAlways || (config_.broadphase == B::kAuto && links_ * obstacles_ > kBroadphasePairs);
+  for (const ShapeSpec& o : config_.obstacles) moving_ = moving_ || o.velocity.has_value();
+  if (broadphase_) {
+    query_->build_broadphase(links_, obstacles_);
+    poses_.resize(static_cast<std::size_t>(obstacles_));
+    candidates_.resize(static_cast<std::size_t>(obstacles_));
+  }
 }
 
 ObstacleAvoidance::~ObstacleAvoidance() = default;
@@ -77,26 +88,62 @@ Eigen::Isometry3d ObstacleAvoidance::obstacle_pose(int k, double t) const {
 
 void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder) const {
   const KinematicsData& kin = *ctx.kinematics;
-  const bool planar = robot_->kind() == ChainKind::kPlanar;
   auto A = builder.inequality_matrix();
   auto b = builder.inequality_rhs();
   const auto& links = robot_->link_shapes();
+  if (broadphase_) {
+    add_near_pairs(ctx, builder);
+    return;
+  }
   for (int o = 0; o < obstacles_; ++o) {
     const Eigen::Isometry3d To = obstacle_pose(o, ctx.t);
-    const auto& v = config_.obstacles[static_cast<std::size_t>(o)].velocity;
-    const Eigen::Vector3d v_b = v ? vec(*v) : Eigen::Vector3d::Zero();
     for (int l = 0; l < links_; ++l) {
-      const int row = o * links_ + l;
       const auto& shape = links[static_cast<std::size_t>(l)];
-      const Eigen::Isometry3d Tl = kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose;
-      const ShapeDistance d = query_->distance(l, Tl, links_ + o, To);
-      Eigen::Vector3d n;
-      if (!distances_.take(row, d, planar, Tl.translation() - To.translation(), n)) {
-        slack_row(A.row(row), b(row));
-        continue;
-      }
-      point_jacobian(*robot_, kin, shape.link, d.point_a, jacobian_);
-      damper_row(distances_.damper(), d.distance, n, jacobian_, v_b, A.row(row), b(row));
+      pair_row(kin, l, kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose, o, To, A, b);
+    }
+  }
+}
+
+void ObstacleAvoidance::pair_row(const KinematicsData& kin, int l, const Eigen::Isometry3d& Tl, int o,
+                                 const Eigen::Isometry3d& To, Eigen::Block<Eigen::MatrixXd>& A,
+                                 Eigen::VectorBlock<Eigen::VectorXd>& b) const {
+  const int row = o * links_ + l;
+  const auto& v = config_.obstacles[static_cast<std::size_t>(o)].velocity;
+  const Eigen::Vector3d v_b = v ? vec(*v) : Eigen::Vector3d::Zero();
+  const ShapeDistance d = query_->distance(l, Tl, links_ + o, To);
+  Eigen::Vector3d n;
+  if (!distances_.take(row, d, robot_->kind() == ChainKind::kPlanar, Tl.translation() - To.translation(), n)) {
+    slack_row(A.row(row), b(row));
+    return;
+  }
+  point_jacobian(*robot_, kin, robot_->link_shapes()[static_cast<std::size_t>(l)].link, d.point_a, jacobian_);
+  damper_row(distances_.damper(), d.distance, n, jacobian_, v_b, A.row(row), b(row));
+}
+
+void ObstacleAvoidance::add_near_pairs(const Context& ctx, QpBuilder& builder) const {
+  const KinematicsData& kin = *ctx.kinematics;
+  auto A = builder.inequality_matrix();
+  auto b = builder.inequality_rhs();
+  const auto& links = robot_->link_shapes();
+  for (int o = 0; o < obstacles_; ++o) poses_[static_cast<std::size_t>(o)] = obstacle_pose(o, ctx.t);
+  // The tree holds the obstacles' boxes: static ones are placed once, moving ones refitted every step.
+  if (moving_ || !placed_) {
+    query_->move_group(poses_.data());
+    placed_ = true;
+  }
+  for (int l = 0; l < links_; ++l) {
+    const auto& shape = links[static_cast<std::size_t>(l)];
+    const Eigen::Isometry3d Tl = kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose;
+    // Every pair of this link shape is beyond d_i unless the tree says otherwise.
+    for (int o = 0; o < obstacles_; ++o) {
+      const int row = o * links_ + l;
+      distances_.beyond(row);
+      slack_row(A.row(row), b(row));
+    }
+    const int count = query_->near(l, Tl, distances_.damper().influence_distance, candidates_.data());
+    for (int k = 0; k < count; ++k) {
+      const int o = candidates_[static_cast<std::size_t>(k)] - links_;
+      pair_row(kin, l, Tl, o, poses_[static_cast<std::size_t>(o)], A, b);
     }
   }
 }
@@ -115,7 +162,7 @@ std::string ObstacleAvoidance::describe_inequality_row(int row) const {
 bool ObstacleAvoidance::violated() const { return distances_.violated(); }
 
 std::string ObstacleAvoidance::describe_violation() const {
-  return "in collision: " + describe_inequality_row(distances_.worst());
+  return distances_.describe_violation([this](int row) { return describe_inequality_row(row); });
 }
 
 std::vector<std::string> ObstacleAvoidance::recorded_columns() const { return distances_.columns(); }

@@ -88,7 +88,7 @@ std::string SelfCollision::describe_inequality_row(int row) const {
 bool SelfCollision::violated() const { return distances_.violated(); }
 
 std::string SelfCollision::describe_violation() const {
-  return "in collision: " + describe_inequality_row(distances_.worst());
+  return distances_.describe_violation([this](int row) { return describe_inequality_row(row); });
 }
 
 std::vector<std::string> SelfCollision::recorded_columns() const { return distances_.columns(); }

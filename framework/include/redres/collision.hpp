@@ -5,15 +5,15 @@
 /// libfcl 0.7) behind DistanceQuery, whose one .cpp is the only place that includes FCL.
 ///
 /// FCL 0.7 facts the implementation respects (measured on Debian's package; docs/collision.md):
-/// - an overlapping pair queried without signed distance returns -1 with zeroed points, so a query is unsigned
-///   first and repeated with signed distance (GJK/EPA, libccd solver; never the independent solver, which aborts
-///   on penetrating capsules) only when the unsigned result is <= 0; for two overlapping spheres or capsules the
-///   penetration comes from their axes instead (exact, and FCL's GJK signed distance was seen to loop forever on
-///   penetrating capsules);
+/// - an overlapping pair queried without signed distance returns -1 with zeroed points, and FCL's signed distance
+///   (GJK/EPA) loops or aborts on some overlapping pairs (Debian builds with live asserts; the independent solver
+///   aborts on penetrating capsules): every query is unsigned, and an overlap is measured without FCL, exactly, for
+///   a sphere or capsule against a sphere, capsule or box; the depth of other overlapping pairs (a cylinder, two
+///   boxes) is not measured, and the query reports the pair as failed (ok = false);
 /// - the result is cleared before every query, and `min_distance` is read (not the return value);
 /// - witness points are in the world frame, and p_b - p_a flips when the shapes overlap;
 /// - Halfspace and Plane distance queries crash, so they are not offered (a wall is a thin box);
-/// - FCL throws std::logic_error from EPA in rare near-touching box configurations: caught, reported as a status.
+/// - FCL throws std::logic_error from GJK in rare near-touching box configurations: caught, reported as a status.
 
 #include <array>
 #include <limits>
@@ -81,9 +81,20 @@ class DistanceQuery {
   /// Number of shapes.
   [[nodiscard]] int size() const noexcept;
   /// Signed distance between shape a at world pose Ta and shape b at world pose Tb (each pose is the shape's own,
-  /// i.e. owner pose * ShapeSpec::pose()). Allocation-free when the shapes are apart and analytic (sphere and
-  /// capsule pairs); overlapping pairs run FCL's GJK/EPA, which allocates.
+  /// i.e. owner pose * ShapeSpec::pose()). Allocation-free for sphere and capsule pairs and for any overlap it
+  /// measures; pairs apart that involve a box or a cylinder run FCL's GJK, which may allocate.
   [[nodiscard]] ShapeDistance distance(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb) const;
+
+  /// Broadphase, for scenes with many pairs: puts shapes [first, first + count) (the "group", e.g. the obstacles)
+  /// into FCL's dynamic AABB tree. Call once, then move_group() before the first near().
+  void build_broadphase(int first, int count);
+  /// Places group shape first + k at poses[k] (world), for every k, and refits the tree. (FCL does not refresh an
+  /// object's bounding box on setTransform; this calls computeAABB() on each and then the tree's update().)
+  void move_group(const Eigen::Isometry3d* poses);
+  /// The group shapes whose bounding boxes come closer than `within` to the bounding box of shape a at pose Ta: a
+  /// superset of the group shapes within `within` of shape a. Writes their indices (first + k) into `out`, which
+  /// must hold the group's size, and returns how many. Without build_broadphase(), every group is empty.
+  int near(int a, const Eigen::Isometry3d& Ta, double within, int* out) const;
 
  private:
   struct Impl;

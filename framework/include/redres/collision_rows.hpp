@@ -12,6 +12,8 @@
 /// distance, zero at the safety distance. For d < d_s the bound turns positive: the pair must separate at
 /// xi (d_s - d) / (d_i - d_s), a speed bounded by the penetration; the arm is pushed out, not held.
 
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -48,12 +50,17 @@ class PairDistances {
   /// `fallback`). Returns whether the pair gets a damper row: the query worked, the pair is within d_i and the normal
   /// is defined; otherwise the caller writes a slack row.
   bool take(int row, const ShapeDistance& d, bool planar, const Eigen::Vector3d& fallback, Eigen::Vector3d& n);
+  /// Records pair `row` as beyond d_i without measuring it (a broadphase ruled it out): distance +inf.
+  void beyond(int row) { distance_[static_cast<std::size_t>(row)] = std::numeric_limits<double>::infinity(); }
   /// The damper the pairs are held by.
   [[nodiscard]] const Damper& damper() const noexcept { return damper_; }
   /// Pair `row`'s distance at the last contribution.
   [[nodiscard]] double operator[](int row) const { return distance_[static_cast<std::size_t>(row)]; }
-  /// A pair overlaps.
+  /// A pair overlaps, or could not be measured (it may overlap).
   [[nodiscard]] bool violated() const;
+  /// "in collision: <the worst pair>", or "cannot measure the distance ...: <the pair>" (describe_row(row) names a
+  /// pair); empty when nothing is violated.
+  [[nodiscard]] std::string describe_violation(const std::function<std::string(int)>& describe_row) const;
   /// The pair with the smallest distance (FCL failures skipped).
   [[nodiscard]] int worst() const;
   /// The recorded columns: {minimum, active}.

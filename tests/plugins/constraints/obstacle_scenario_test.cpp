@@ -81,6 +81,8 @@ struct ObstacleCase {
   double max_position_error;  // the scheme's own accuracy on the same path without obstacles, with a margin
 };
 
+void PrintTo(const ObstacleCase& c, std::ostream* os) { *os << c.config; }
+
 class ObstacleScenarios : public ::testing::TestWithParam<ObstacleCase> {};
 
 TEST_P(ObstacleScenarios, LinksKeepTheSafetyDistanceAndTheTaskIsMet) {

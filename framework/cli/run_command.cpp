@@ -181,7 +181,7 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet)
     o.run = simulate(o.scenario, [&bar](double f, double t) { bar.update(f, t); });
   }
   o.summary = summarise(o.scenario, o.run);
-  write_run(o.run, o.summary, out);
+  write_run(*o.scenario.robot, o.run, o.summary, out);
   if (!quiet) {
     const RunSummary& s = o.summary;
     std::cout << std::setprecision(4) << s.name << ": " << s.steps << " steps of " << s.tau << " s, engine "
@@ -210,7 +210,7 @@ std::string num(double v, int precision = 6) {
 void add_run_commands(CLI::App& app, Action& action) {
   auto opts = std::make_shared<RunOptions>();
 
-  CLI::App* run = app.add_subcommand("run", "Run a scenario and write trajectory.csv and summary.json");
+  CLI::App* run = app.add_subcommand("run", "Run a scenario and write trajectory.csv, frames.csv and summary.json");
   run->add_option("SCENARIO", opts->scenarios, "scenario TOML file")->required()->expected(1);
   run->add_option("--out", opts->out, "output directory")->required();
   run->add_option("--set", opts->overrides, "override a scenario value: key.path=value (repeatable)");

@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libfcl-dev libccd-dev liboctomap-dev libnlopt-cxx-dev libnlopt-dev libtomlplusplus-dev
   libmuparser-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev librapidcheck-dev libbenchmark-dev
-  python3 python3-matplotlib python3-numpy
+  python3 python3-matplotlib python3-numpy python3-pil
 )
 
 missing=()

@@ -2,33 +2,47 @@
 """Renders the paper's figures from redres runs (trajectory.csv and summary.json), as PNG files.
 
     plot_run.py RUN_DIR                      figures of one run, written into RUN_DIR
+    plot_run.py --animate RUN_DIR            an animation of the arm and the obstacles, written into RUN_DIR
     plot_run.py --compare DIR... --out OUT   Fig. 5 (w of every run) into OUT, and each run's figures
 
 Per run:
   fig3_profiles.png         theta_dot and theta profiles (Fig. 3 for the p = 1 run; Fig. 4(c), (d) otherwise)
-  fig4_task.png             (a) arm snapshots, (b) desired path and trajectory, (c) theta_dot, (d) theta
+  fig4_task.png             (a) arm snapshots with the obstacles (planar: their cross-sections with the plane z = 0;
+                            spatial: 3-D), the arm at its closest approach to an obstacle highlighted with its
+                            collision shapes, (b) desired path and trajectory, (c) theta_dot, (d) theta
   fig6_joint_angles.png     each theta with its limits and its safety region
   fig7_joint_velocities.png each theta_dot with its velocity limits and the merged bounds
   fig9b_position_error.png  the position error over time
   fig_collision_distances.png  (runs with obstacle_avoidance or self_collision) the smallest distances over time,
                             with each plugin's safety and influence distances
-Uses matplotlib and numpy (Debian: python3-matplotlib, python3-numpy). Exit codes: 0 figures written, 3 matplotlib
-or numpy cannot be imported (with a message saying what to install), 1 or 2 any other failure.
+With --animate: animation.mp4 (matplotlib's FFMpegWriter) when ffmpeg is on PATH, else animation.gif (PillowWriter),
+at most MAX_ANIMATION_FRAMES frames: the arm (and its collision shapes when there are obstacles), the obstacles where
+they are at each time, the end-effector trail and the desired path.
+
+The arm is drawn from frames.csv (joint frames computed by redres, so no kinematics here) and the obstacles and link
+shapes from summary.json (docs/output_formats.md). Uses matplotlib and numpy (Debian: python3-matplotlib,
+python3-numpy; matplotlib brings Pillow, python3-pil, which the GIF needs). Exit codes: 0 written, 3 matplotlib or
+numpy cannot be imported (with a message saying what to install), 1 or 2 any other failure.
 """
 import argparse
 import json
 import os
+import shutil
 import sys
 
 # A missing library has its own exit code, so that `redres --plots` can say what to install instead of reporting a
 # failed plot; the check costs nothing, as the figures need these imports anyway.
 EXIT_MISSING_LIBRARY = 3
+MAX_ANIMATION_FRAMES = 240
 try:
     import matplotlib
 
     matplotlib.use("Agg")
+    import matplotlib.animation  # noqa: E402
+    import matplotlib.patches  # noqa: E402
     import matplotlib.pyplot as plt  # noqa: E402
     import numpy as np  # noqa: E402
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 except ImportError as e:
     missing = e.name if e.name in ("matplotlib", "numpy") else f"a library matplotlib needs ({e})"
     print(f"plot_run.py: {missing} is not installed for {sys.executable}: apt-get install python3-matplotlib "
@@ -63,46 +77,321 @@ def profiles(ax_v, ax_q, data, n):
     ax_q.grid(alpha=0.3)
 
 
-def planar_chain(summary, theta):
-    """Joint positions of a planar chain with relative joint angles."""
-    lengths = summary["robot"]["link_lengths"]
-    pts = [(0.0, 0.0)]
-    angle = 0.0
-    x = y = 0.0
-    for q, length in zip(theta, lengths):
-        angle += q
-        x += length * np.cos(angle)
-        y += length * np.sin(angle)
-        pts.append((x, y))
-    return np.array(pts)
+def load_frames(run_dir):
+    """frames.csv as (t, points, rotations): points (rows, n + 2, 3) is the base origin, the n joint frames' origins
+    and the end effector; rotations (rows, n, 3, 3) the joint frames' rotations. None for a run without the file."""
+    path = os.path.join(run_dir, "frames.csv")
+    if not os.path.exists(path):
+        return None
+    f = np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True, deletechars=""))
+    n = sum(1 for c in f.dtype.names if c.startswith("joint_") and c.endswith("_x"))
+    rows = len(f)
+    points = np.zeros((rows, n + 2, 3))
+    rotations = np.zeros((rows, n, 3, 3))
+    for j in range(1, n + 1):
+        points[:, j] = np.column_stack([f[f"joint_{j}_{a}"] for a in "xyz"])
+        for a in range(3):
+            for b in range(3):
+                rotations[:, j - 1, a, b] = f[f"joint_{j}_r{a + 1}{b + 1}"]
+    points[:, n + 1] = np.column_stack([f[f"ee_{a}"] for a in "xyz"])
+    return f["t"], points, rotations
 
 
-def fig_task(run_dir, data, summary, n, name):
+def obstacles(summary):
+    return summary.get("obstacles", [])
+
+
+def moving(obstacle):
+    return any(v != 0.0 for v in obstacle.get("velocity", [0.0, 0.0, 0.0]))
+
+
+def obstacle_pose(obstacle, t):
+    """World position and rotation of an obstacle at time t: p(t) = p0 + v t, rotation fixed."""
+    p = np.array(obstacle["position"]) + t * np.array(obstacle.get("velocity", [0.0, 0.0, 0.0]))
+    return p, np.array(obstacle["rotation"])
+
+
+def link_shape_poses(summary, rotations_k, points_k):
+    """(shape, world position, world rotation) of every link collision shape at one row of frames.csv."""
+    out = []
+    for shape in summary["robot"].get("link_shapes", []):
+        j = shape["joint"] - 1
+        Rj, oj = rotations_k[j], points_k[j + 1]
+        out.append((shape, oj + Rj @ np.array(shape["position"]), Rj @ np.array(shape["rotation"])))
+    return out
+
+
+def bounding_radius(shape):
+    kind = shape["shape"]
+    if kind == "sphere":
+        return shape["radius"]
+    if kind == "capsule":
+        return shape["radius"] + 0.5 * shape["length"]
+    if kind == "cylinder":
+        return float(np.hypot(shape["radius"], 0.5 * shape["length"]))
+    return 0.5 * float(np.linalg.norm(shape["size"]))
+
+
+def inside(shape, q):
+    """Whether local points q (..., 3) lie in the shape (centred on its pose; axis along local z)."""
+    kind = shape["shape"]
+    if kind == "sphere":
+        return np.linalg.norm(q, axis=-1) <= shape["radius"]
+    if kind == "capsule":
+        h = 0.5 * shape["length"]
+        d = q.copy()
+        d[..., 2] = q[..., 2] - np.clip(q[..., 2], -h, h)
+        return np.linalg.norm(d, axis=-1) <= shape["radius"]
+    if kind == "cylinder":
+        return (np.abs(q[..., 2]) <= 0.5 * shape["length"]) & (np.hypot(q[..., 0], q[..., 1]) <= shape["radius"])
+    return np.all(np.abs(q) <= 0.5 * np.array(shape["size"]), axis=-1)
+
+
+def plane_section(shape, p, R, directions=120):
+    """The shape's cross-section with the plane z = 0 as a polygon (directions x 2), found along rays from the
+    centre's projection (the sections are convex); None when that point is not inside the shape."""
+    c = np.array([p[0], p[1], 0.0])
+    if not inside(shape, R.T @ (c - p)):
+        return None
+    a = np.linspace(0.0, 2.0 * np.pi, directions, endpoint=False)
+    d = np.column_stack([np.cos(a), np.sin(a), np.zeros_like(a)])
+    lo = np.zeros(directions)
+    hi = np.full(directions, 2.0 * bounding_radius(shape) + 1e-9)
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        ok = inside(shape, (c + mid[:, None] * d - p) @ R)
+        lo = np.where(ok, mid, lo)
+        hi = np.where(ok, hi, mid)
+    return c[:2] + lo[:, None] * d[:, :2]
+
+
+def surface(shape, p, R):
+    """A 3-D mesh of the shape at world pose (p, R): (X, Y, Z) grids, or for a box a list of its 6 faces."""
+    kind = shape["shape"]
+    if kind == "box":
+        h = 0.5 * np.array(shape["size"])
+        corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h @ R.T + p
+        faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
+        return [corners[f] for f in faces]
+    r = shape["radius"]
+    h = 0.5 * shape.get("length", 0.0)
+    if kind == "sphere":
+        v = np.linspace(0.0, np.pi, 13)
+        rho, z = r * np.sin(v), r * np.cos(v)
+    elif kind == "capsule":
+        v1, v2 = np.linspace(0.0, np.pi / 2, 7), np.linspace(np.pi / 2, np.pi, 7)
+        rho = r * np.sin(np.concatenate([v1, v2]))
+        z = np.concatenate([r * np.cos(v1) + h, r * np.cos(v2) - h])
+    else:
+        rho, z = np.array([0.0, r, r, 0.0]), np.array([h, h, -h, -h])
+    u = np.linspace(0.0, 2.0 * np.pi, 21)
+    local = np.stack([np.outer(rho, np.cos(u)), np.outer(rho, np.sin(u)), np.outer(z, np.ones_like(u))], axis=-1)
+    world = local @ R.T + p
+    return world[..., 0], world[..., 1], world[..., 2]
+
+
+def draw_section(ax, shape, p, R, **style):
+    """The shape's z = 0 section as a filled patch on 2-D axes; the patch, or None when it misses the plane."""
+    poly = plane_section(shape, p, R)
+    if poly is None:
+        return None
+    patch = matplotlib.patches.Polygon(poly, closed=True, **style)
+    ax.add_patch(patch)
+    return patch
+
+
+def draw_solid(ax, shape, p, R, color, alpha):
+    """The shape on 3-D axes; the artists drawn."""
+    mesh = surface(shape, p, R)
+    if isinstance(mesh, list):
+        faces = Poly3DCollection(mesh, facecolor=color, edgecolor=color, alpha=alpha, linewidth=0.5)
+        ax.add_collection3d(faces)
+        return [faces]
+    return [ax.plot_surface(*mesh, color=color, alpha=alpha, linewidth=0, shade=True)]
+
+
+def closest_approach(data, frames_t):
+    """(frames row, t, distance) of the smallest obstacle distance recorded, or None without one."""
+    columns = [c for c in data.dtype.names if c.split(".")[-1] == "min_obstacle_distance"]
+    if not columns:
+        return None
+    d = np.min(np.column_stack([data[c] for c in columns]), axis=1)
+    if not np.isfinite(d).any():
+        return None
+    k = int(np.nanargmin(np.where(np.isfinite(d), d, np.nan)))
+    row = int(np.argmin(np.abs(frames_t - data["t"][k])))
+    return row, float(data["t"][k]), float(d[k])
+
+
+def obstacle_times(summary, duration, count=5):
+    """Times at which to draw the obstacles in a still figure: t = 0 only, unless one moves."""
+    if any(moving(o) for o in obstacles(summary)):
+        return np.linspace(0.0, duration, count)
+    return np.array([0.0])
+
+
+def equal_3d(ax, points):
+    """Equal scales on 3-D axes around the given points (k x 3)."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    centre, half = 0.5 * (lo + hi), 0.5 * max(float((hi - lo).max()), 1e-3) * 1.05
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_zlabel("z (m)")
+
+
+def scene_points(summary, frames, duration):
+    """Points that the scene covers over the run (arm, obstacles' extents), for fixed 3-D limits."""
+    pts = [frames[1].reshape(-1, 3)]
+    for o in obstacles(summary):
+        r = bounding_radius(o)
+        for t in (0.0, duration):
+            p, _ = obstacle_pose(o, t)
+            pts.append(np.array([p - r, p + r]))
+    return np.vstack(pts)
+
+
+OBSTACLE_COLOUR = "tab:orange"
+CLOSEST_COLOUR = "tab:blue"
+
+
+def snapshot_planar(ax, data, summary, frames, duration):
+    t_f, pts, rots = frames
+    for k in np.unique(np.linspace(0, len(t_f) - 1, 25).round().astype(int)):
+        ax.plot(pts[k, :, 0], pts[k, :, 1], "-o", color="0.6", lw=0.8, ms=2)
+    ax.plot(data["r_x"], data["r_y"], "r", lw=1.2, label="end-effector trajectory")
+    times = obstacle_times(summary, duration)
+    for i, t in enumerate(times):
+        alpha = 0.7 if len(times) == 1 else 0.15 + 0.55 * i / (len(times) - 1)
+        for o in obstacles(summary):
+            p, R = obstacle_pose(o, t)
+            patch = draw_section(ax, o, p, R, facecolor=OBSTACLE_COLOUR, edgecolor="k", lw=0.6, alpha=alpha)
+            if patch is not None and i in (0, len(times) - 1) and len(times) > 1 and moving(o):
+                ax.annotate(f"t = {t:.3g} s", p[:2], xytext=(0, -12 if i == 0 else 12), textcoords="offset points",
+                            fontsize=6, ha="center", va="center")
+    if obstacles(summary):
+        ax.plot([], [], "s", color=OBSTACLE_COLOUR, label="obstacles (faded: earlier)" if len(times) > 1
+                else "obstacles")
+    closest = closest_approach(data, t_f)
+    if closest is not None:
+        k, t, d = closest
+        for shape, p, R in link_shape_poses(summary, rots[k], pts[k]):
+            draw_section(ax, shape, p, R, facecolor=CLOSEST_COLOUR, edgecolor=CLOSEST_COLOUR, lw=0.5, alpha=0.25)
+        for o in obstacles(summary):
+            if moving(o):
+                p, R = obstacle_pose(o, t_f[k])
+                draw_section(ax, o, p, R, facecolor="none", edgecolor=CLOSEST_COLOUR, lw=1.0)
+        ax.plot(pts[k, :, 0], pts[k, :, 1], "-o", color=CLOSEST_COLOUR, lw=1.5, ms=3,
+                label=f"closest approach (t = {t:.2f} s)")
+    ax.autoscale_view()
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.legend(fontsize=6, loc="lower right")
+
+
+def zoom_closest(ax, summary, frames, closest):
+    """The arm's collision shapes and the obstacle nearest to them at the closest approach, zoomed (planar)."""
+    t_f, pts, rots = frames
+    k, t, d = closest
+    links = link_shape_poses(summary, rots[k], pts[k])
+    link_radius = max([sh["radius"] for sh, _, _ in links if "radius" in sh] or [0.0])
+
+    def gap(o):  # centre of the obstacle to the nearest joint segment
+        p, _ = obstacle_pose(o, t_f[k])
+        a, b = pts[k, :-1], pts[k, 1:]
+        ab = b - a
+        s = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-18), 0.0, 1.0)
+        return float(np.min(np.linalg.norm(a + s[:, None] * ab - p, axis=1)))
+
+    nearest = min(obstacles(summary), key=gap)
+    centre, _ = obstacle_pose(nearest, t_f[k])
+    half = 1.5 * (bounding_radius(nearest) + link_radius + max(d, 0.0)) + 0.01
+    for o in obstacles(summary):
+        draw_section(ax, o, *obstacle_pose(o, t_f[k]), facecolor=OBSTACLE_COLOUR, edgecolor="k", lw=0.8, alpha=0.8)
+    for shape, p, R in links:
+        draw_section(ax, shape, p, R, facecolor=CLOSEST_COLOUR, edgecolor=CLOSEST_COLOUR, lw=0.8, alpha=0.3)
+    ax.plot(pts[k, :, 0], pts[k, :, 1], "-o", color=CLOSEST_COLOUR, lw=1.5, ms=4)
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(f"(a') closest approach, t = {t:.2f} s:\nlinks' collision shapes {d * 1000:.1f} mm from the obstacle",
+                 fontsize=10)
+
+
+def snapshot_spatial(ax, data, summary, frames, duration):
+    t_f, pts, rots = frames
+    ax.plot(data["rd_x"], data["rd_y"], data["rd_z"], "b-", lw=3, alpha=0.4, label="desired path")
+    ax.plot(data["r_x"], data["r_y"], data["r_z"], "r--", lw=1, label="end-effector trajectory")
+    snaps = np.unique(np.linspace(0, len(t_f) - 1, 8).round().astype(int))
+    for i, k in enumerate(snaps):
+        last = i == len(snaps) - 1
+        ax.plot(pts[k, :, 0], pts[k, :, 1], pts[k, :, 2], "-o", color="k" if last else "0.5",
+                alpha=1.0 if last else 0.25 + 0.5 * i / max(len(snaps) - 1, 1), lw=2 if last else 1, ms=3,
+                label="arm at t = T (grey: earlier)" if last else None)
+    times = obstacle_times(summary, duration, 3)
+    for i, t in enumerate(times):
+        alpha = 0.5 if len(times) == 1 else 0.15 + 0.35 * i / (len(times) - 1)
+        for o in obstacles(summary):
+            draw_solid(ax, o, *obstacle_pose(o, t), OBSTACLE_COLOUR, alpha)
+    closest = closest_approach(data, t_f)
+    if closest is not None:
+        k, t, d = closest
+        for shape, p, R in link_shape_poses(summary, rots[k], pts[k]):
+            if shape["shape"] == "box":
+                draw_solid(ax, shape, p, R, CLOSEST_COLOUR, 0.2)
+            else:
+                ax.plot_wireframe(*surface(shape, p, R), color=CLOSEST_COLOUR, lw=0.3, alpha=0.5)
+        ax.plot(pts[k, :, 0], pts[k, :, 1], pts[k, :, 2], "-o", color=CLOSEST_COLOUR, lw=2, ms=3,
+                label=f"closest approach: t = {t:.2f} s, d = {d * 1000:.1f} mm")
+    equal_3d(ax, np.vstack([scene_points(summary, frames, duration),
+                            np.column_stack([data["rd_x"], data["rd_y"], data["rd_z"]])]))
+    ax.legend(fontsize=7, loc="upper left")
+
+
+def fig_task(run_dir, data, summary, frames, n, name):
     planar = summary["robot"]["kind"] == "planar"
     fig = plt.figure(figsize=(12, 9))
     t = data["t"]
+    duration = float(t[-1])
+    # A planar run that came close to an obstacle gets a third panel in the top row: the closest approach, zoomed.
+    closest = closest_approach(data, frames[0]) if planar and frames is not None and obstacles(summary) else None
+    grid = fig.add_gridspec(2, 6)
+    top = [grid[0, 0:2], grid[0, 2:4], grid[0, 4:6]] if closest else [grid[0, 0:3], grid[0, 3:6]]
     if planar:
-        ax_a = fig.add_subplot(2, 2, 1)
-        for k in np.linspace(0, len(t) - 1, 25).astype(int):
-            pts = planar_chain(summary, [data[f"theta_{j}"][k] for j in range(1, n + 1)])
-            ax_a.plot(pts[:, 0], pts[:, 1], "-o", color="0.6", lw=0.8, ms=2)
-        ax_a.plot(data["r_x"], data["r_y"], "r", lw=1.2)
-        ax_a.set_aspect("equal")
+        ax_a = fig.add_subplot(top[0])
+        if frames is not None:
+            snapshot_planar(ax_a, data, summary, frames, duration)
+        else:
+            ax_a.plot(data["r_x"], data["r_y"], "r", lw=1.2)
+            ax_a.set_aspect("equal")
+            ax_a.text(0.5, 0.02, "no frames.csv in this run: no arm drawn", transform=ax_a.transAxes, ha="center",
+                      fontsize=7)
         ax_a.set_title("(a) motion trajectories")
-        ax_a.set_xlabel("x (m)")
-        ax_a.set_ylabel("y (m)")
-        ax_b = fig.add_subplot(2, 2, 2)
+        if closest:
+            zoom_closest(fig.add_subplot(top[1]), summary, frames, closest)
+        ax_b = fig.add_subplot(top[-1])
         ax_b.plot(data["rd_x"], data["rd_y"], "b-", lw=3, alpha=0.4, label="desired path")
         ax_b.plot(data["r_x"], data["r_y"], "r--", lw=1, label="end-effector trajectory")
         ax_b.set_aspect("equal")
         ax_b.set_xlabel("x (m)")
         ax_b.set_ylabel("y (m)")
     else:
-        ax_a = fig.add_subplot(2, 2, 1, projection="3d")
-        ax_a.plot(data["rd_x"], data["rd_y"], data["rd_z"], "b-", lw=3, alpha=0.4, label="desired path")
-        ax_a.plot(data["r_x"], data["r_y"], data["r_z"], "r--", lw=1, label="end-effector trajectory")
-        ax_a.set_title("(a) path in space")
-        ax_b = fig.add_subplot(2, 2, 2)
+        ax_a = fig.add_subplot(top[0], projection="3d")
+        if frames is not None:
+            snapshot_spatial(ax_a, data, summary, frames, duration)
+            ax_a.set_title("(a) arm snapshots and path")
+        else:
+            ax_a.plot(data["rd_x"], data["rd_y"], data["rd_z"], "b-", lw=3, alpha=0.4, label="desired path")
+            ax_a.plot(data["r_x"], data["r_y"], data["r_z"], "r--", lw=1, label="end-effector trajectory")
+            ax_a.set_title("(a) path in space (no frames.csv: no arm drawn)")
+        ax_b = fig.add_subplot(top[-1])
         ax_b.plot(t, data["rd_x"] - data["rd_x"][0], label="x")
         ax_b.plot(t, data["rd_y"] - data["rd_y"][0], label="y")
         ax_b.plot(t, data["rd_z"] - data["rd_z"][0], label="z")
@@ -110,9 +399,10 @@ def fig_task(run_dir, data, summary, n, name):
         ax_b.set_ylabel("desired displacement (m)")
     ax_b.set_title("(b) end-effector path and trajectory")
     ax_b.legend(fontsize=8)
-    profiles(fig.add_subplot(2, 2, 3), fig.add_subplot(2, 2, 4), data, n)
-    fig.axes[-2].set_title(r"(c) $\dot\theta$ profiles")
-    fig.axes[-1].set_title(r"(d) $\theta$ profiles")
+    ax_c, ax_d = fig.add_subplot(grid[1, 0:3]), fig.add_subplot(grid[1, 3:6])
+    profiles(ax_c, ax_d, data, n)
+    ax_c.set_title(r"(c) $\dot\theta$ profiles")
+    ax_d.set_title(r"(d) $\theta$ profiles")
     fig.suptitle(f"{name}: end-effector task")
     fig.tight_layout()
     fig.savefig(os.path.join(run_dir, "fig4_task.png"), dpi=110)
@@ -243,13 +533,146 @@ def plot_run(run_dir, quiet):
     n = joints(summary)
     name = summary.get("name", os.path.basename(os.path.normpath(run_dir)))
     fig_profiles(run_dir, data, n, name)
-    fig_task(run_dir, data, summary, n, name)
+    fig_task(run_dir, data, summary, load_frames(run_dir), n, name)
     fig_angles(run_dir, data, summary, n, name)
     fig_velocities(run_dir, data, n, name)
     fig_error(run_dir, data, name)
     fig_distances(run_dir, data, summary, name)
     if not quiet:
         print(f"figures written to {run_dir}")
+
+
+def animation_writer(fps):
+    """(writer, file name): FFMpegWriter to animation.mp4 when ffmpeg is on PATH, else PillowWriter to
+    animation.gif (Pillow is a dependency of matplotlib, so the GIF can always be made)."""
+    if shutil.which("ffmpeg"):
+        return matplotlib.animation.FFMpegWriter(fps=fps, bitrate=1800), "animation.mp4"
+    return matplotlib.animation.PillowWriter(fps=fps), "animation.gif"
+
+
+def animate_run(run_dir, quiet):
+    """The arm, its collision shapes (when there are obstacles), the obstacles where they are, the end-effector
+    trail and the desired path, over the run: animation.mp4 or animation.gif in run_dir."""
+    data, summary = load(run_dir)
+    frames = load_frames(run_dir)
+    if frames is None:
+        raise SystemExit(f"plot_run.py: --animate: no frames.csv in {run_dir} (runs of redres before it wrote one)")
+    name = summary.get("name", os.path.basename(os.path.normpath(run_dir)))
+    t_f, pts, rots = frames
+    duration = float(data["t"][-1])
+    rows = np.unique(np.linspace(0, len(t_f) - 1, min(len(t_f), MAX_ANIMATION_FRAMES)).round().astype(int))
+    # About real time for runs of 6 to 24 s, faster for longer ones, never below 4 frames per second.
+    fps = int(np.clip(round(len(rows) / max(duration, 1e-9)), 4, 25)) if duration > 0 else 10
+    planar = summary["robot"]["kind"] == "planar"
+    obs = obstacles(summary)
+    shapes = bool(obs) and bool(summary["robot"].get("link_shapes"))
+    distance_columns = [c for c in data.dtype.names if c.split(".")[-1] == "min_obstacle_distance"]
+    t_data = data["t"]
+
+    def min_distance(t):
+        if not distance_columns:
+            return None
+        k = int(np.argmin(np.abs(t_data - t)))
+        return min(float(data[c][k]) for c in distance_columns)
+
+    writer, file_name = animation_writer(fps)
+    fig = plt.figure(figsize=(6.4, 6.0))
+    if planar:
+        ax = fig.add_subplot(1, 1, 1)
+        ax.plot(data["rd_x"], data["rd_y"], "b-", lw=3, alpha=0.25, label="desired path")
+        (trail,) = ax.plot([], [], "r", lw=1.2, label="end-effector trajectory")
+        (arm,) = ax.plot([], [], "-o", color="k", lw=2, ms=4, label="arm")
+        all_pts = [pts[:, :, :2].reshape(-1, 2), np.column_stack([data["rd_x"], data["rd_y"]])]
+        for o in obs:
+            r = bounding_radius(o)
+            for t in (0.0, duration):
+                p, _ = obstacle_pose(o, t)
+                all_pts.append(np.array([p[:2] - r, p[:2] + r]))
+        if shapes:
+            r = max(bounding_radius(sh) for sh in summary["robot"]["link_shapes"])
+            all_pts.append(np.vstack([pts[:, :, :2].reshape(-1, 2) - r, pts[:, :, :2].reshape(-1, 2) + r]))
+        both = np.vstack(all_pts)
+        lo, hi = both.min(axis=0), both.max(axis=0)
+        pad = 0.05 * float((hi - lo).max())
+        ax.set_xlim(lo[0] - pad, hi[0] + pad)
+        ax.set_ylim(lo[1] - pad, hi[1] + pad)
+        ax.set_aspect("equal")
+        # A figure of about the scene's shape (the height fixed), so that little of it is margin.
+        ratio = (hi[0] - lo[0] + 2 * pad) / max(hi[1] - lo[1] + 2 * pad, 1e-9)
+        fig.set_size_inches(float(np.clip(6.0 * ratio + 1.2, 4.8, 10.0)), 6.4)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.grid(alpha=0.3)
+        if obs:
+            ax.plot([], [], "s", color=OBSTACLE_COLOUR, label="obstacles")
+        ax.legend(fontsize=7, loc="upper right")
+        dynamic = []  # patches redrawn every frame
+
+        def update(i):
+            k = rows[i]
+            t = t_f[k]
+            for artist in dynamic:
+                artist.remove()
+            dynamic.clear()
+            for o in obs:
+                patch = draw_section(ax, o, *obstacle_pose(o, t), facecolor=OBSTACLE_COLOUR, edgecolor="k", lw=0.6,
+                                     alpha=0.8)
+                if patch is not None:
+                    dynamic.append(patch)
+            if shapes:
+                for shape, p, R in link_shape_poses(summary, rots[k], pts[k]):
+                    patch = draw_section(ax, shape, p, R, facecolor=CLOSEST_COLOUR, edgecolor=CLOSEST_COLOUR,
+                                         lw=0.5, alpha=0.25)
+                    if patch is not None:
+                        dynamic.append(patch)
+            arm.set_data(pts[k, :, 0], pts[k, :, 1])
+            shown = t_data <= t + 1e-12
+            trail.set_data(data["r_x"][shown], data["r_y"][shown])
+            set_title(t)
+    else:
+        ax = fig.add_subplot(1, 1, 1, projection="3d")
+        ax.plot(data["rd_x"], data["rd_y"], data["rd_z"], "b-", lw=3, alpha=0.25, label="desired path")
+        (trail,) = ax.plot([], [], [], "r", lw=1.2, label="end-effector trajectory")
+        (arm,) = ax.plot([], [], [], "-o", color="k", lw=3, ms=4, label="arm")
+        equal_3d(ax, np.vstack([scene_points(summary, frames, duration),
+                                np.column_stack([data["rd_x"], data["rd_y"], data["rd_z"]])]))
+        if obs:
+            ax.plot([], [], "s", color=OBSTACLE_COLOUR, label="obstacles")
+        ax.legend(fontsize=7, loc="upper left")
+        static = [o for o in obs if not moving(o)]
+        for o in static:
+            draw_solid(ax, o, *obstacle_pose(o, 0.0), OBSTACLE_COLOUR, 0.5)
+        dynamic = []
+
+        def update(i):
+            k = rows[i]
+            t = t_f[k]
+            for artist in dynamic:
+                artist.remove()
+            dynamic.clear()
+            for o in obs:
+                if moving(o):
+                    dynamic.extend(draw_solid(ax, o, *obstacle_pose(o, t), OBSTACLE_COLOUR, 0.5))
+            arm.set_data_3d(pts[k, :, 0], pts[k, :, 1], pts[k, :, 2])
+            shown = t_data <= t + 1e-12
+            trail.set_data_3d(data["r_x"][shown], data["r_y"][shown], data["r_z"][shown])
+            set_title(t)
+
+    def set_title(t):
+        d = min_distance(t)
+        extra = f", smallest obstacle distance {d * 1000:.1f} mm" if d is not None and np.isfinite(d) else ""
+        ax.set_title(f"{name}: t = {t:.2f} s{extra}", fontsize=9)
+
+    set_title(t_f[rows[0]])  # before the layout, so that it keeps room for the title
+    fig.tight_layout()
+    anim = matplotlib.animation.FuncAnimation(fig, update, frames=len(rows), blit=False)
+    path = os.path.join(run_dir, file_name)
+    anim.save(path, writer=writer, dpi=90 if planar else 80)
+    plt.close(fig)
+    if not quiet:
+        print(f"{len(rows)} frames at {fps} frames/s with {type(writer).__name__}"
+              + ("" if file_name.endswith(".mp4") else " (ffmpeg is not on PATH: a GIF)"))
+    return path
 
 
 def plot_compare(dirs, out, quiet):
@@ -275,11 +698,17 @@ def plot_compare(dirs, out, quiet):
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("run_dir", nargs="?", help="a run directory (trajectory.csv, summary.json)")
+    p.add_argument("--animate", action="store_true",
+                   help="write RUN_DIR/animation.mp4 (ffmpeg on PATH) or else RUN_DIR/animation.gif, not the figures")
     p.add_argument("--compare", nargs="+", metavar="DIR", help="run directories to compare")
     p.add_argument("--out", help="output directory for the comparison figure")
     p.add_argument("--quiet", action="store_true")
     a = p.parse_args()
-    if a.compare:
+    if a.animate:
+        if not a.run_dir or a.compare:
+            p.error("--animate takes one RUN_DIR")
+        animate_run(a.run_dir, a.quiet)
+    elif a.compare:
         plot_compare(a.compare, a.out or os.path.dirname(os.path.normpath(a.compare[0])), a.quiet)
     elif a.run_dir:
         plot_run(a.run_dir, a.quiet)

@@ -34,6 +34,7 @@ struct RunOptions {
   std::vector<std::string> overrides;
   bool quiet = false;
   bool plots = false;
+  bool animate = false;
   bool no_plots = false;
 };
 
@@ -168,6 +169,22 @@ void render_plots(const Plotter& p, std::vector<std::string> args, bool quiet, c
   }
 }
 
+// The animation of a run: plot_run.py --animate DIR writes DIR/animation.mp4 (ffmpeg on PATH) or else
+// DIR/animation.gif. An animation left by an earlier run into DIR is removed first, so that the file found
+// afterwards is this run's; it is an error if there is none.
+std::filesystem::path render_animation(const Plotter& p, const std::filesystem::path& dir, bool quiet,
+                                       const std::string& outputs) {
+  const std::filesystem::path files[] = {dir / "animation.mp4", dir / "animation.gif"};
+  for (const auto& f : files) std::filesystem::remove(f);
+  render_plots(p, {"--animate", dir.string()}, quiet, outputs);
+  for (const auto& f : files) {
+    std::error_code ec;
+    if (std::filesystem::file_size(f, ec) > 0 && !ec) return f;
+  }
+  throw std::runtime_error(p.request + ": plot_run.py --animate wrote neither animation.mp4 nor animation.gif in " +
+                           dir.string() + "; " + outputs + " were written");
+}
+
 struct Outcome {
   Scenario scenario;
   RunResult run;
@@ -181,7 +198,7 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet)
     o.run = simulate(o.scenario, [&bar](double f, double t) { bar.update(f, t); });
   }
   o.summary = summarise(o.scenario, o.run);
-  write_run(o.run, o.summary, out);
+  write_run(*o.scenario.robot, o.run, o.summary, out);
   if (!quiet) {
     const RunSummary& s = o.summary;
     std::cout << std::setprecision(4) << s.name << ": " << s.steps << " steps of " << s.tau << " s, engine "
@@ -210,7 +227,7 @@ std::string num(double v, int precision = 6) {
 void add_run_commands(CLI::App& app, Action& action) {
   auto opts = std::make_shared<RunOptions>();
 
-  CLI::App* run = app.add_subcommand("run", "Run a scenario and write trajectory.csv and summary.json");
+  CLI::App* run = app.add_subcommand("run", "Run a scenario and write trajectory.csv, frames.csv and summary.json");
   run->add_option("SCENARIO", opts->scenarios, "scenario TOML file")->required()->expected(1);
   run->add_option("--out", opts->out, "output directory")->required();
   run->add_option("--set", opts->overrides, "override a scenario value: key.path=value (repeatable)");
@@ -218,15 +235,26 @@ void add_run_commands(CLI::App& app, Action& action) {
   run->add_flag("--plots", opts->plots,
                 "render the figures into the output directory (plot_run.py with the python3 on PATH, which needs "
                 "matplotlib; exit code 2 when they cannot be made)");
+  run->add_flag("--animate", opts->animate,
+                "render an animation of the arm and the obstacles into the output directory: animation.mp4 when "
+                "ffmpeg is on PATH, else animation.gif (plot_run.py, as --plots)");
   run->callback([opts, &action] {
     action = [opts] {
       Scenario scenario = load_scenario(opts->scenarios.front(), opts->overrides);
-      std::optional<Plotter> plotter;
+      std::optional<Plotter> plotter, animator;
       if (opts->plots || scenario.plots) {
         plotter = find_plotter(opts->plots ? "--plots" : opts->scenarios.front() + ": [output] plots = true");
       }
+      if (opts->animate || scenario.animate) {
+        animator = find_plotter(opts->animate ? "--animate" : opts->scenarios.front() + ": [output] animate = true");
+      }
       const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet);
-      if (plotter) render_plots(*plotter, {opts->out}, opts->quiet, "trajectory.csv and summary.json in " + opts->out);
+      const std::string written = "trajectory.csv, frames.csv and summary.json in " + opts->out;
+      if (plotter) render_plots(*plotter, {opts->out}, opts->quiet, written);
+      if (animator) {
+        const std::filesystem::path file = render_animation(*animator, opts->out, opts->quiet, written);
+        if (!opts->quiet) std::cout << "animation: " << file.string() << "\n";
+      }
       return o.run.failures > 0 ? kExitFailedSteps : kExitOk;
     };
   });

@@ -4,23 +4,86 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "redres/error.hpp"
+#include "redres/kinematics.hpp"
+
 namespace redres {
 
-void write_run(const RunResult& run, const RunSummary& summary, const std::filesystem::path& dir) {
-  std::filesystem::create_directories(dir);
-  const Trajectory& tr = run.trajectory;
-  const std::filesystem::path csv = dir / "trajectory.csv";
-  std::FILE* f = std::fopen(csv.string().c_str(), "w");
-  if (f == nullptr) throw std::runtime_error("cannot write " + csv.string());
-  const auto& cols = tr.columns();
+namespace {
+
+// A table as comma-separated text with one header line, numbers as %.12g.
+void write_csv(const Trajectory& table, const std::filesystem::path& file) {
+  std::FILE* f = std::fopen(file.string().c_str(), "w");
+  if (f == nullptr) throw std::runtime_error("cannot write " + file.string());
+  const auto& cols = table.columns();
   for (std::size_t c = 0; c < cols.size(); ++c) std::fprintf(f, "%s%s", c ? "," : "", cols[c].c_str());
   std::fputc('\n', f);
-  for (std::size_t r = 0; r < tr.size(); ++r) {
-    const double* row = tr.row(r);
-    for (std::size_t c = 0; c < tr.width(); ++c) std::fprintf(f, "%s%.12g", c ? "," : "", row[c]);
+  for (std::size_t r = 0; r < table.size(); ++r) {
+    const double* row = table.row(r);
+    for (std::size_t c = 0; c < table.width(); ++c) std::fprintf(f, "%s%.12g", c ? "," : "", row[c]);
     std::fputc('\n', f);
   }
-  if (std::fclose(f) != 0) throw std::runtime_error("cannot write " + csv.string());
+  if (std::fclose(f) != 0) throw std::runtime_error("cannot write " + file.string());
+}
+
+// Columns per joint in frames.csv: origin, then the rotation row by row.
+constexpr std::size_t kFrameColumns = 12;
+
+}  // namespace
+
+Trajectory joint_frames(const RobotModel& robot, const Trajectory& run, std::size_t max_rows) {
+  REDRES_REQUIRE(max_rows >= 2, "joint_frames", "max_rows >= 2");
+  const int n = robot.dof();
+  const auto joints = static_cast<std::size_t>(n);
+  std::vector<std::string> columns = {"t"};
+  std::vector<std::size_t> c_theta;
+  for (int j = 1; j <= n; ++j) {
+    const std::string J = std::to_string(j);
+    for (const char* c : {"_x", "_y", "_z", "_r11", "_r12", "_r13", "_r21", "_r22", "_r23", "_r31", "_r32", "_r33"}) {
+      columns.push_back("joint_" + J + c);
+    }
+    c_theta.push_back(run.column("theta_" + J));
+  }
+  for (const char* axis : {"ee_x", "ee_y", "ee_z"}) columns.emplace_back(axis);
+  const std::size_t rows = run.size();
+  // Stride k = ceil((rows - 1) / (max_rows - 1)) keeps floor((rows - 1) / k) + 1 <= max_rows rows, plus the last
+  // one when the stride does not land on it, which then had room (floor((rows - 1) / k) <= max_rows - 2).
+  const std::size_t stride = rows <= max_rows ? 1 : (rows - 1 + max_rows - 2) / (max_rows - 1);
+  std::vector<std::size_t> kept;
+  for (std::size_t r = 0; r < rows; r += stride) kept.push_back(r);
+  if (rows > 0 && kept.back() != rows - 1) kept.push_back(rows - 1);
+  Trajectory out(std::move(columns), kept.size());
+  const std::size_t c_t = run.column("t");
+  KinematicsData k(robot);
+  Eigen::VectorXd theta(n);
+  const auto put = [](double* at, const Eigen::Vector3d& p) {
+    at[0] = p.x();
+    at[1] = p.y();
+    at[2] = p.z();
+  };
+  for (const std::size_t r : kept) {
+    for (std::size_t j = 0; j < joints; ++j) theta(static_cast<Eigen::Index>(j)) = run(r, c_theta[j]);
+    compute_kinematics(robot, theta, k, KinematicsLevel::kPosition);
+    double* row = out.append_row();
+    row[0] = run(r, c_t);
+    for (std::size_t j = 0; j < joints; ++j) {
+      const Eigen::Isometry3d& T = k.link_frames[j];
+      double* at = row + 1 + kFrameColumns * j;
+      put(at, T.translation());
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) at[3 + 3 * a + b] = T.linear()(a, b);
+      }
+    }
+    put(row + 1 + kFrameColumns * joints, k.ee_pose.translation());
+  }
+  return out;
+}
+
+void write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
+               const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  write_csv(run.trajectory, dir / "trajectory.csv");
+  write_csv(joint_frames(robot, run.trajectory), dir / "frames.csv");
   std::ofstream js(dir / "summary.json");
   js << to_json(summary) << "\n";
   if (!js) throw std::runtime_error("cannot write " + (dir / "summary.json").string());

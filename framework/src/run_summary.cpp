@@ -94,16 +94,54 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
     out.robot.upper_limits.push_back(robot.upper_limits()(j));
     out.robot.link_lengths.push_back(robot.joint(j).length);
   }
+  for (const auto& l : robot.link_shapes()) out.robot.link_shapes.push_back({l.link + 1, l.spec});
   const auto collect = [&](const Plugin& p) {
     if (!p.active()) return;
     PluginMetrics pm{p.name(), {}};
     p.summarise(robot, tr, pm.metrics);
     if (!pm.metrics.empty()) out.metrics.push_back(std::move(pm));
+    std::vector<ShapeSpec> shapes;
+    p.scene_obstacles(shapes);
+    for (auto& shape : shapes) out.obstacles.push_back({p.name(), std::move(shape)});
   };
   for (const auto& o : s.scheme->objectives()) collect(*o);
   for (const auto& c : s.scheme->constraints()) collect(*c);
   return out;
 }
+
+namespace {
+
+nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// A shape: its kind, sizes and pose in its owner's frame (docs/output_formats.md).
+nlohmann::json shape_json(const ShapeSpec& shape) {
+  const Eigen::Isometry3d T = shape.pose();
+  const Eigen::Matrix3d R = T.linear();
+  nlohmann::json j = {{"shape", std::string(config_io::enum_name(shape.shape))}};
+  switch (shape.shape) {
+    case ShapeSpec::Kind::kSphere: j["radius"] = shape.radius.value_or(0.0); break;
+    case ShapeSpec::Kind::kCapsule:
+    case ShapeSpec::Kind::kCylinder:
+      j["radius"] = shape.radius.value_or(0.0);
+      j["length"] = shape.axis_length();
+      break;
+    case ShapeSpec::Kind::kBox: j["size"] = shape.size.value_or(std::array<double, 3>{0.0, 0.0, 0.0}); break;
+  }
+  j["position"] = vector_json(T.translation());
+  j["rotation"] = {vector_json(R.row(0).transpose()), vector_json(R.row(1).transpose()),
+                   vector_json(R.row(2).transpose())};
+  return j;
+}
+
+// An obstacle: its plugin, its shape at t = 0 in the world frame, and its velocity.
+nlohmann::json obstacle_json(const ObstacleFacts& o) {
+  nlohmann::json j = {{"plugin", o.plugin}};
+  j.update(shape_json(o.shape));
+  j["velocity"] = o.shape.velocity.value_or(std::array<double, 3>{0.0, 0.0, 0.0});
+  return j;
+}
+
+}  // namespace
 
 std::string to_json(const RunSummary& s) {
   nlohmann::json metrics = nlohmann::json::object();
@@ -114,6 +152,14 @@ std::string to_json(const RunSummary& s) {
           m.values.size() == 1 && !m.per_joint ? nlohmann::json(m.values.front()) : nlohmann::json(m.values);
     }
     metrics[pm.plugin] = figures;
+  }
+  nlohmann::json obstacles = nlohmann::json::array();
+  for (const auto& o : s.obstacles) obstacles.push_back(obstacle_json(o));
+  nlohmann::json link_shapes = nlohmann::json::array();
+  for (const auto& l : s.robot.link_shapes) {
+    nlohmann::json j = {{"joint", l.joint}};
+    j.update(shape_json(l.shape));
+    link_shapes.push_back(j);
   }
   const ManipulabilityStats& w = s.manipulability;
   const nlohmann::json j = {
@@ -148,8 +194,10 @@ std::string to_json(const RunSummary& s) {
         {"joint_names", s.robot.joint_names},
         {"lower_limits", s.robot.lower_limits},
         {"upper_limits", s.robot.upper_limits},
-        {"link_lengths", s.robot.link_lengths}}},
+        {"link_lengths", s.robot.link_lengths},
+        {"link_shapes", link_shapes}}},
       {"metrics", metrics},
+      {"obstacles", obstacles},
   };
   return j.dump(2);
 }

@@ -95,6 +95,7 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   if (auto out = r.optional_table("output")) {
     const TableReader o(out->file_ptr(), out->raw(), "output");
     s.plots = o.boolean("plots", false);
+    s.animate = o.boolean("animate", false);
     o.finish();
   }
   r.finish();

@@ -173,6 +173,10 @@ void ObstacleAvoidance::summarise(const RobotModel& /*robot*/, const Trajectory&
   distances_.summarise(run, name(), out);
 }
 
+void ObstacleAvoidance::scene_obstacles(std::vector<ShapeSpec>& out) const {
+  out.insert(out.end(), config_.obstacles.begin(), config_.obstacles.end());
+}
+
 namespace {
 // For the conformance checks (obstacles have no default): a sphere in the plane, near the test arms' reach.
 ObstacleAvoidanceConfig example() {

@@ -32,6 +32,7 @@
 namespace redres {
 
 class Trajectory;
+struct ShapeSpec;
 
 /// A named figure that a plugin adds to the run summary (one number, or one per joint).
 struct Metric {
@@ -76,6 +77,9 @@ class Plugin {
     (void)run;
     (void)out;
   }
+  /// Obstacles this plugin keeps the robot away from, for summary.json and the figures: world-frame shapes at
+  /// t = 0, each with its constant velocity if it moves (default: none).
+  virtual void scene_obstacles(std::vector<ShapeSpec>& out) const { (void)out; }
 
  protected:
   explicit Plugin(std::string type);

@@ -2,11 +2,12 @@
 /// @file
 /// The summary of a run as a value: the figures the CLI prints, `compare` tabulates, the golden tests check and
 /// summary.json serialises (field by field; docs/output_formats.md). Plugins add their own figures through
-/// Plugin::summarise(), collected under `metrics`.
+/// Plugin::summarise(), collected under `metrics`, and their obstacles through Plugin::scene_obstacles().
 
 #include <string>
 #include <vector>
 
+#include "redres/collision.hpp"
 #include "redres/plugin.hpp"
 #include "redres/simulation.hpp"
 
@@ -27,18 +28,32 @@ struct SolverStats {
   std::string first_failure;  //!< "t = ...: <status>: <diagnosis>", or empty
 };
 
+/// A collision shape of a link, in that link's frame (the frames of frames.csv).
+struct LinkShapeFacts {
+  int joint = 0;    //!< the link's joint, 1-based
+  ShapeSpec shape;  //!< with its pose in the link frame resolved (RobotModel::LinkShape::spec)
+};
+
 /// Facts about the robot that the plotting tools need.
 struct RobotFacts {
   std::string name;
   std::string kind;  //!< "planar" or "spatial"
   std::vector<std::string> joint_names;
   std::vector<double> lower_limits, upper_limits, link_lengths;
+  std::vector<LinkShapeFacts> link_shapes;  //!< the links' collision shapes, in joint order
 };
 
 /// The figures one plugin reported.
 struct PluginMetrics {
   std::string plugin;           //!< instance name
   std::vector<Metric> metrics;  //!< its named figures
+};
+
+/// One obstacle of the scene, for drawing: a world-frame shape at t = 0 (with its velocity if it moves), and the
+/// plugin that reported it (Plugin::scene_obstacles).
+struct ObstacleFacts {
+  std::string plugin;  //!< instance name
+  ShapeSpec shape;     //!< as configured
 };
 
 /// The summary of one run.
@@ -62,7 +77,8 @@ struct RunSummary {
   SolverStats solver;
   double wall_time_s = 0.0;  //!< time spent in the loop (s)
   RobotFacts robot;
-  std::vector<PluginMetrics> metrics;  //!< per plugin that reports figures
+  std::vector<PluginMetrics> metrics;    //!< per plugin that reports figures
+  std::vector<ObstacleFacts> obstacles;  //!< every active plugin's obstacles, in the scenario's order
 
   /// A plugin's metric by plugin instance name and metric name, or nullptr.
   [[nodiscard]] const Metric* metric(const std::string& plugin, const std::string& metric_name) const;

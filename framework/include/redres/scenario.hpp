@@ -16,6 +16,7 @@
 ///   [[objectives]] ... [[constraints]] ...      # see plugin.hpp
 ///   [solver]      engine = "projection", ...    # see lvi.hpp
 ///   [output]      plots = false                 # render the figures with tools/plot_run.py after a run
+///                 animate = false               # and/or the animation (animation.mp4 or animation.gif)
 
 #include <filesystem>
 #include <memory>
@@ -42,6 +43,7 @@ struct Scenario {
   std::unique_ptr<Scheme> scheme;              //!< objectives and constraints
   std::unique_ptr<LviEngine> engine;           //!< solver
   bool plots = false;                          //!< [output] plots
+  bool animate = false;                        //!< [output] animate
 
   /// Number of control steps N = round(T / tau); the run records N + 1 rows, t = 0 .. T.
   [[nodiscard]] int steps() const;

@@ -9,7 +9,7 @@
 /// proportional to the penetration. Obstacles are spheres, capsules, cylinders or boxes with a pose in the world
 /// (base) frame, optionally moving at a constant velocity; for a planar robot they lie in the plane z = 0.
 /// Records per step `min_obstacle_distance` (m) and `obstacle_rows_active`; reports `min_obstacle_distance` and
-/// `steps_with_active_rows` to the run summary.
+/// `steps_with_active_rows` to the run summary, and its obstacles to summary.json's `obstacles` (for drawing).
 ///
 /// Pairs: brute force over the fixed list (every link shape against every obstacle: about 0.1 us per analytic
 /// pair), or, for scenes with many pairs (`broadphase = "auto"`: more than kBroadphasePairs), FCL's dynamic AABB tree
@@ -66,6 +66,8 @@ class ObstacleAvoidance final : public Configured<Constraint, ObstacleAvoidanceC
   [[nodiscard]] std::vector<std::string> recorded_columns() const override;
   void record(double* values) const override;
   void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const override;
+  /// Its obstacles, as configured (summary.json's `obstacles`).
+  void scene_obstacles(std::vector<ShapeSpec>& out) const override;
 
   /// The obstacle's world pose at time t (its pose moved by velocity * t).
   [[nodiscard]] Eigen::Isometry3d obstacle_pose(int k, double t) const;

@@ -1,0 +1,77 @@
+// joint_frames (frames.csv): the rows it keeps and the frames it computes.
+
+#include <gtest/gtest.h>
+
+#include "redres/kinematics.hpp"
+#include "redres/run_output.hpp"
+#include "test_util.hpp"
+
+namespace redres {
+namespace {
+
+// A recorded run of `rows` rows for the Panda: t = k / 100 and theta moving from home.
+Trajectory fake_run(const RobotModel& robot, std::size_t rows) {
+  std::vector<std::string> columns = {"t"};
+  for (int j = 1; j <= robot.dof(); ++j) columns.push_back("theta_" + std::to_string(j));
+  Trajectory run(columns, rows);
+  for (std::size_t r = 0; r < rows; ++r) {
+    double* row = run.append_row();
+    row[0] = 0.01 * static_cast<double>(r);
+    for (int j = 0; j < robot.dof(); ++j) row[1 + j] = 0.1 * (j + 1) * std::sin(0.01 * static_cast<double>(r));
+  }
+  return run;
+}
+
+TEST(JointFrames, KeepsEveryRowUpToTheLimitThenAFixedStrideAndTheLastRow) {
+  const RobotModel robot = load_robot(source_path("robots/franka_panda.toml"));
+  for (const std::size_t rows : {1u, 2u, 7u, 500u, 501u, 998u, 999u, 1000u, 4001u}) {
+    for (const std::size_t max_rows : {2u, 3u, 10u, 500u}) {
+      const Trajectory run = fake_run(robot, rows);
+      const Trajectory f = joint_frames(robot, run, max_rows);
+      const std::string what = std::to_string(rows) + " rows, at most " + std::to_string(max_rows);
+      EXPECT_LE(f.size(), max_rows) << what;
+      if (rows <= max_rows) {
+        EXPECT_EQ(f.size(), rows) << what;
+      } else {
+        EXPECT_GE(f.size(), (max_rows + 1) / 2) << what;  // the smallest stride, not a coarser one
+      }
+      ASSERT_GE(f.size(), 1u) << what;
+      EXPECT_EQ(f(0, 0), 0.0) << what;
+      EXPECT_EQ(f(f.size() - 1, 0), run(rows - 1, 0)) << what;
+      // Equal steps between the kept rows, but the last one may come sooner.
+      if (f.size() >= 3) {
+        const double step = f(1, 0) - f(0, 0);
+        for (std::size_t k = 1; k + 1 < f.size(); ++k) EXPECT_NEAR(f(k, 0) - f(k - 1, 0), step, 1e-12) << what;
+        EXPECT_LE(f(f.size() - 1, 0) - f(f.size() - 2, 0), step + 1e-12) << what;
+      }
+    }
+  }
+}
+
+TEST(JointFrames, AreTheKinematicsOfTheRecordedTheta) {
+  const RobotModel robot = load_robot(source_path("robots/franka_panda.toml"));
+  const Trajectory run = fake_run(robot, 1201);
+  const Trajectory f = joint_frames(robot, run);
+  ASSERT_EQ(f.size(), 401u);  // stride ceil(1200 / 499) = 3
+  EXPECT_EQ(f.width(), 1u + 12u * 7u + 3u);
+  KinematicsData k(robot);
+  Eigen::VectorXd theta(robot.dof());
+  for (const std::size_t r : {0u, 200u, 400u}) {
+    for (int j = 0; j < robot.dof(); ++j) theta(j) = run(3 * r, 1 + static_cast<std::size_t>(j));
+    compute_kinematics(robot, theta, k, KinematicsLevel::kPosition);
+    for (int j = 0; j < robot.dof(); ++j) {
+      const std::string J = "joint_" + std::to_string(j + 1);
+      const Eigen::Isometry3d& T = k.link_frames[static_cast<std::size_t>(j)];
+      EXPECT_EQ(f.at(r, J + "_x"), T.translation().x());
+      EXPECT_EQ(f.at(r, J + "_y"), T.translation().y());
+      EXPECT_EQ(f.at(r, J + "_z"), T.translation().z());
+      EXPECT_EQ(f.at(r, J + "_r12"), T.linear()(0, 1));
+      EXPECT_EQ(f.at(r, J + "_r31"), T.linear()(2, 0));
+    }
+    EXPECT_EQ(f.at(r, "ee_x"), k.ee_pose.translation().x());
+    EXPECT_EQ(f.at(r, "ee_z"), k.ee_pose.translation().z());
+  }
+}
+
+}  // namespace
+}  // namespace redres

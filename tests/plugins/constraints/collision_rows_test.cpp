@@ -256,7 +256,7 @@ TEST(CollisionRows, ContributionsAllocateNothingWhileNothingPenetrates) {
   EXPECT_GT((qp.A.array() != 0.0).count(), 0);
 }
 
-// A cluttered scene (120 obstacles around the Panda: spheres, capsules and boxes, a third of them moving; 1080 pairs):
+// A cluttered scene (120 obstacles around the Panda: spheres, capsules and boxes, a third of them moving; 960 pairs):
 // the broadphase path (FCL's AABB tree) writes exactly the rows of the brute-force path, at random configurations
 // and times, while measuring far fewer pairs; and, with static obstacles, it allocates nothing per step.
 std::vector<ShapeSpec> clutter(std::mt19937& rng, bool moving) {
@@ -278,7 +278,7 @@ TEST(CollisionRows, TheBroadphaseWritesTheRowsOfBruteForce) {
   using B = ObstacleAvoidance::Config::Broadphase;
   const ObstacleAvoidance::Config base{.obstacles = obstacles, .influence_distance = 0.15};
   ObstacleAvoidance::Config tree_config = base, brute_config = base;
-  tree_config.broadphase = B::kAuto;  // 9 link shapes x 120 obstacles > kBroadphasePairs
+  tree_config.broadphase = B::kAuto;  // 8 link shapes x 120 obstacles > kBroadphasePairs
   brute_config.broadphase = B::kNever;
   Built tree = build(robot, std::make_unique<ObstacleAvoidance>(tree_config, robot));
   Built brute = build(robot, std::make_unique<ObstacleAvoidance>(brute_config, robot));

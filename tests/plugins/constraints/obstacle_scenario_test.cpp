@@ -5,6 +5,8 @@
 // a failed step that names the pair and its distance. Distances are recomputed here, independently, from the
 // recorded angles and time (a moving obstacle is at p0 + v t).
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "redres/constraints/obstacle_avoidance.hpp"
@@ -173,6 +175,30 @@ TEST(ObstacleScenario, AStartInCollisionIsAFailedStepNamingThePair) {
                                      "at distance -"),
               std::string::npos)
         << run.first_failure;
+  }
+}
+
+// A sphere on the hand's own path (inside the R's bowl): the task and the damper cannot both hold, so the run has
+// failed steps, the first one infeasible at t > 0 with a diagnosis that names the task rows and the link-obstacle
+// pair with its distance; the recorded trajectory stays finite (no silent NaN).
+TEST(ObstacleScenario, AnObstacleOnThePathIsAnInfeasibleStepNamingThePair) {
+  Scenario s =
+      load_scenario(source_path("configs/paper_r_obstacle.toml"),
+                    {R"(constraints.3.obstacles=[{ shape = "sphere", radius = 0.015, xyz = [0.32, 1.11, 0.0] }])"});
+  const RunResult run = simulate(s);
+  ASSERT_GT(run.failures, 0);
+  EXPECT_EQ(run.first_failure.rfind("t = 0 s", 0), std::string::npos) << run.first_failure;
+  EXPECT_NE(run.first_failure.find("infeasible"), std::string::npos) << run.first_failure;
+  EXPECT_NE(run.first_failure.find("from 'task_tracking'"), std::string::npos) << run.first_failure;
+  EXPECT_NE(run.first_failure.find("from 'obstacle_avoidance': link 'joint6' capsule(r = 0.02 m, l = 0.103 m) vs "
+                                   "obstacle 1 sphere(r = 0.015 m) at distance "),
+            std::string::npos)
+      << run.first_failure;
+  const Trajectory& tr = run.trajectory;
+  for (std::size_t r = 0; r < tr.size(); ++r) {
+    for (std::size_t c = 0; c < tr.width(); ++c) {
+      ASSERT_TRUE(std::isfinite(tr(r, c))) << "row " << r << ", column " << tr.columns()[c];
+    }
   }
 }
 

@@ -93,8 +93,9 @@ class Newton final : public LviEngine {
     dxa_.setZero(n);
     wx_.setZero(n);
     wdx_.setZero(n);
-    ha_.setZero(n, n);
-    llt_ = Eigen::LLT<Eigen::MatrixXd>(n);
+    // Sized by a factorisation (LLT(n) leaves its status uninitialised, and copying that is undefined).
+    ha_.setIdentity(n, n);
+    llt_.compute(ha_);
     fallback_ = make_engine("projection", settings());
     fallback_result_.x.resize(0);
     fallback_->setup(n, m_e, m_i, fallback_result_);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -168,8 +169,12 @@ double box_point(const Eigen::Vector3d& q, const Eigen::Vector3d& h, Eigen::Vect
 }
 
 // Signed distance between a sphere or capsule (axis [p0, p1] in the world, radius r) and a box (pose Tb, half sides
-// h), exact also when they overlap: the signed distance to a box is convex, so its minimum along the axis is found
-// by golden-section search. Witness points: on the round shape and on the box, with round - box = d u.
+// h): the minimum over the axis of the point-box signed distance, minus r. The signed distance to a box is convex,
+// so that minimum is found by golden-section search. Apart, this is the exact distance. Overlapping, it is the
+// axis-based measure also used for two capsules: exact for a sphere and for a capsule whose axis stays outside the
+// box; when the axis crosses the box it is the depth of the deepest axis point below its nearest face (less than
+// the true penetration), with the normal of that face. Witness points: on the round shape and on the box, with
+// round - box = d u.
 void round_box(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double r, const Eigen::Isometry3d& Tb,
                const Eigen::Vector3d& h, double& d, Eigen::Vector3d& on_round, Eigen::Vector3d& on_box) {
   const Eigen::Isometry3d to_box = Tb.inverse();
@@ -247,15 +252,16 @@ struct NearData {
 };
 
 // FCL's tree calls this for each leaf whose box is closer to the query's than `dist` (leaves reached before the
-// first call are not filtered, hence the test here). Keeping dist at `within` makes the tree return every such leaf
-// rather than only the nearest (its own callbacks lower dist to the smallest distance found).
+// first call are not filtered, hence the test here). Keeping dist just above `within` makes the tree return every
+// leaf at most `within` away (as brute force keeps pairs with d <= d_i), rather than only the nearest (its own
+// callbacks lower dist to the smallest distance found).
 bool near_callback(fcl::CollisionObjectd* group_object, fcl::CollisionObjectd* /*query*/, void* data, double& dist) {
   auto& d = *static_cast<NearData*>(data);
-  if (group_object->getAABB().distance(*d.query) < d.within) {
+  if (group_object->getAABB().distance(*d.query) <= d.within) {
     d.out[d.count++] = static_cast<int>(reinterpret_cast<std::intptr_t>(group_object->getUserData()));
   }
-  dist = d.within;
-  return false;  // never stop early
+  dist = std::nextafter(d.within, std::numeric_limits<double>::infinity());  // the tree prunes boxes at >= dist
+  return false;                                                              // never stop early
 }
 
 }  // namespace
@@ -318,7 +324,7 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
     const bool box_a = impl_->box_half[static_cast<std::size_t>(a)].has_value();
     const bool box_b = impl_->box_half[static_cast<std::size_t>(b)].has_value();
     if ((ra.round && box_b) || (box_a && rb.round)) {
-      // A sphere or capsule against a box (a link and a table, say), apart or overlapping: exact, without FCL,
+      // A sphere or capsule against a box (a link and a table, say), apart or overlapping, without FCL (see round_box),
       // whose GJK allocates on every such query and whose EPA (for an overlap) can abort the process in 0.7 (a live
       // assert in Debian's build).
       const bool a_round = ra.round;

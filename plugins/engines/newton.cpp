@@ -398,10 +398,7 @@ class Newton final : public LviEngine {
       u_.head(n) = x_;
       u_.segment(n, me) = y_;
     }
-    const double scale =
-        1.0 + std::max({qp.zeta.lpNorm<Eigen::Infinity>(), me > 0 ? qp.d.lpNorm<Eigen::Infinity>() : 0.0,
-                        mi > 0 ? qp.b.lpNorm<Eigen::Infinity>() : 0.0});
-    const double target = std::min(settings().tolerance, 1e-12 * scale);
+    set_norms(qp);
     const auto solved = [&](double e2) {
       result.x = u_.head(n).cwiseMax(qp.lo).cwiseMin(qp.hi);
       result.y = u_.segment(n, me);
@@ -412,15 +409,49 @@ class Newton final : public LviEngine {
       return true;
     };
     double e2 = natural_residual2(qp, u_);
-    if (std::sqrt(e2) <= target) return solved(e2);
+    if (std::sqrt(e2) <= target_at(u_)) return solved(e2);
     ++iterations;
-    if (exact_step_lands(qp, target, e2)) return solved(e2);
-    return augmented_lagrangian(qp, target, iterations) && (e2 = natural_residual2(qp, u_), solved(e2));
+    if (exact_step_lands(qp, e2)) return solved(e2);
+    return augmented_lagrangian(qp, iterations) && (e2 = natural_residual2(qp, u_), solved(e2));
+  }
+
+  // Infinity norms of W, J, J', A and A' for target_at(), once per solve (loops: no temporaries).
+  void set_norms(const QpProblem& qp) {
+    const auto row_sums = [](const Eigen::MatrixXd& m, bool transposed) {
+      double best = 0.0;
+      const Eigen::Index outer = transposed ? m.cols() : m.rows(), inner = transposed ? m.rows() : m.cols();
+      for (Eigen::Index i = 0; i < outer; ++i) {
+        double sum = 0.0;
+        for (Eigen::Index k = 0; k < inner; ++k) sum += std::abs(transposed ? m(k, i) : m(i, k));
+        best = std::max(best, sum);
+      }
+      return best;
+    };
+    norm_w_ = row_sums(qp.W, false);
+    norm_j_ = row_sums(qp.J, false);
+    norm_jt_ = row_sums(qp.J, true);
+    norm_a_ = row_sums(qp.A, false);
+    norm_at_ = row_sums(qp.A, true);
+    data_scale_ = std::max({qp.zeta.lpNorm<Eigen::Infinity>(), qp.m_eq() > 0 ? qp.d.lpNorm<Eigen::Infinity>() : 0.0,
+                            qp.m_in() > 0 ? qp.b.lpNorm<Eigen::Infinity>() : 0.0});
+  }
+
+  // The general path's accuracy at w = [x; y; z]: min(tolerance, 1e-12 s) with s the size of the terms the
+  // residual adds up there, 1 + max(|zeta|, |d|, |b|, |W||x| + |J'||y| + |A'||z|, |J||x|, |A||x|) (infinity
+  // norms): rounding alone leaves about 1e-16 s, so a large W or large multipliers raise the bar accordingly.
+  double target_at(const Eigen::VectorXd& w) const {
+    const Eigen::Index n = xa_.size(), me = y_.size();
+    const Eigen::Index mi = w.size() - n - me;
+    const double x = w.head(n).lpNorm<Eigen::Infinity>();
+    const double y = me > 0 ? w.segment(n, me).lpNorm<Eigen::Infinity>() : 0.0;
+    const double z = mi > 0 ? w.tail(mi).lpNorm<Eigen::Infinity>() : 0.0;
+    const double terms = std::max({data_scale_, norm_w_ * x + norm_jt_ * y + norm_at_ * z, norm_j_ * x, norm_a_ * x});
+    return std::min(settings().tolerance, 1e-12 * (1.0 + terms));
   }
 
   // Step 1 of general_solve() from u_ (natural_residual2(u_) just computed, so mu_ and e_ hold its values): on
-  // landing (||e|| <= target at u_ + du), moves u_ there, leaves ||e||^2 in e2 and returns true.
-  bool exact_step_lands(const QpProblem& qp, double target, double& e2) {
+  // landing (||e|| <= target_at() there), moves u_ to u_ + du, leaves ||e||^2 in e2 and returns true.
+  bool exact_step_lands(const QpProblem& qp, double& e2) {
     const Eigen::Index N = u_.size();
     for (Eigen::Index i = 0; i < N; ++i) {
       const double v = u_(i) - mu_(i);
@@ -439,7 +470,7 @@ class Newton final : public LviEngine {
     if (!du_.allFinite()) return false;
     trial_ = u_ + du_;
     const double landed = natural_residual2(qp, trial_);
-    if (!(std::sqrt(landed) <= target)) return false;
+    if (!(std::sqrt(landed) <= target_at(trial_))) return false;
     u_.swap(trial_);
     e2 = landed;
     return true;
@@ -450,7 +481,7 @@ class Newton final : public LviEngine {
 
   // Step 2 of general_solve(): the method of multipliers from u_, trying step 1 after each outer iteration.
   // Rows r: J (m_e, l = h = d), A (m_i, l = -inf, h = b), then the bounds (n, the identity).
-  bool augmented_lagrangian(const QpProblem& qp, double target, int& iterations) {
+  bool augmented_lagrangian(const QpProblem& qp, int& iterations) {
     const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in(), R = me + mi + n;
     Ct_.leftCols(me) = qp.J.transpose();
     Ct_.middleCols(me, mi) = qp.A.transpose();
@@ -462,7 +493,8 @@ class Newton final : public LviEngine {
     row_lo_.tail(n) = qp.lo;
     row_hi_.tail(n) = qp.hi;
     // rho_r = rho / |c_r|^2, rho a large multiple of W's scale: the outer iteration contracts the multipliers'
-    // error by about 1 / (1 + rho sigma), and the inner Hessian's conditioning stays far from double precision.
+    // error by about 1 / (1 + rho sigma), while the inner Hessian W + rho C'C stays well conditioned (see the cap
+    // below).
     const double rho = 1e4 * qp.W.diagonal().cwiseAbs().maxCoeff();
     for (int r = 0; r < R; ++r) {
       const double c2 = Ct_.col(r).squaredNorm();
@@ -491,22 +523,26 @@ class Newton final : public LviEngine {
         const double cx = Ct_.col(r).dot(xa_);
         violation = std::max(violation, std::abs(excess(r, cx)));
         lambda_(r) = rho_(r) * excess(r, cx + (rho_(r) > 0.0 ? lambda_(r) / rho_(r) : 0.0));
-        if (!(std::abs(lambda_(r)) <= varpi)) return false;  // runaway multipliers: the rows cannot be met
+        // Runaway duals of the rows (y, z; the LVI bounds them by varpi): the rows cannot be met. The bounds'
+        // multipliers are not duals of the LVI (Omega clips x instead) and may be as large as the data make them.
+        if (r < me + mi && !(std::abs(lambda_(r)) <= varpi)) return false;
       }
+      u_.head(n) = xa_;
+      u_.segment(n, me) = -lambda_.head(me);
+      u_.tail(mi) = lambda_.segment(me, mi);
+      const double target = target_at(u_);
       // Where the violation does not shrink fast (large multipliers at a nearly degenerate solution, which the
-      // update approaches by rho * violation per iteration), raise the penalties tenfold (up to 1e8 times).
-      if (violation > 0.25 * last_violation && rho_scale_ < 1e8) {
+      // update approaches by rho * violation per iteration), raise the penalties tenfold, up to 1e6 times (the inner
+      // Hessian's conditioning grows with them), and only while the violation is above the accuracy sought.
+      if (violation > 0.25 * last_violation && violation > target && rho_scale_ < 1e6) {
         rho_ *= 10.0;
         rho_scale_ *= 10.0;
       }
       last_violation = violation;
-      u_.head(n) = xa_;
-      u_.segment(n, me) = -lambda_.head(me);
-      u_.tail(mi) = lambda_.segment(me, mi);
       double e2 = natural_residual2(qp, u_);
       if (std::sqrt(e2) <= target) return true;
       ++iterations;
-      if (exact_step_lands(qp, target, e2)) return true;
+      if (exact_step_lands(qp, e2)) return true;
     }
     return false;
   }
@@ -748,6 +784,7 @@ class Newton final : public LviEngine {
   Eigen::VectorXd row_lo_, row_hi_, rho_, lambda_, s_, delta_r_, xa_, ga_, dxa_, wx_, wdx_;
   std::vector<double> breaks_ab_;
   double rho_scale_ = 1.0;
+  double norm_w_ = 0.0, norm_j_ = 0.0, norm_jt_ = 0.0, norm_a_ = 0.0, norm_at_ = 0.0, data_scale_ = 0.0;
   Eigen::MatrixXd ha_;
   Eigen::LLT<Eigen::MatrixXd> llt_;
   std::unique_ptr<LviEngine> fallback_;

@@ -113,7 +113,10 @@ class NloptSlsqp final : public LviEngine {
     for (int r = 0; r < qp.m_in(); ++r) feas = std::max(feas, qp.A.row(r).dot(result.x) - qp.b(r));
     if (code == NLOPT_MAXEVAL_REACHED) {
       info.status = SolverStatus::kMaxIterations;
-    } else if (code > 0 && feas <= settings().tolerance && info.residual <= settings().tolerance) {
+    } else if ((code > 0 || code == NLOPT_ROUNDOFF_LIMITED) && feas <= settings().tolerance &&
+               info.residual <= settings().tolerance) {
+      // Roundoff-limited: SLSQP could not improve further in floating point; its answer counts when it meets the
+      // tolerance like any other.
       info.status = SolverStatus::kSolved;
     } else if (code > 0 || code == NLOPT_ROUNDOFF_LIMITED) {
       info.status = SolverStatus::kMaxIterations;  // stopped short of the tolerance; diagnosed by the caller

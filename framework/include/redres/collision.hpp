@@ -7,9 +7,9 @@
 /// FCL 0.7 facts the implementation respects (measured on Debian's package; docs/collision.md):
 /// - an overlapping pair queried without signed distance returns -1 with zeroed points, and FCL's signed distance
 ///   (GJK/EPA) loops or aborts on some overlapping pairs (Debian builds with live asserts; the independent solver
-///   aborts on penetrating capsules): every query is unsigned, and an overlap is measured without FCL, exactly, for
-///   a sphere or capsule against a sphere, capsule or box; the depth of other overlapping pairs (a cylinder, two
-///   boxes) is not measured, and the query reports the pair as failed (ok = false);
+///   aborts on penetrating capsules): every query is unsigned, and an overlap of a sphere or capsule with a sphere,
+///   capsule or box is measured without FCL, from the capsule's axis; the depth of other overlapping pairs (a cylinder,
+///   two boxes) is not measured, and the query reports the pair as failed (ok = false);
 /// - the result is cleared before every query, and `min_distance` is read (not the return value);
 /// - witness points are in the world frame, and p_b - p_a flips when the shapes overlap;
 /// - Halfspace and Plane distance queries crash, so they are not offered (a wall is a thin box);
@@ -91,8 +91,8 @@ class DistanceQuery {
   /// Places group shape first + k at poses[k] (world), for every k, and refits the tree. (FCL does not refresh an
   /// object's bounding box on setTransform; this calls computeAABB() on each and then the tree's update().)
   void move_group(const Eigen::Isometry3d* poses);
-  /// The group shapes whose bounding boxes come closer than `within` to the bounding box of shape a at pose Ta: a
-  /// superset of the group shapes within `within` of shape a. Writes their indices (first + k) into `out`, which
+  /// The group shapes whose bounding boxes come within `within` (inclusive) of the bounding box of shape a at pose
+  /// Ta: a superset of the group shapes within `within` of shape a. Writes their indices (first + k) into `out`, which
   /// must hold the group's size, and returns how many. Without build_broadphase(), every group is empty.
   int near(int a, const Eigen::Isometry3d& Ta, double within, int* out) const;
 

@@ -103,18 +103,20 @@ void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::V
   data.theta = theta;
 
   // Forward pass: joint frames and end-effector pose.
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  double phi = 0.0;  // planar end-effector angle, kept unwrapped
+  Eigen::Isometry3d T = model.base();
+  double phi = model.base_angle();  // planar end-effector angle, kept unwrapped
   for (int j = 0; j < n; ++j) {
     const JointSpec& joint = model.joint(j);
+    const Vector3d& u = model.axis(j);
     T = T * model.before(j);
-    data.axes.col(j) = T.linear().col(2);
+    // For the z axis, T.linear() * u is T's third column exactly (products with 0 and 1 round nothing).
+    data.axes.col(j) = T.linear() * u;
     data.origins.col(j) = T.translation();
     if (joint.type == JointType::kRevolute) {
-      T.rotate(Eigen::AngleAxisd(theta(j), Eigen::Vector3d::UnitZ()));
+      T.rotate(Eigen::AngleAxisd(theta(j), u));
       phi += theta(j);
     } else {
-      T.translate(Eigen::Vector3d(0.0, 0.0, theta(j)));
+      T.translate(theta(j) * u);
     }
     data.link_frames[static_cast<std::size_t>(j)] = T;
     T = T * model.after(j);

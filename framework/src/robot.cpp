@@ -10,7 +10,14 @@ namespace redres {
 
 const char* to_string(ChainKind kind) { return kind == ChainKind::kPlanar ? "planar" : "spatial"; }
 const char* to_string(JointType type) { return type == JointType::kRevolute ? "revolute" : "prismatic"; }
-const char* to_string(DhConvention convention) { return convention == DhConvention::kStandard ? "dh" : "modified_dh"; }
+const char* to_string(DhConvention convention) {
+  switch (convention) {
+    case DhConvention::kStandard: return "dh";
+    case DhConvention::kModified: return "modified_dh";
+    case DhConvention::kJointFrames: return "joints";
+  }
+  return "?";
+}
 const char* to_string(TaskRows rows) { return rows == TaskRows::kPosition ? "position" : "pose"; }
 
 namespace {
@@ -39,6 +46,13 @@ void validate(const RobotSpec& spec) {
   REDRES_REQUIRE(!spec.name.empty(), fn, "name is not empty");
   REDRES_REQUIRE(!spec.joints.empty(), fn, "the chain has at least one joint");
   REDRES_REQUIRE(spec.end_effector.matrix().allFinite(), fn, "end_effector is finite");
+  REDRES_REQUIRE(spec.base.matrix().allFinite(), fn, "base is finite");
+  if (spec.kind == ChainKind::kPlanar) {
+    const Eigen::Matrix3d& R = spec.base.linear();
+    REDRES_REQUIRE(spec.base.translation().z() == 0.0 && std::abs(R(2, 2) - 1.0) <= 1e-12 &&
+                       std::abs(R(0, 2)) <= 1e-12 && std::abs(R(1, 2)) <= 1e-12,
+                   fn, "a planar chain's base stays in the plane z = 0 (a translation in x, y and a rotation about z)");
+  }
   std::set<std::string> names;
   for (std::size_t j = 0; j < spec.joints.size(); ++j) {
     const JointSpec& jt = spec.joints[j];
@@ -52,6 +66,15 @@ void validate(const RobotSpec& spec) {
     REDRES_REQUIRE(
         std::isfinite(jt.a) && std::isfinite(jt.alpha) && std::isfinite(jt.d) && std::isfinite(jt.theta_offset), fn,
         who + " DH parameters are finite");
+    REDRES_REQUIRE(jt.origin.matrix().allFinite(), fn, who + " origin is finite");
+    REDRES_REQUIRE(jt.axis.allFinite() && jt.axis.norm() > 1e-9, fn,
+                   who + " axis is a finite, non-zero vector (got [" + num(jt.axis.x()) + ", " + num(jt.axis.y()) +
+                       ", " + num(jt.axis.z()) + "])");
+    const bool frames = spec.kind == ChainKind::kSpatial && spec.convention == DhConvention::kJointFrames;
+    if (!frames) {
+      REDRES_REQUIRE(jt.axis == Eigen::Vector3d::UnitZ() && jt.origin.matrix().isIdentity(0.0), fn,
+                     who + " uses the z axis and no origin (only `convention = \"joints\"` gives them)");
+    }
     if (spec.kind == ChainKind::kPlanar) {
       REDRES_REQUIRE(jt.type == JointType::kRevolute, fn,
                      who + " is revolute (planar chains have revolute joints only)");
@@ -75,6 +98,7 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
   upper_.resize(n);
   before_.reserve(static_cast<std::size_t>(n));
   after_.reserve(static_cast<std::size_t>(n));
+  axes_.reserve(static_cast<std::size_t>(n));
   for (int j = 0; j < n; ++j) {
     const JointSpec& jt = joint(j);
     lower_(j) = jt.lower;
@@ -87,12 +111,19 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
       before_.push_back(revolute ? rot_z(jt.theta_offset) : rot_z(jt.theta_offset) * trans(0.0, 0.0, jt.d));
       after_.push_back((revolute ? trans(0.0, 0.0, jt.d) : Isometry3d::Identity()) * trans(jt.a, 0.0, 0.0) *
                        rot_x(jt.alpha));
-    } else {
+    } else if (spec_.convention == DhConvention::kModified) {
       const Isometry3d link = rot_x(jt.alpha) * trans(jt.a, 0.0, 0.0) * rot_z(jt.theta_offset);
       before_.push_back(revolute ? link : link * trans(0.0, 0.0, jt.d));
       after_.push_back(revolute ? trans(0.0, 0.0, jt.d) : Isometry3d::Identity());
+    } else {
+      before_.push_back(jt.origin);
+      after_.push_back(Isometry3d::Identity());
     }
+    // z stays exactly (0, 0, 1) (normalising it changes nothing), so the DH chains compute as before.
+    axes_.push_back(jt.axis.normalized());
   }
+  const Eigen::Matrix3d& R = spec_.base.linear();
+  base_angle_ = spec_.kind == ChainKind::kPlanar ? std::atan2(R(1, 0), R(0, 0)) : 0.0;
   for (int j = 0; j < n; ++j) {
     // The link frame of joint j is the joint's frame after its motion; the next joint's origin (or the end
     // effector's) is after(j) * before(j + 1) in it.
@@ -155,7 +186,26 @@ bool RobotModel::self_collision_pair(int i, int j) const {
 
 namespace {
 
-JointSpec load_joint(const TableReader& entry, ChainKind kind, std::set<std::string>& names) {
+Isometry3d rpy_rotation(const std::vector<double>& rpy) {
+  return Isometry3d(AngleAxisd(rpy[2], Vector3d::UnitZ()) * AngleAxisd(rpy[1], Vector3d::UnitY()) *
+                    AngleAxisd(rpy[0], Vector3d::UnitX()));
+}
+
+// A pose table: spatial `xyz` (m) and `rpy` (rad, roll-pitch-yaw about the fixed x, y, z axes); planar `xyz`
+// ([x, y], m) and `angle` (rad, about z). `position` is accepted for `xyz` (the end effector's older key).
+Isometry3d read_pose(const TableReader& t, bool planar) {
+  if (t.has("xyz") && t.has("position")) t.fail("position", "give `xyz` or `position`, not both");
+  const char* key = t.has("position") ? "position" : "xyz";
+  if (planar) {
+    const std::vector<double> p = t.has(key) ? t.numbers(key, 2) : std::vector<double>{0.0, 0.0};
+    return trans(p[0], p[1], 0.0) * rot_z(t.number("angle", 0.0));
+  }
+  const std::vector<double> p = t.has(key) ? t.numbers(key, 3) : std::vector<double>{0.0, 0.0, 0.0};
+  const std::vector<double> rpy = t.has("rpy") ? t.numbers("rpy", 3) : std::vector<double>{0.0, 0.0, 0.0};
+  return trans(p[0], p[1], p[2]) * rpy_rotation(rpy);
+}
+
+JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention convention, std::set<std::string>& names) {
   JointSpec jt;
   jt.name = entry.string("name");
   if (jt.name.empty()) entry.fail("name", "expected a non-empty joint name");
@@ -170,6 +220,18 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, std::set<std::str
   if (kind == ChainKind::kPlanar) {
     jt.length = r.number("length");
     if (!(jt.length > 0.0)) r.fail("length", "expected a link length > 0 m, got " + num(jt.length));
+  } else if (convention == DhConvention::kJointFrames) {
+    if (auto origin = r.optional_table("origin")) {
+      const TableReader o(origin->file_ptr(), origin->raw(), "joint '" + jt.name + "' origin");
+      jt.origin = read_pose(o, false);
+      o.finish();
+    }
+    if (r.has("axis")) {
+      const std::vector<double> a = r.numbers("axis", 3);
+      jt.axis = Vector3d(a[0], a[1], a[2]);
+      if (!(jt.axis.norm() > 1e-9)) r.fail("axis", "expected a non-zero axis vector [x, y, z]");
+      jt.axis.normalize();
+    }
   } else {
     jt.a = r.number("a", 0.0);
     jt.alpha = r.number("alpha", 0.0);
@@ -227,28 +289,28 @@ RobotModel load_robot(const TableReader& r) {
   if (spec.name.empty()) r.fail("name", "expected a non-empty robot name");
   spec.kind = r.choice("kind", {"planar", "spatial"}) == "planar" ? ChainKind::kPlanar : ChainKind::kSpatial;
   if (spec.kind == ChainKind::kSpatial) {
-    spec.convention =
-        r.choice("convention", {"dh", "modified_dh"}) == "dh" ? DhConvention::kStandard : DhConvention::kModified;
+    const std::string c = r.choice("convention", {"dh", "modified_dh", "joints"});
+    spec.convention = c == "dh"            ? DhConvention::kStandard
+                      : c == "modified_dh" ? DhConvention::kModified
+                                           : DhConvention::kJointFrames;
   }
   spec.task = r.choice("task", {"position", "pose"}, "position") == "position" ? TaskRows::kPosition : TaskRows::kPose;
 
   std::set<std::string> names;
-  for (const TableReader& entry : r.tables("joints")) spec.joints.push_back(load_joint(entry, spec.kind, names));
+  for (const TableReader& entry : r.tables("joints")) {
+    spec.joints.push_back(load_joint(entry, spec.kind, spec.convention, names));
+  }
   const auto n = static_cast<Eigen::Index>(spec.joints.size());
 
   if (auto ee = r.optional_table("end_effector")) {
     const TableReader e(ee->file_ptr(), ee->raw(), "end_effector");
-    if (spec.kind == ChainKind::kPlanar) {
-      const std::vector<double> p = e.has("position") ? e.numbers("position", 2) : std::vector<double>{0.0, 0.0};
-      spec.end_effector = trans(p[0], p[1], 0.0) * rot_z(e.number("angle", 0.0));
-    } else {
-      const std::vector<double> p = e.has("position") ? e.numbers("position", 3) : std::vector<double>{0.0, 0.0, 0.0};
-      const std::vector<double> rpy = e.has("rpy") ? e.numbers("rpy", 3) : std::vector<double>{0.0, 0.0, 0.0};
-      spec.end_effector = trans(p[0], p[1], p[2]) *
-                          Isometry3d(AngleAxisd(rpy[2], Vector3d::UnitZ()) * AngleAxisd(rpy[1], Vector3d::UnitY()) *
-                                     AngleAxisd(rpy[0], Vector3d::UnitX()));
-    }
+    spec.end_effector = read_pose(e, spec.kind == ChainKind::kPlanar);
     e.finish();
+  }
+  if (auto base = r.optional_table("base")) {
+    const TableReader b(base->file_ptr(), base->raw(), "base");
+    spec.base = read_pose(b, spec.kind == ChainKind::kPlanar);
+    b.finish();
   }
 
   if (r.has("home")) {

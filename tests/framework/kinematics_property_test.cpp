@@ -109,6 +109,77 @@ RC_GTEST_PROP(KinematicsProperty, ManipulabilityGradientsMatchCentralDifferences
   if (k.mu > 1e-3) expect_close(k.grad_mu, fd_mu, 1e-5, "grad mu");
 }
 
+// The pose of the end effector, recomputed here from the spec by the formula in robot.hpp, without RobotModel's
+// precomputed transforms: T = P A_1 M_1 B_1 ... A_n M_n B_n E. Checks that the model (including the base pose, joint
+// origins and arbitrary axes) is built as documented; the central-difference properties above check the
+// derivatives against it.
+RC_GTEST_PROP(KinematicsProperty, EndEffectorPoseFollowsTheDocumentedProduct, ()) {
+  const int n = *rc::gen::inRange(1, 9);
+  const TaskRows task = *rc::gen::element(TaskRows::kPosition, TaskRows::kPose);
+  const RobotSpec spec = random_spatial(n, task);
+  const RobotModel model(spec);
+  const Eigen::VectorXd theta = random_theta(model);
+  Eigen::Isometry3d T = spec.base;
+  for (int j = 0; j < n; ++j) {
+    const JointSpec& jt = spec.joints[static_cast<std::size_t>(j)];
+    Eigen::Isometry3d A = Eigen::Isometry3d::Identity(), B = Eigen::Isometry3d::Identity();
+    const bool rev = jt.type == JointType::kRevolute;
+    const auto Rz = [](double a) { return Eigen::Isometry3d(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ())); };
+    const auto Rx = [](double a) { return Eigen::Isometry3d(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX())); };
+    const auto Tr = [](double x, double y, double z) { return Eigen::Isometry3d(Eigen::Translation3d(x, y, z)); };
+    Eigen::Vector3d u = Eigen::Vector3d::UnitZ();
+    switch (spec.convention) {
+      case DhConvention::kStandard:
+        A = Rz(jt.theta_offset) * (rev ? Eigen::Isometry3d::Identity() : Tr(0, 0, jt.d));
+        B = (rev ? Tr(0, 0, jt.d) : Eigen::Isometry3d::Identity()) * Tr(jt.a, 0, 0) * Rx(jt.alpha);
+        break;
+      case DhConvention::kModified:
+        A = Rx(jt.alpha) * Tr(jt.a, 0, 0) * Rz(jt.theta_offset) *
+            (rev ? Eigen::Isometry3d::Identity() : Tr(0, 0, jt.d));
+        B = rev ? Tr(0, 0, jt.d) : Eigen::Isometry3d::Identity();
+        break;
+      case DhConvention::kJointFrames:
+        A = jt.origin;
+        u = jt.axis.normalized();
+        break;
+    }
+    const Eigen::Isometry3d M =
+        rev ? Eigen::Isometry3d(Eigen::AngleAxisd(theta(j), u)) : Eigen::Isometry3d(Eigen::Translation3d(theta(j) * u));
+    T = T * A * M * B;
+  }
+  T = T * spec.end_effector;
+  KinematicsData k(model);
+  compute_kinematics(model, theta, k, KinematicsLevel::kPosition);
+  RC_ASSERT((k.ee_pose.matrix() - T.matrix()).cwiseAbs().maxCoeff() <= 1e-12);
+}
+
+// A DH chain and the same chain written as joint frames (origin_j = B_{j-1} A_j, axis z, the last B folded into the
+// end effector) give the same f, J and w: the two descriptions meet in one model.
+RC_GTEST_PROP(KinematicsProperty, DhChainsAndTheirJointFramesAgree, ()) {
+  const int n = *rc::gen::inRange(2, 9);
+  const TaskRows task = *rc::gen::element(TaskRows::kPosition, TaskRows::kPose);
+  const RobotSpec dh = random_spatial(n, task);
+  RC_PRE(dh.convention != DhConvention::kJointFrames);  // a DH chain (either convention) to rewrite
+  const RobotModel a(dh);
+  RobotSpec frames = dh;
+  frames.convention = DhConvention::kJointFrames;
+  for (int j = 0; j < n; ++j) {
+    JointSpec& jt = frames.joints[static_cast<std::size_t>(j)];
+    jt.origin = (j > 0 ? a.after(j - 1) : Eigen::Isometry3d::Identity()) * a.before(j);
+    jt.axis = Eigen::Vector3d::UnitZ();
+    jt.a = jt.alpha = jt.d = jt.theta_offset = 0.0;  // (a prismatic joint's Tz(d_j) is in a.before(j) already)
+  }
+  frames.end_effector = a.after(n - 1) * dh.end_effector;
+  const RobotModel b(frames);
+  const Eigen::VectorXd theta = random_theta(a);
+  KinematicsData ka(a), kb(b);
+  compute_kinematics(a, theta, ka, KinematicsLevel::kManipulability);
+  compute_kinematics(b, theta, kb, KinematicsLevel::kManipulability);
+  RC_ASSERT((ka.f - kb.f).cwiseAbs().maxCoeff() <= 1e-12);
+  RC_ASSERT((ka.J - kb.J).cwiseAbs().maxCoeff() <= 1e-12);
+  RC_ASSERT(std::abs(ka.w - kb.w) <= 1e-12 * (1.0 + ka.w));
+}
+
 RC_GTEST_PROP(KinematicsProperty, PlanarBaseRotationLeavesManipulabilityUnchanged, ()) {
   const int n = *rc::gen::inRange(2, 10);
   const TaskRows task = *rc::gen::element(TaskRows::kPosition, TaskRows::kPose);

@@ -22,7 +22,7 @@ const std::vector<Bad>& corpus() {
   static const std::vector<Bad> c = {
       {"unknown_top_key.toml",
        "3:1",
-       {"unknown key 'colour'", "known keys: collision_exclude, end_effector, home, joints, kind"}},
+       {"unknown key 'colour'", "known keys: base, collision_exclude, end_effector, home, joints, kind"}},
       {"unknown_joint_key.toml", "6:1", {"unknown key 'mass' in joint 'j1'", "length, limits, name"}},
       {"unknown_law_key.toml", "14:1", {"unknown key 'sigma'", "known keys: a, b, s, sigma_max, sigma_min, type"}},
       {"wrong_type_number.toml",
@@ -63,6 +63,11 @@ const std::vector<Bad>& corpus() {
       {"syntax_error.toml", "3:17", {"TOML syntax error"}},
       {"spatial_without_convention.toml", "1:1", {"missing required key 'convention'"}},
       {"end_effector_wrong_size.toml", "4:12", {"key 'position': expected an array of 2 numbers, got 3"}},
+      {"joints_zero_axis.toml", "6:8", {"joint 'j1': key 'axis': expected a non-zero axis vector"}},
+      {"joints_with_dh_key.toml", "6:1", {"unknown key 'd' in joint 'j1'", "axis, collision, limits, name, origin"}},
+      {"dh_with_axis.toml", "6:1", {"unknown key 'axis' in joint 'j1'", "a, alpha, collision, d, limits"}},
+      {"joints_origin_unknown_key.toml", "6:31", {"unknown key 'quat' in joint 'j1' origin", "rpy, xyz"}},
+      {"planar_base_rpy.toml", "5:1", {"unknown key 'rpy' in base", "angle, position, xyz"}},
   };
   return c;
 }

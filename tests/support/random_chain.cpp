@@ -29,6 +29,10 @@ RobotSpec random_planar(int n, TaskRows task) {
     spec.end_effector.translation() = Eigen::Vector3d(draw(-0.2, 0.2), draw(-0.2, 0.2), 0.0);
     spec.end_effector.rotate(Eigen::AngleAxisd(draw(-1.0, 1.0), Eigen::Vector3d::UnitZ()));
   }
+  if (*rc::gen::inRange(0, 2) == 1) {  // a base moved and turned in the plane
+    spec.base.translation() = Eigen::Vector3d(draw(-0.5, 0.5), draw(-0.5, 0.5), 0.0);
+    spec.base.rotate(Eigen::AngleAxisd(draw(-3.0, 3.0), Eigen::Vector3d::UnitZ()));
+  }
   return spec;
 }
 
@@ -37,15 +41,29 @@ RobotSpec random_spatial(int n, TaskRows task) {
   spec.name = "random_spatial";
   spec.kind = ChainKind::kSpatial;
   spec.task = task;
-  spec.convention = *rc::gen::inRange(0, 2) == 0 ? DhConvention::kStandard : DhConvention::kModified;
+  const int convention = *rc::gen::inRange(0, 3);
+  spec.convention = convention == 0   ? DhConvention::kStandard
+                    : convention == 1 ? DhConvention::kModified
+                                      : DhConvention::kJointFrames;
   for (int j = 0; j < n; ++j) {
     JointSpec jt;
     jt.name = "j" + std::to_string(j + 1);
     jt.type = *rc::gen::inRange(0, 4) == 0 ? JointType::kPrismatic : JointType::kRevolute;
-    jt.a = draw(-0.4, 0.4);
-    jt.alpha = draw(-3.14, 3.14);
-    jt.d = draw(-0.4, 0.4);
-    jt.theta_offset = draw(-3.14, 3.14);
+    if (spec.convention == DhConvention::kJointFrames) {
+      // A random origin (offset and turn) and a random axis, as a URDF joint has.
+      jt.origin.translation() = Eigen::Vector3d(draw(-0.4, 0.4), draw(-0.4, 0.4), draw(-0.4, 0.4));
+      jt.origin.rotate(Eigen::AngleAxisd(draw(-3.14, 3.14), Eigen::Vector3d::UnitZ()) *
+                       Eigen::AngleAxisd(draw(-3.14, 3.14), Eigen::Vector3d::UnitY()) *
+                       Eigen::AngleAxisd(draw(-3.14, 3.14), Eigen::Vector3d::UnitX()));
+      jt.axis = Eigen::Vector3d(draw(-1.0, 1.0), draw(-1.0, 1.0), draw(-1.0, 1.0));
+      if (jt.axis.norm() < 0.1) jt.axis = Eigen::Vector3d::UnitY();
+      jt.axis.normalize();
+    } else {
+      jt.a = draw(-0.4, 0.4);
+      jt.alpha = draw(-3.14, 3.14);
+      jt.d = draw(-0.4, 0.4);
+      jt.theta_offset = draw(-3.14, 3.14);
+    }
     if (jt.type == JointType::kRevolute) {
       jt.lower = -draw(0.2, 3.0);
       jt.upper = draw(0.2, 3.0);
@@ -58,6 +76,10 @@ RobotSpec random_spatial(int n, TaskRows task) {
   }
   spec.end_effector.translation() = Eigen::Vector3d(draw(-0.2, 0.2), draw(-0.2, 0.2), draw(0.0, 0.2));
   spec.end_effector.rotate(Eigen::AngleAxisd(draw(-1.0, 1.0), Eigen::Vector3d::UnitX()));
+  if (*rc::gen::inRange(0, 2) == 1) {  // a base placed anywhere, turned any way
+    spec.base.translation() = Eigen::Vector3d(draw(-0.5, 0.5), draw(-0.5, 0.5), draw(-0.5, 0.5));
+    spec.base.rotate(Eigen::AngleAxisd(draw(-3.0, 3.0), Eigen::Vector3d(draw(-1, 1), draw(-1, 1), 1.0).normalized()));
+  }
   return spec;
 }
 

@@ -5,9 +5,13 @@
 /// Notation (as in the paper): n joints, theta in R^n joint positions (rad for revolute, m for prismatic),
 /// m task rows, f(theta) in R^m the end-effector task coordinates, J = df/dtheta in R^{m x n}.
 ///
-/// Geometry. Every joint j is a fixed transform A_j, then the joint motion (Rz(theta_j) for revolute, Tz(theta_j)
-/// for prismatic), then a fixed transform B_j; the end effector is a fixed transform E after the last joint:
-///   T(theta) = A_1 M_1(theta_1) B_1 ... A_n M_n(theta_n) B_n E.
+/// Geometry. The chain starts at the base pose P (the robot's base in the world; identity by default). Every joint j
+/// is a fixed transform A_j, then the joint motion M_j (a rotation by theta_j about the joint's unit axis u_j for a
+/// revolute joint, a translation by theta_j u_j for a prismatic one), then a fixed transform B_j; the end effector
+/// is a fixed transform E after the last joint:
+///   T(theta) = P A_1 M_1(theta_1) B_1 ... A_n M_n(theta_n) B_n E.
+/// Every description below is converted into these transforms at load, so there is one kinematics code path. u_j is
+/// the z axis (0, 0, 1) for planar chains and both DH conventions.
 /// - planar chains (relative joint angles, docs/letter_r.md): A_j = I, B_j = Tx(l_j);
 ///   so x = sum_i l_i cos(theta_1 + ... + theta_i) and y likewise with sin.
 /// - spatial, standard DH (`convention = "dh"`): A_j = Rz(theta_offset_j) [Tz(d_j) if prismatic],
@@ -15,6 +19,8 @@
 /// - spatial, modified DH (`convention = "modified_dh"`, Craig): A_j = Rx(alpha_j) Tx(a_j) Rz(theta_offset_j)
 ///   [Tz(d_j) if prismatic], B_j = [Tz(d_j) if revolute]; alpha_j and a_j are those of the link before joint j
 ///   (Craig's alpha_{j-1}, a_{j-1}). Joint j moves about/along the z axis of frame j.
+/// - spatial, joint frames (`convention = "joints"`, as in URDF): A_j = the joint's origin (xyz, then roll-pitch-yaw
+///   about the fixed x, y, z axes), B_j = I; u_j = the joint's `axis` in the frame after A_j (normalised).
 ///
 /// Task rows (`task`): planar "position" = (x, y), planar "pose" = (x, y, phi) with phi the end-effector angle;
 /// spatial "position" = (x, y, z), spatial "pose" = (x, y, z, wx, wy, wz) where the last three rows of J are the
@@ -39,23 +45,25 @@ namespace redres {
 enum class ChainKind { kPlanar, kSpatial };
 /// Joint type.
 enum class JointType { kRevolute, kPrismatic };
-/// Denavit-Hartenberg convention of a spatial chain.
-enum class DhConvention { kStandard, kModified };
+/// How a spatial chain is described: Denavit-Hartenberg (standard or modified) or joint frames (origin and axis).
+enum class DhConvention { kStandard, kModified, kJointFrames };
 /// Which task-space rows the chain exposes.
 enum class TaskRows { kPosition, kPose };
 
 /// One joint as described in the robot file.
 struct JointSpec {
-  std::string name;                                        //!< unique joint name
-  JointType type = JointType::kRevolute;                   //!< revolute (rad) or prismatic (m; spatial chains only)
-  double length = 0.0;                                     //!< planar link length l_j after the joint (m, > 0)
-  double a = 0.0;                                          //!< DH link length (m)
-  double alpha = 0.0;                                      //!< DH link twist (rad)
-  double d = 0.0;                                          //!< DH link offset (m)
-  double theta_offset = 0.0;                               //!< DH joint-angle offset (rad)
-  double lower = 0.0;                                      //!< position limit theta^- (rad or m)
-  double upper = 0.0;                                      //!< position limit theta^+ (rad or m)
-  std::shared_ptr<const VelocityLimitLaw> velocity_limit;  //!< theta_dot^-(theta), theta_dot^+(theta)
+  std::string name;                                          //!< unique joint name
+  JointType type = JointType::kRevolute;                     //!< revolute (rad) or prismatic (m; spatial chains only)
+  double length = 0.0;                                       //!< planar link length l_j after the joint (m, > 0)
+  double a = 0.0;                                            //!< DH link length (m)
+  double alpha = 0.0;                                        //!< DH link twist (rad)
+  double d = 0.0;                                            //!< DH link offset (m)
+  double theta_offset = 0.0;                                 //!< DH joint-angle offset (rad)
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  //!< joint frames: A_j, in the previous link frame
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();           //!< joint frames: the axis u_j (other chains: z)
+  double lower = 0.0;                                        //!< position limit theta^- (rad or m)
+  double upper = 0.0;                                        //!< position limit theta^+ (rad or m)
+  std::shared_ptr<const VelocityLimitLaw> velocity_limit;    //!< theta_dot^-(theta), theta_dot^+(theta)
   /// Collision shapes of the link that joint j moves, in the link frame (the joint's frame after its motion, before
   /// the fixed transform to the next joint). A capsule with neither `length` nor `from`/`to` runs along the link:
   /// from the joint's origin to the next joint's origin (the end effector's, for the last joint).
@@ -69,6 +77,7 @@ struct RobotSpec {
   DhConvention convention = DhConvention::kStandard;               //!< spatial only
   TaskRows task = TaskRows::kPosition;                             //!< task rows
   std::vector<JointSpec> joints;                                   //!< the chain, base to tip
+  Eigen::Isometry3d base = Eigen::Isometry3d::Identity();          //!< P, the base in the world (planar: in-plane)
   Eigen::Isometry3d end_effector = Eigen::Isometry3d::Identity();  //!< E, in the last joint's frame
   Eigen::VectorXd home;                                            //!< home configuration (size n; empty = zeros)
   std::string source;                                              //!< file the spec came from (may be empty)
@@ -105,6 +114,12 @@ class RobotModel {
   /// Position limits theta^- and theta^+.
   [[nodiscard]] const Eigen::VectorXd& lower_limits() const noexcept { return lower_; }
   [[nodiscard]] const Eigen::VectorXd& upper_limits() const noexcept { return upper_; }
+  /// Base pose P in the world.
+  [[nodiscard]] const Eigen::Isometry3d& base() const noexcept { return spec_.base; }
+  /// Planar chains: the base's rotation about z (rad), which starts the end-effector angle phi.
+  [[nodiscard]] double base_angle() const noexcept { return base_angle_; }
+  /// Unit axis u_j of joint j, in the frame after A_j.
+  [[nodiscard]] const Eigen::Vector3d& axis(int j) const { return axes_[static_cast<std::size_t>(j)]; }
   /// End-effector transform E in the last joint's frame.
   [[nodiscard]] const Eigen::Isometry3d& end_effector() const noexcept { return spec_.end_effector; }
   /// Fixed transforms before and after joint j's motion.
@@ -138,6 +153,8 @@ class RobotModel {
   std::vector<std::string> task_names_;
   Eigen::VectorXd lower_, upper_;
   std::vector<Eigen::Isometry3d> before_, after_;
+  std::vector<Eigen::Vector3d> axes_;
+  double base_angle_ = 0.0;
   std::vector<LinkShape> link_shapes_;
 };
 

@@ -1,8 +1,12 @@
 #include "redres/robot.hpp"
 
 #include "redres/plugin_loader.hpp"
+#include "redres/urdf.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -275,6 +279,157 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
   return jt;
 }
 
+// A shape placed in a link's frame, moved into the joint's link frame the link rides on (`at`).
+ShapeSpec placed(ShapeSpec shape, const Isometry3d& at) {
+  if (shape.from && shape.to) {
+    const Vector3d a = at * Vector3d((*shape.from)[0], (*shape.from)[1], (*shape.from)[2]);
+    const Vector3d b = at * Vector3d((*shape.to)[0], (*shape.to)[1], (*shape.to)[2]);
+    shape.from = std::array<double, 3>{a.x(), a.y(), a.z()};
+    shape.to = std::array<double, 3>{b.x(), b.y(), b.z()};
+    return shape;
+  }
+  const Isometry3d t = at * shape.pose();
+  shape.xyz = {t.translation().x(), t.translation().y(), t.translation().z()};
+  const Eigen::Matrix3d& R = t.linear();
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  shape.rpy = std::abs(std::cos(pitch)) > 1e-9
+                  ? std::array<double, 3>{std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0))}
+                  : std::array<double, 3>{0.0, pitch, std::atan2(-R(0, 1), R(1, 1))};
+  return shape;
+}
+
+// A robot file that names a URDF (`urdf`, `base_link`, `tip_link`): the chain comes from the URDF
+// (read_urdf_chain); `[[joints]]` entries, by joint name, may replace a joint's `limits` and `velocity_limit`;
+// `[[links]]` entries, by link name, give collision shapes that replace (`replace = true`, the default) or add to
+// the URDF's. Fills name, kind, convention, joints and end_effector (the tip link's frame).
+void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
+  const std::filesystem::path file = r.path("urdf");
+  const std::string base_link = r.string("base_link"), tip_link = r.string("tip_link");
+  UrdfChain chain;
+  try {
+    chain = read_urdf_chain(file, base_link, tip_link);
+  } catch (const UrdfError& e) {
+    r.fail("urdf", e.what());
+  }
+  spec.name = r.string("name", chain.robot_name);
+  if (spec.name.empty()) r.fail("name", "expected a non-empty robot name (the URDF gives none)");
+  if (r.has("kind") && r.choice("kind", {"spatial"}) != "spatial") r.fail("kind", "a URDF chain is spatial");
+  if (r.has("convention") && r.choice("convention", {"joints"}) != "joints") {
+    r.fail("convention", "a URDF chain is made of joint frames");
+  }
+  spec.kind = ChainKind::kSpatial;
+  spec.convention = DhConvention::kJointFrames;
+  spec.end_effector = chain.tip;
+
+  // Overrides by joint name.
+  std::map<std::string, TableReader> overrides;
+  if (r.has("joints")) {
+    for (const TableReader& entry : r.tables("joints")) {
+      const std::string name = entry.string("name");
+      const bool known =
+          std::any_of(chain.joints.begin(), chain.joints.end(), [&](const UrdfJoint& j) { return j.name == name; });
+      if (!known)
+        entry.fail("name", "no moving joint named '" + name + "' between '" + base_link + "' and '" + tip_link +
+                               "' in " + file.string());
+      if (!overrides.emplace(name, entry).second) entry.fail("name", "a second entry for joint '" + name + "'");
+    }
+  }
+  for (const UrdfJoint& uj : chain.joints) {
+    JointSpec jt;
+    jt.name = uj.name;
+    jt.type = uj.prismatic ? JointType::kPrismatic : JointType::kRevolute;
+    jt.origin = uj.origin;
+    jt.axis = uj.axis;
+    jt.lower = uj.lower;
+    jt.upper = uj.upper;
+    const auto o = overrides.find(uj.name);
+    const std::optional<TableReader> entry =
+        o == overrides.end()
+            ? std::nullopt
+            : std::optional<TableReader>(TableReader(o->second.file_ptr(), o->second.raw(), "joint '" + uj.name + "'"));
+    if (entry) (void)entry->has("name");
+    if (entry && entry->has("limits")) {
+      const std::vector<double> lim = entry->numbers("limits", 2);
+      jt.lower = lim[0];
+      jt.upper = lim[1];
+      if (!(jt.lower < jt.upper)) entry->fail("limits", "expected [lower, upper] with lower < upper");
+    } else if (uj.continuous) {
+      r.fail("urdf", "joint '" + uj.name + "' is continuous in " + file.string() +
+                         ", which gives it no position limits: give its `limits` in a [[joints]] entry");
+    } else if (!(uj.lower < uj.upper)) {
+      r.fail("urdf", "joint '" + uj.name + "' in " + file.string() + " has limits lower " + num(uj.lower) +
+                         " >= upper " + num(uj.upper) + ": fix the URDF or give its `limits` in a [[joints]] entry");
+    }
+    if (entry && entry->has("velocity_limit")) {
+      const TableReader law_table = entry->table("velocity_limit");
+      const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' velocity_limit");
+      jt.velocity_limit = make_velocity_limit(law_reader);
+      law_reader.finish();
+      if (auto bad = check_velocity_law(*jt.velocity_limit, jt.lower, jt.upper)) {
+        law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() +
+                        "' is invalid at theta = " + num(bad->theta) + ": " + bad->reason);
+      }
+    } else if (uj.velocity > 0.0) {
+      const auto law = parse_toml_string(
+          "type = \"constant\"\nlower = " + num(-uj.velocity) + "\nupper = " + num(uj.velocity) + "\n",
+          file.string() + " (joint '" + uj.name + "' velocity limit)");
+      jt.velocity_limit = velocity_limit_registry().create(TableReader::root(law));
+    } else {
+      r.fail("urdf", "joint '" + uj.name + "' in " + file.string() +
+                         " has no velocity limit: give one in the URDF (<limit velocity=...>) or a `velocity_limit` "
+                         "in a [[joints]] entry");
+    }
+    if (entry) entry->finish();
+    spec.joints.push_back(std::move(jt));
+  }
+
+  // Collision shapes: the URDF's, per link, unless [[links]] replaces them.
+  std::map<std::string, TableReader> link_entries;
+  if (r.has("links")) {
+    for (const TableReader& entry : r.tables("links")) {
+      const std::string name = entry.string("name");
+      const bool known =
+          std::any_of(chain.links.begin(), chain.links.end(), [&](const UrdfLink& l) { return l.name == name; });
+      if (!known) {
+        entry.fail("name", "no link named '" + name + "' that moves with the chain from '" + base_link + "' to '" +
+                               tip_link + "' in " + file.string());
+      }
+      if (!link_entries.emplace(name, entry).second) entry.fail("name", "a second entry for link '" + name + "'");
+    }
+  }
+  for (const UrdfLink& link : chain.links) {
+    JointSpec& jt = spec.joints[static_cast<std::size_t>(link.joint)];
+    const auto e = link_entries.find(link.name);
+    bool replace = false;
+    if (e != link_entries.end()) {
+      const TableReader entry(e->second.file_ptr(), e->second.raw(), "link '" + link.name + "'");
+      (void)entry.has("name");
+      replace = entry.boolean("replace", true);
+      std::vector<ShapeSpec> shapes;
+      if (entry.has("collision")) config_io::read(entry, "collision", shapes);
+      for (std::size_t k = 0; k < shapes.size(); ++k) {
+        if (shapes[k].shape == ShapeSpec::Kind::kCapsule && !shapes[k].length && !shapes[k].from) {
+          entry.fail("collision", "shape " + std::to_string(k + 1) +
+                                      ": a capsule of a URDF link needs `length` (with `xyz`, `rpy`) or `from` and "
+                                      "`to`, in the link's frame");
+        }
+        if (shapes[k].velocity)
+          entry.fail("collision", "shape " + std::to_string(k + 1) + " has a velocity; only obstacles move");
+        jt.collision.push_back(placed(shapes[k], link.pose));
+      }
+      entry.finish();
+    }
+    if (replace) continue;
+    if (!link.meshes.empty()) {
+      r.fail("urdf", "link '" + link.name + "' in " + file.string() + " has a mesh collision element ('" +
+                         link.meshes.front() +
+                         "'), which redres does not read: give the link's shapes in a [[links]] entry (replace = "
+                         "true), e.g. capsules");
+    }
+    for (const ShapeSpec& s : link.shapes) jt.collision.push_back(placed(s, link.pose));
+  }
+}
+
 }  // namespace
 
 RobotModel load_robot(const std::filesystem::path& file) {
@@ -285,26 +440,34 @@ RobotModel load_robot(const TableReader& r) {
   load_plugins_from(r);  // plugin libraries first: their velocity-limit laws may be named below
   RobotSpec spec;
   spec.source = r.file().path.string();
-  spec.name = r.string("name");
-  if (spec.name.empty()) r.fail("name", "expected a non-empty robot name");
-  spec.kind = r.choice("kind", {"planar", "spatial"}) == "planar" ? ChainKind::kPlanar : ChainKind::kSpatial;
-  if (spec.kind == ChainKind::kSpatial) {
-    const std::string c = r.choice("convention", {"dh", "modified_dh", "joints"});
-    spec.convention = c == "dh"            ? DhConvention::kStandard
-                      : c == "modified_dh" ? DhConvention::kModified
-                                           : DhConvention::kJointFrames;
+  const bool from_urdf = r.has("urdf");
+  if (from_urdf) {
+    load_urdf_chain(r, spec);
+  } else {
+    spec.name = r.string("name");
+    if (spec.name.empty()) r.fail("name", "expected a non-empty robot name");
+    spec.kind = r.choice("kind", {"planar", "spatial"}) == "planar" ? ChainKind::kPlanar : ChainKind::kSpatial;
+    if (spec.kind == ChainKind::kSpatial) {
+      const std::string c = r.choice("convention", {"dh", "modified_dh", "joints"});
+      spec.convention = c == "dh"            ? DhConvention::kStandard
+                        : c == "modified_dh" ? DhConvention::kModified
+                                             : DhConvention::kJointFrames;
+    }
   }
   spec.task = r.choice("task", {"position", "pose"}, "position") == "position" ? TaskRows::kPosition : TaskRows::kPose;
 
-  std::set<std::string> names;
-  for (const TableReader& entry : r.tables("joints")) {
-    spec.joints.push_back(load_joint(entry, spec.kind, spec.convention, names));
+  if (!from_urdf) {
+    std::set<std::string> names;
+    for (const TableReader& entry : r.tables("joints")) {
+      spec.joints.push_back(load_joint(entry, spec.kind, spec.convention, names));
+    }
   }
   const auto n = static_cast<Eigen::Index>(spec.joints.size());
 
   if (auto ee = r.optional_table("end_effector")) {
     const TableReader e(ee->file_ptr(), ee->raw(), "end_effector");
-    spec.end_effector = read_pose(e, spec.kind == ChainKind::kPlanar);
+    // After the URDF's tip link, when there is one (spec.end_effector holds that link's frame).
+    spec.end_effector = spec.end_effector * read_pose(e, spec.kind == ChainKind::kPlanar);
     e.finish();
   }
   if (auto base = r.optional_table("base")) {

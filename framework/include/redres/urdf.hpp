@@ -1,0 +1,60 @@
+#pragma once
+/// @file
+/// Reading a serial chain out of a URDF file (urdfdom, Debian's liburdfdom-dev), for robot files that name one
+/// (`urdf = "..."`, docs/robot_format.md). Only the chain between two links is read: its moving joints become joint
+/// frames (origin and axis, robot.hpp), fixed joints are folded into the next origin (or into the tip transform
+/// after the last moving joint), and the collision elements of the links the chain moves become collision shapes.
+/// urdfdom is included only by urdf.cpp.
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "redres/collision.hpp"
+
+namespace redres {
+
+/// A problem with a URDF file: the message names the file and the element.
+class UrdfError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// One moving joint of the chain, as the URDF gives it.
+struct UrdfJoint {
+  std::string name;                                          //!< the joint's name
+  bool prismatic = false;                                    //!< else revolute or continuous
+  bool continuous = false;                                   //!< a continuous joint has no position limits
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  //!< from the previous moving joint's link frame
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();           //!< in the joint's frame (normalised)
+  double lower = 0.0, upper = 0.0;                           //!< position limits (rad or m); unset if continuous
+  double velocity = 0.0;                                     //!< velocity limit (rad/s or m/s); 0 if not given
+};
+
+/// A link of the chain that moves with a joint: its shapes, placed in that joint's link frame.
+struct UrdfLink {
+  std::string name;                                        //!< the link's name
+  int joint = 0;                                           //!< index of the moving joint it rides on (0-based)
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< the link's frame in that joint's link frame
+  std::vector<ShapeSpec> shapes;                           //!< its sphere, box and cylinder collision elements
+  std::vector<std::string> meshes;                         //!< the file names of its mesh collision elements
+};
+
+/// The chain from `base_link` to `tip_link`.
+struct UrdfChain {
+  std::string robot_name;                                 //!< the URDF's robot name
+  std::vector<UrdfJoint> joints;                          //!< the moving joints, base to tip
+  std::vector<UrdfLink> links;                            //!< the links after the first moving joint, base to tip
+  Eigen::Isometry3d tip = Eigen::Isometry3d::Identity();  //!< tip_link's frame in the last joint's link frame
+};
+
+/// Reads the chain. Throws UrdfError naming the file and the element for: a missing or unparsable file (with
+/// urdfdom's own messages), a missing link, a tip that is not below the base, a floating, planar or mimic joint in
+/// the chain, and a chain without moving joints.
+[[nodiscard]] UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link,
+                                        const std::string& tip_link);
+
+}  // namespace redres

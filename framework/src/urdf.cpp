@@ -1,0 +1,172 @@
+// The only translation unit that includes urdfdom.
+
+#include "redres/urdf.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+namespace redres {
+
+namespace {
+
+// Collects urdfdom's messages (it reports parse errors through console_bridge, not through its return value), so
+// that they go into the error instead of to stderr.
+class Collect final : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char* /*filename*/, int /*line*/) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) messages += (messages.empty() ? "" : "; ") + text;
+  }
+  std::string messages;
+};
+
+Eigen::Isometry3d pose_of(const urdf::Pose& p) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
+  t.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).toRotationMatrix();
+  return t;
+}
+
+std::array<double, 3> xyz_of(const Eigen::Isometry3d& t) {
+  return {t.translation().x(), t.translation().y(), t.translation().z()};
+}
+
+// Roll, pitch, yaw of R = Rz(yaw) Ry(pitch) Rx(roll), the convention ShapeSpec reads.
+std::array<double, 3> rpy_of(const Eigen::Matrix3d& R) {
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  if (std::abs(std::cos(pitch)) > 1e-9) return {roll, pitch, yaw};
+  return {0.0, pitch, std::atan2(-R(0, 1), R(1, 1))};  // gimbal lock: put the whole turn in yaw
+}
+
+}  // namespace
+
+UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link,
+                          const std::string& tip_link) {
+  const std::string where = file.string();
+  std::ifstream in(file);
+  if (!in) throw UrdfError(where + ": cannot open the URDF file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  const std::string xml = text.str();
+
+  urdf::ModelInterfaceSharedPtr model;
+  std::string messages;
+  {
+    // console_bridge's handler is process-wide: one reader at a time.
+    static std::mutex lock;
+    const std::lock_guard<std::mutex> guard(lock);
+    Collect collect;
+    console_bridge::useOutputHandler(&collect);
+    model = urdf::parseURDF(xml);
+    console_bridge::restorePreviousOutputHandler();
+    messages = collect.messages;
+  }
+  if (!model)
+    throw UrdfError(where + ": not a valid URDF (" + (messages.empty() ? "urdfdom gave no reason" : messages) + ")");
+
+  UrdfChain chain;
+  chain.robot_name = model->getName();
+  const urdf::LinkConstSharedPtr base = model->getLink(base_link);
+  if (!base) throw UrdfError(where + ": no link named '" + base_link + "' (base_link)");
+  urdf::LinkConstSharedPtr link = model->getLink(tip_link);
+  if (!link) throw UrdfError(where + ": no link named '" + tip_link + "' (tip_link)");
+
+  // Walk up from the tip to the base; the joints met, reversed, are the chain.
+  std::vector<urdf::LinkConstSharedPtr> links{link};
+  while (link->name != base_link) {
+    const urdf::JointConstSharedPtr joint = link->parent_joint;
+    if (!joint) {
+      throw UrdfError(where + ": link '" + tip_link + "' (tip_link) is not below link '" + base_link +
+                      "' (base_link): walking up from it reaches the root '" + link->name + "'");
+    }
+    link = model->getLink(joint->parent_link_name);
+    if (!link) throw UrdfError(where + ": joint '" + joint->name + "' names a missing parent link");
+    links.push_back(link);
+  }
+  std::reverse(links.begin(), links.end());  // base first
+
+  Eigen::Isometry3d fixed = Eigen::Isometry3d::Identity();  // fixed joints since the last moving one
+  for (std::size_t k = 1; k < links.size(); ++k) {
+    const urdf::JointConstSharedPtr joint = links[k]->parent_joint;
+    const std::string who = where + ": joint '" + joint->name + "'";
+    if (joint->mimic) throw UrdfError(who + " is a mimic joint; a chain of independent joints is expected");
+    const Eigen::Isometry3d origin = pose_of(joint->parent_to_joint_origin_transform);
+    switch (joint->type) {
+      case urdf::Joint::FIXED: fixed = fixed * origin; break;
+      case urdf::Joint::REVOLUTE:
+      case urdf::Joint::CONTINUOUS:
+      case urdf::Joint::PRISMATIC: {
+        UrdfJoint j;
+        j.name = joint->name;
+        j.prismatic = joint->type == urdf::Joint::PRISMATIC;
+        j.continuous = joint->type == urdf::Joint::CONTINUOUS;
+        j.origin = fixed * origin;
+        fixed = Eigen::Isometry3d::Identity();
+        j.axis = Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
+        if (!(j.axis.norm() > 1e-9)) throw UrdfError(who + " has a zero axis");
+        j.axis.normalize();
+        if (joint->limits) {
+          j.lower = joint->limits->lower;
+          j.upper = joint->limits->upper;
+          j.velocity = joint->limits->velocity;
+        }
+        chain.joints.push_back(j);
+        break;
+      }
+      default:
+        throw UrdfError(who + " is a " +
+                        (joint->type == urdf::Joint::FLOATING ? std::string("floating")
+                         : joint->type == urdf::Joint::PLANAR ? std::string("planar")
+                                                              : std::string("unknown")) +
+                        " joint; a chain of revolute, continuous, prismatic and fixed joints is expected");
+    }
+    if (chain.joints.empty()) continue;  // still on the base: these links do not move
+    UrdfLink l;
+    l.name = links[k]->name;
+    l.joint = static_cast<int>(chain.joints.size()) - 1;
+    l.pose = fixed;
+    for (const urdf::CollisionSharedPtr& c : links[k]->collision_array) {
+      if (!c || !c->geometry) continue;
+      const Eigen::Isometry3d at = pose_of(c->origin);
+      ShapeSpec s;
+      s.xyz = xyz_of(at);
+      s.rpy = rpy_of(at.linear());
+      switch (c->geometry->type) {
+        case urdf::Geometry::SPHERE:
+          s.shape = ShapeSpec::Kind::kSphere;
+          s.radius = static_cast<const urdf::Sphere&>(*c->geometry).radius;
+          break;
+        case urdf::Geometry::BOX: {
+          const urdf::Vector3& d = static_cast<const urdf::Box&>(*c->geometry).dim;
+          s.shape = ShapeSpec::Kind::kBox;
+          s.size = std::array<double, 3>{d.x, d.y, d.z};
+          break;
+        }
+        case urdf::Geometry::CYLINDER: {
+          const auto& cyl = static_cast<const urdf::Cylinder&>(*c->geometry);
+          s.shape = ShapeSpec::Kind::kCylinder;
+          s.radius = cyl.radius;
+          s.length = cyl.length;
+          break;
+        }
+        case urdf::Geometry::MESH: l.meshes.push_back(static_cast<const urdf::Mesh&>(*c->geometry).filename); continue;
+      }
+      l.shapes.push_back(s);
+    }
+    chain.links.push_back(std::move(l));
+  }
+  if (chain.joints.empty()) {
+    throw UrdfError(where + ": no moving joint between '" + base_link + "' and '" + tip_link + "'");
+  }
+  chain.tip = fixed;
+  return chain;
+}
+
+}  // namespace redres

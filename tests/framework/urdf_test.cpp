@@ -1,0 +1,221 @@
+// Robots from URDF (urdfdom): the shipped Panda URDF (robots/franka_panda_urdf.toml) is the DH Panda
+// (robots/franka_panda.toml): the same f, J and w at 1000 random configurations, and the same capsules in the world.
+// The URDF's own primitive collision elements are read when no [[links]] entry replaces them. Every kind of bad URDF
+// is a ConfigError naming the robot file's `urdf` key, the URDF file and the element.
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "redres/kinematics.hpp"
+#include "test_util.hpp"
+
+namespace redres {
+namespace {
+
+Eigen::VectorXd random_inside(const RobotModel& robot, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Eigen::VectorXd theta(robot.dof());
+  for (int j = 0; j < robot.dof(); ++j) {
+    theta(j) = robot.lower_limits()(j) + u(rng) * (robot.upper_limits()(j) - robot.lower_limits()(j));
+  }
+  return theta;
+}
+
+// The world end points of a capsule of `robot` at the configuration in `k`.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> capsule_in_world(const RobotModel& robot, const KinematicsData& k,
+                                                             std::size_t s) {
+  const auto& shape = robot.link_shapes()[s];
+  const Eigen::Isometry3d T = k.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose;
+  const Eigen::Vector3d half = T.linear().col(2) * (0.5 * shape.spec.axis_length());
+  return {T.translation() - half, T.translation() + half};
+}
+
+TEST(Urdf, ThePandaUrdfIsTheDhPanda) {
+  const RobotModel dh = load_robot(source_path("robots/franka_panda.toml"));
+  const RobotModel urdf = load_robot(source_path("robots/franka_panda_urdf.toml"));
+  ASSERT_EQ(urdf.dof(), 7);
+  ASSERT_EQ(urdf.link_shapes().size(), dh.link_shapes().size());
+  KinematicsData a(dh), b(urdf);
+  std::mt19937 rng(21);
+  double worst_f = 0.0, worst_j = 0.0, worst_w = 0.0, worst_shape = 0.0;
+  for (int k = 0; k < 1000; ++k) {
+    const Eigen::VectorXd theta = random_inside(dh, rng);
+    compute_kinematics(dh, theta, a, KinematicsLevel::kManipulability);
+    compute_kinematics(urdf, theta, b, KinematicsLevel::kManipulability);
+    worst_f = std::max(worst_f, (a.f - b.f).cwiseAbs().maxCoeff());
+    worst_j = std::max(worst_j, (a.J - b.J).cwiseAbs().maxCoeff());
+    worst_w = std::max(worst_w, std::abs(a.w - b.w) / (1e-12 + a.w));
+    for (std::size_t s = 0; s < dh.link_shapes().size(); ++s) {
+      ASSERT_EQ(urdf.link_shapes()[s].link, dh.link_shapes()[s].link);
+      const auto [p0, p1] = capsule_in_world(dh, a, s);
+      const auto [q0, q1] = capsule_in_world(urdf, b, s);
+      worst_shape = std::max({worst_shape, (p0 - q0).norm(), (p1 - q1).norm()});
+    }
+  }
+  RecordProperty("max_f_difference", std::to_string(worst_f));
+  RecordProperty("max_J_difference", std::to_string(worst_j));
+  RecordProperty("max_capsule_end_difference", std::to_string(worst_shape));
+  EXPECT_LE(worst_f, 1e-12);
+  EXPECT_LE(worst_j, 1e-12);
+  EXPECT_LE(worst_w, 1e-10);
+  EXPECT_LE(worst_shape, 1e-12);
+  EXPECT_EQ(urdf.self_collision_pair(0, 2), false);  // collision_exclude by joint name
+  EXPECT_EQ(urdf.self_collision_pair(1, 3), true);
+}
+
+// A scratch directory with a URDF and a robot file that names it.
+struct Files {
+  std::filesystem::path dir;
+  explicit Files(const std::string& name) : dir(std::filesystem::temp_directory_path() / ("redres_urdf_" + name)) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+  }
+  ~Files() { std::filesystem::remove_all(dir); }
+  std::filesystem::path write(const std::string& file, const std::string& text) const {
+    std::ofstream(dir / file) << text;
+    return dir / file;
+  }
+};
+
+const char* const kTwoLinkUrdf = R"(<?xml version="1.0"?>
+<robot name="two">
+  <link name="base"/>
+  <link name="l1">
+    <collision><origin xyz="0 0 0.1" rpy="0 0 0"/><geometry><cylinder radius="0.03" length="0.2"/></geometry></collision>
+  </link>
+  <link name="l2">
+    <collision><origin xyz="0.05 0 0" rpy="0 1.5707963267948966 0"/><geometry><box size="0.1 0.02 0.02"/></geometry></collision>
+  </link>
+  <link name="tool">
+    <collision><origin xyz="0 0 0" rpy="0 0 0"/><geometry><sphere radius="0.02"/></geometry></collision>
+  </link>
+  <joint name="a" type="revolute">
+    <parent link="base"/><child link="l1"/><origin xyz="0 0 0.2" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" velocity="2" effort="1"/>
+  </joint>
+  <joint name="b" type="revolute">
+    <parent link="l1"/><child link="l2"/><origin xyz="0 0 0.2" rpy="0 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" velocity="3" effort="1"/>
+  </joint>
+  <joint name="t" type="fixed">
+    <parent link="l2"/><child link="tool"/><origin xyz="0.1 0 0" rpy="0 0 0"/>
+  </joint>
+</robot>
+)";
+
+const char* const kRobot = R"(urdf = "two.urdf"
+base_link = "base"
+tip_link = "tool"
+)";
+
+TEST(Urdf, PrimitivesLimitsAndTheFoldedToolComeFromTheUrdf) {
+  const Files f("primitives");
+  f.write("two.urdf", kTwoLinkUrdf);
+  const RobotModel robot = load_robot(f.write("two.toml", kRobot));
+  EXPECT_EQ(robot.name(), "two");
+  ASSERT_EQ(robot.dof(), 2);
+  EXPECT_EQ(robot.axis(1), Eigen::Vector3d::UnitY());
+  EXPECT_EQ(robot.upper_limits()(1), 1.0);
+  Eigen::VectorXd lo(2), hi(2);
+  robot.velocity_limits(Eigen::Vector2d::Zero(), lo, hi);
+  EXPECT_EQ(hi(1), 3.0);
+  EXPECT_EQ(lo(0), -2.0);
+  // Three shapes: l1's cylinder and l2's box ride on joints a and b; the tool's sphere rides on b, 0.1 m out.
+  ASSERT_EQ(robot.link_shapes().size(), 3u);
+  EXPECT_EQ(robot.link_shapes()[2].link, 1);
+  EXPECT_LE((robot.link_shapes()[2].pose.translation() - Eigen::Vector3d(0.1, 0, 0)).norm(), 1e-15);
+  KinematicsData k(robot);
+  compute_kinematics(robot, Eigen::Vector2d(0.3, 0.5), k, KinematicsLevel::kPosition);
+  // Tool at 0.1 m along l2's x axis: joint b turns about y, so x tilts down by 0.5 rad; joint a turns about z.
+  const Eigen::Vector3d tool(0.1 * std::cos(0.5) * std::cos(0.3), 0.1 * std::cos(0.5) * std::sin(0.3),
+                             0.4 - 0.1 * std::sin(0.5));
+  EXPECT_LE((k.f - tool).norm(), 1e-15);
+}
+
+struct BadUrdf {
+  const char* what;
+  std::string urdf;         // the URDF text ("" = no file at all)
+  std::string robot_extra;  // appended to the robot file
+  std::vector<std::string> says;
+};
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+
+TEST(Urdf, BadUrdfsAreErrorsNamingTheFileAndTheElement) {
+  const std::string good = kTwoLinkUrdf;
+  const std::vector<BadUrdf> cases = {
+      {"missing file", "", "", {"two.urdf: cannot open the URDF file"}},
+      {"joint names a missing link",
+       replace(good, R"(<parent link="l1"/>)", R"(<parent link="nowhere"/>)"),
+       "",
+       {"two.urdf: not a valid URDF", "nowhere"}},
+      {"tip not below base", good, "", {}},  // replaced below: base_link below the tip
+      {"floating joint",
+       replace(good, R"(name="b" type="revolute")", R"(name="b" type="floating")"),
+       "",
+       {"joint 'b' is a floating joint"}},
+      {"mimic joint",
+       replace(good, R"(<axis xyz="0 1 0"/>)", R"(<axis xyz="0 1 0"/><mimic joint="a"/>)"),
+       "",
+       {"joint 'b' is a mimic joint"}},
+      {"mesh",
+       replace(good, R"(<box size="0.1 0.02 0.02"/>)", R"(<mesh filename="l2.stl"/>)"),
+       "",
+       {"link 'l2'", "mesh collision element ('l2.stl')", "[[links]]"}},
+      {"continuous without limits",
+       replace(good, R"(name="a" type="revolute")", R"(name="a" type="continuous")"),
+       "",
+       {"joint 'a' is continuous", "give its `limits`"}},
+      {"no velocity limit",
+       replace(good, R"(velocity="3")", R"(velocity="0")"),
+       "",
+       {"joint 'b'", "has no velocity limit"}},
+      {"unknown joint override", good, "[[joints]]\nname = \"zz\"\n", {"no moving joint named 'zz'"}},
+      {"unknown link override", good, "[[links]]\nname = \"base\"\n", {"no link named 'base' that moves"}},
+  };
+  for (const BadUrdf& c : cases) {
+    SCOPED_TRACE(c.what);
+    const Files f("bad");
+    if (!c.urdf.empty()) f.write("two.urdf", c.urdf);
+    std::string robot = std::string(kRobot) + c.robot_extra;
+    std::vector<std::string> says = c.says;
+    if (std::string(c.what) == "tip not below base") {
+      robot = replace(replace(robot, "base_link = \"base\"", "base_link = \"l2\""), "tip_link = \"tool\"",
+                      "tip_link = \"l1\"");
+      says = {"link 'l1' (tip_link) is not below link 'l2' (base_link)"};
+    }
+    const auto file = f.write("two.toml", robot);
+    try {
+      (void)load_robot(file);
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(file.string() + ":", 0), 0u) << what;
+      for (const std::string& s : says)
+        EXPECT_NE(what.find(s), std::string::npos) << "missing '" << s << "' in: " << what;
+    }
+  }
+}
+
+TEST(Urdf, JointOverridesReplaceLimitsAndLaws) {
+  const Files f("override");
+  f.write("two.urdf", replace(kTwoLinkUrdf, R"(name="a" type="revolute")", R"(name="a" type="continuous")"));
+  const RobotModel robot = load_robot(f.write("two.toml", std::string(kRobot) + R"(
+[[joints]]
+name = "a"
+limits = [-1.2, 1.2]
+velocity_limit = { type = "push_rod", a = 0.1, b = 0.2, s = 0.1, sigma_min = -0.05, sigma_max = 0.05 }
+)"));
+  EXPECT_EQ(robot.upper_limits()(0), 1.2);
+  EXPECT_EQ(robot.joint(0).velocity_limit->type(), "push_rod");
+}
+
+}  // namespace
+}  // namespace redres

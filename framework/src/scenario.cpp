@@ -66,6 +66,13 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   s.source = file.string();
   s.name = r.string("name", file.stem().string());
   s.robot = std::make_unique<RobotModel>(load_robot(r.path("robot")));
+  if (r.has("task")) {
+    // The scenario chooses the task rows (the robot file's `task` is only the default), so that one robot file
+    // serves position and pose scenarios alike.
+    RobotSpec spec = s.robot->spec();
+    spec.task = r.choice("task", {"position", "pose"}) == "position" ? TaskRows::kPosition : TaskRows::kPose;
+    s.robot = std::make_unique<RobotModel>(std::move(spec));
+  }
   s.theta0 = read_theta0(r, *s.robot);
   s.duration = r.number("duration");
   s.tau = r.number("step");

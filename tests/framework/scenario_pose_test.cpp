@@ -50,5 +50,23 @@ TEST(PoseTask, IiwaHoldsItsOrientationWhileItDrawsACircle) {
   EXPECT_NEAR(m->values.at(0), worst, 1e-9);
 }
 
+// The scenario chooses the task rows: the Panda's robot file says "position", and `task = "pose"` in the scenario
+// (here through --set) makes the same run hold the flange's orientation too; the robot file is not copied.
+TEST(PoseTask, TheScenarioChoosesTheTaskRows) {
+  Scenario position = load_scenario(source_path("configs/panda_helix.toml"));
+  Scenario pose = load_scenario(source_path("configs/panda_helix.toml"), {"task=pose"});
+  ASSERT_EQ(position.robot->task_dim(), 3);
+  ASSERT_EQ(pose.robot->task_dim(), 6);
+  EXPECT_EQ(pose.robot->name(), position.robot->name());
+  const RunResult run = simulate(pose);
+  const RunSummary sum = summarise(pose, run);
+  EXPECT_EQ(sum.solver.failures, 0) << sum.solver.first_failure;
+  EXPECT_LT(sum.max_position_error, 1e-4);
+  const Metric* orientation = sum.metric("task_tracking", "max_orientation_error");
+  ASSERT_NE(orientation, nullptr);
+  EXPECT_LT(orientation->values.at(0), 1e-4);
+  EXPECT_THROW((void)load_scenario(source_path("configs/panda_helix.toml"), {"task=\"orientation\""}), ConfigError);
+}
+
 }  // namespace
 }  // namespace redres

@@ -9,7 +9,8 @@ namespace redres {
 const Schema<ManipulabilityConfig>& ManipulabilityConfig::schema() {
   using C = ManipulabilityConfig;
   static const Schema<C> s{
-      {field("measure", &C::measure, "", "w = det(JJ') (the paper) or Yoshikawa's sqrt(det(JJ'))"),
+      {field("measure", &C::measure, "",
+             "w = det(JJ') (the paper), Yoshikawa's sqrt(det(JJ')), or log det(JJ') (scale-free)"),
        field("schedule", &C::schedule, "", "p(t): constant p, p sin(pi t/T), smoothstep ramps, or a formula"),
        field("p", &C::p, "", "coefficient magnitude (not used by the expression schedule)"),
        field("ramp_fraction", &C::ramp_fraction, "", "smoothstep: each ramp's share of T",
@@ -59,24 +60,37 @@ double Manipulability::coefficient(double t, double T) const {
 }
 
 KinematicsLevel Manipulability::kinematics_level() const {
-  return config_.measure == Measure::kDet ? KinematicsLevel::kManipulability : KinematicsLevel::kAll;
+  return config_.measure == Measure::kYoshikawa ? KinematicsLevel::kAll : KinematicsLevel::kManipulability;
 }
 
+namespace {
+// log det(JJ') and its gradient divide by w: floored, so that an exact singularity gives a large, finite push.
+constexpr double kLogFloor = 1e-300;
+}  // namespace
+
 std::optional<double> Manipulability::potential(const Context& ctx) const {
-  const double value = config_.measure == Measure::kDet ? ctx.kinematics->w : ctx.kinematics->mu;
+  const KinematicsData& k = *ctx.kinematics;
+  const double value = config_.measure == Measure::kDet         ? k.w
+                       : config_.measure == Measure::kYoshikawa ? k.mu
+                                                                : std::log(std::max(k.w, kLogFloor));
   return -coefficient(ctx.t, ctx.T) * value;
 }
 
 void Manipulability::add_to(const Context& ctx, QpBuilder& builder) const {
   const double p = coefficient(ctx.t, ctx.T);
+  const KinematicsData& k = *ctx.kinematics;
   Eigen::VectorXd& z = builder.scratch();
-  z = -p * (config_.measure == Measure::kDet ? ctx.kinematics->grad_w : ctx.kinematics->grad_mu);
+  switch (config_.measure) {
+    case Measure::kDet: z = -p * k.grad_w; break;
+    case Measure::kYoshikawa: z = -p * k.grad_mu; break;
+    case Measure::kLogDet: z = (-p / std::max(k.w, kLogFloor)) * k.grad_w; break;
+  }
   builder.add_linear(z);
 }
 
 namespace {
 const bool kRegistered = objective_registry().add_plugin<Manipulability>(
-    "zeta += -p(t) grad w (eq. 5): maximises det(JJ') or sqrt(det(JJ')) with a coefficient schedule");
+    "zeta += -p(t) grad w (eq. 5): maximises det(JJ'), sqrt(det(JJ')) or log det(JJ') with a coefficient schedule");
 }  // namespace
 
 }  // namespace redres

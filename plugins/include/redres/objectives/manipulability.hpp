@@ -2,8 +2,10 @@
 /// @file
 /// `manipulability`: the manipulability-maximising term of eq. 5, zeta += -weight p(t) grad w. Together with
 /// `min_velocity_norm` (W = I) it is the paper's index |x - p q|^2 / 2 up to a constant (eq. 4). The measure is
-/// w = det(J J') (`det`, the paper) or Yoshikawa's sqrt(det(J J')) (`yoshikawa`); its gradient comes from the
-/// kinematics (adjugate / SVD forms, exact at singularities).
+/// w = det(J J') (`det`, the paper), Yoshikawa's sqrt(det(J J')) (`yoshikawa`), or log det(J J') (`log_det`); the
+/// gradients come from the kinematics (adjugate / SVD forms, exact at singularities; grad log w = grad w / w, with w
+/// floored at 1e-300). `log_det` is scale-free: its gradient does not change when the arm's lengths are scaled, so
+/// one p serves arms whose w is 1e-2 (spatial 7-DOF arms) and 1 alike; docs/paper.md says how to choose p.
 ///
 /// Coefficient schedules p(t), t in [0, T]:
 /// - `constant`: p(t) = p;
@@ -25,12 +27,12 @@ namespace redres {
 /// The configuration of `manipulability`. Designated initialisers follow this order, e.g.
 /// `Manipulability::Config{.p = 2.0, .schedule = Manipulability::Schedule::kSine}`.
 struct ManipulabilityConfig {
-  enum class Measure { kDet, kYoshikawa };
+  enum class Measure { kDet, kYoshikawa, kLogDet };
   enum class Schedule { kConstant, kSine, kSmoothstep, kExpression };
 
   double p = 2.0;                        //!< coefficient magnitude
   Schedule schedule = Schedule::kSine;   //!< p(t)
-  Measure measure = Measure::kDet;       //!< det(JJ') (the paper) or sqrt(det(JJ'))
+  Measure measure = Measure::kDet;       //!< det(JJ') (the paper), sqrt(det(JJ')) or log det(JJ')
   double ramp_fraction = 0.25;           //!< smoothstep: each ramp's share of T
   std::optional<std::string> formula{};  //!< expression: p(t) as a formula of t and T
 
@@ -41,7 +43,8 @@ struct ManipulabilityConfig {
 inline auto enum_names(ManipulabilityConfig::Measure) {
   using M = ManipulabilityConfig::Measure;
   return std::array{std::pair{M::kDet, std::string_view("det")},
-                    std::pair{M::kYoshikawa, std::string_view("yoshikawa")}};
+                    std::pair{M::kYoshikawa, std::string_view("yoshikawa")},
+                    std::pair{M::kLogDet, std::string_view("log_det")}};
 }
 inline auto enum_names(ManipulabilityConfig::Schedule) {
   using S = ManipulabilityConfig::Schedule;

@@ -12,7 +12,7 @@ Per run:
                             collision shapes, (b) desired path and trajectory, (c) theta_dot, (d) theta
   fig6_joint_angles.png     each theta with its limits and its safety region
   fig7_joint_velocities.png each theta_dot with its velocity limits and the merged bounds
-  fig9b_position_error.png  the position error over time
+  fig9b_position_error.png  the position error over time (and the orientation error, for pose tasks)
   fig_collision_distances.png  (runs with obstacle_avoidance or self_collision) the smallest distances over time,
                             with each plugin's safety and influence distances
 With --animate: animation.mp4 (matplotlib's FFMpegWriter) when ffmpeg is on PATH, else animation.gif (PillowWriter),
@@ -476,12 +476,21 @@ def fig_velocities(run_dir, data, n, name):
 
 
 def fig_error(run_dir, data, name):
-    fig, ax = plt.subplots(figsize=(7, 3.5))
+    """The position error, and for pose tasks the orientation error (the angle of R_d R') below it."""
+    pose = "orientation_error" in data.dtype.names
+    fig, axes = plt.subplots(2 if pose else 1, 1, figsize=(7, 5.5 if pose else 3.5), sharex=True, squeeze=False)
+    ax = axes[0][0]
     ax.plot(data["t"], data["position_error"], "b")
-    ax.set_xlabel("t (s)")
     ax.set_ylabel(r"$\|r_d - f(\theta)\|$ (m)")
     ax.set_title(f"{name}: position error (max {data['position_error'].max():.3g} m)")
     ax.grid(alpha=0.3)
+    if pose:
+        ax2 = axes[1][0]
+        ax2.plot(data["t"], data["orientation_error"], "r")
+        ax2.set_ylabel("orientation error (rad)")
+        ax2.set_title(f"orientation error (max {data['orientation_error'].max():.3g} rad)")
+        ax2.grid(alpha=0.3)
+    axes[-1][0].set_xlabel("t (s)")
     fig.tight_layout()
     fig.savefig(os.path.join(run_dir, "fig9b_position_error.png"), dpi=110)
     plt.close(fig)

@@ -2,11 +2,37 @@
 
 #include <algorithm>
 #include <chrono>
+#include <numbers>
 #include <sstream>
+
+#include <Eigen/Geometry>
 
 namespace redres {
 
 namespace {
+
+bool has_orientation_rows(const RobotModel& robot) {
+  return robot.task_dim() > (robot.kind() == ChainKind::kPlanar ? 2 : 3);
+}
+
+// The rotation vector w (|w| <= pi) written as the equivalent w + 2 pi k w/|w| closest to `previous`, so that the
+// recorded columns have no 2 pi jumps where the rotation angle passes pi.
+Eigen::Vector3d continuous_rotation_vector(const Eigen::Vector3d& w, const Eigen::Vector3d& previous) {
+  const double angle = w.norm();
+  if (!(angle > 0.0)) return w;
+  const Eigen::Vector3d u = w / angle;
+  Eigen::Vector3d best = w;
+  for (int k = -3; k <= 3; ++k) {
+    const Eigen::Vector3d candidate = (angle + 2.0 * std::numbers::pi * k) * u;
+    if ((candidate - previous).squaredNorm() < (best - previous).squaredNorm()) best = candidate;
+  }
+  return best;
+}
+
+Eigen::Matrix3d rotation_of(const Eigen::Vector3d& w) {
+  const double angle = w.norm();
+  return angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+}
 
 std::vector<std::string> trajectory_columns(const RobotModel& robot) {
   const int n = robot.dof();
@@ -21,8 +47,9 @@ std::vector<std::string> trajectory_columns(const RobotModel& robot) {
   add("hi_");
   for (const auto& name : robot.task_names()) cols.push_back("rd_" + name);
   for (const auto& name : robot.task_names()) cols.push_back("r_" + name);
-  for (const char* c : {"position_error", "manipulability", "solver_iterations", "solver_residual"})
-    cols.emplace_back(c);
+  cols.emplace_back("position_error");
+  if (has_orientation_rows(robot)) cols.emplace_back("orientation_error");
+  for (const char* c : {"manipulability", "solver_iterations", "solver_residual"}) cols.emplace_back(c);
   add("vel_lo_");
   add("vel_hi_");
   cols.emplace_back("solver_status");
@@ -70,6 +97,9 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   ctrl.set_kinematics_level(KinematicsLevel::kManipulability);
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
   Eigen::VectorXd theta = s.theta0, theta_pred(n), vlo(n), vhi(n);
+  const bool orientation_rows = has_orientation_rows(robot);
+  const bool spatial_orientation = orientation_rows && robot.kind() == ChainKind::kSpatial;
+  Eigen::Vector3d wd_prev = Eigen::Vector3d::Zero(), w_prev = Eigen::Vector3d::Zero();
   const auto start = std::chrono::steady_clock::now();
   const int report_every = std::max(1, steps / 200);
   const auto note = [&run](const StepOutput& o, double t) {
@@ -108,9 +138,27 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
     for (int j = 0; j < n; ++j) row[c++] = out.theta_dot(j);
     for (int j = 0; j < n; ++j) row[c++] = qp.lo(j);
     for (int j = 0; j < n; ++j) row[c++] = qp.hi(j);
-    for (int r = 0; r < m; ++r) row[c++] = ctrl.r_d()(r);
-    for (int r = 0; r < m; ++r) row[c++] = kin.f(r);
+    if (spatial_orientation) {
+      // Rotation vectors, recorded without 2 pi jumps (the controller itself uses rotations, not these vectors).
+      wd_prev =
+          continuous_rotation_vector(ctrl.r_d().tail<3>(), k == 0 ? Eigen::Vector3d(ctrl.r_d().tail<3>()) : wd_prev);
+      w_prev = continuous_rotation_vector(kin.f.tail<3>(), k == 0 ? Eigen::Vector3d(kin.f.tail<3>()) : w_prev);
+      for (int r = 0; r < 3; ++r) row[c++] = ctrl.r_d()(r);
+      for (int r = 0; r < 3; ++r) row[c++] = wd_prev(r);
+      for (int r = 0; r < 3; ++r) row[c++] = kin.f(r);
+      for (int r = 0; r < 3; ++r) row[c++] = w_prev(r);
+    } else {
+      for (int r = 0; r < m; ++r) row[c++] = ctrl.r_d()(r);
+      for (int r = 0; r < m; ++r) row[c++] = kin.f(r);
+    }
     row[c++] = (ctrl.r_d().head(position_rows) - kin.f.head(position_rows)).norm();
+    if (orientation_rows) {
+      // The angle between the desired and the actual orientation: planar |phi_d - phi|; spatial the angle of
+      // R_d R' (from the rotations themselves).
+      row[c++] = spatial_orientation
+                     ? Eigen::AngleAxisd(rotation_of(ctrl.r_d().tail<3>()) * kin.ee_pose.linear().transpose()).angle()
+                     : std::abs(ctrl.r_d()(2) - kin.f(2));
+    }
     row[c++] = kin.w;
     row[c++] = out.info.iterations;
     row[c++] = out.info.residual;

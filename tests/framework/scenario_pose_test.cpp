@@ -2,6 +2,8 @@
 // stay below the tolerances that scenario documents (1e-4 m and 1e-4 rad), the orientation reference is the
 // flange's orientation at t = 0, and task_tracking's summary metric agrees with an independent computation.
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -66,6 +68,32 @@ TEST(PoseTask, TheScenarioChoosesTheTaskRows) {
   ASSERT_NE(orientation, nullptr);
   EXPECT_LT(orientation->values.at(0), 1e-4);
   EXPECT_THROW((void)load_scenario(source_path("configs/panda_helix.toml"), {"task=\"orientation\""}), ConfigError);
+}
+
+// The Panda holds its flange pointing down: a rotation by an angle of about pi, where the rotation vector
+// (|w| <= pi) flips sign with every wobble. The recorded columns keep one continuous representation instead: no jump
+// between steps, although the angle goes both below and above pi; and orientation_error is the angle of R_d R'.
+TEST(PoseTask, RotationVectorColumnsHaveNoJumpsAtPi) {
+  Scenario s = load_scenario(source_path("configs/panda_helix.toml"), {"task=pose"});
+  const RunResult run = simulate(s);
+  const Trajectory& tr = run.trajectory;
+  double below = 0.0, above = 0.0, jump = 0.0, worst_error = 0.0;
+  Eigen::Vector3d prev = Eigen::Vector3d::Zero();
+  for (std::size_t r = 0; r < tr.size(); ++r) {
+    const Eigen::Vector3d w(tr.at(r, "r_wx"), tr.at(r, "r_wy"), tr.at(r, "r_wz"));
+    const Eigen::Vector3d wd(tr.at(r, "rd_wx"), tr.at(r, "rd_wy"), tr.at(r, "rd_wz"));
+    below = std::max(below, M_PI - w.norm());
+    above = std::max(above, w.norm() - M_PI);
+    if (r > 0) jump = std::max(jump, (w - prev).cwiseAbs().maxCoeff());
+    prev = w;
+    const double angle = Eigen::AngleAxisd(rotation(wd) * rotation(w).transpose()).angle();
+    EXPECT_NEAR(tr.at(r, "orientation_error"), angle, 1e-12);
+    worst_error = std::max(worst_error, angle);
+  }
+  EXPECT_GT(below, 0.0);  // the angle was below pi ...
+  EXPECT_GT(above, 0.0);  // ... and above it: without care the vector would have flipped
+  EXPECT_LT(jump, 1e-4);
+  EXPECT_LT(worst_error, 1e-4);
 }
 
 }  // namespace

@@ -96,5 +96,35 @@ TEST(PoseTask, RotationVectorColumnsHaveNoJumpsAtPi) {
   EXPECT_LT(worst_error, 1e-4);
 }
 
+// The shipped pose configs with manipulability maximisation (URDF robots, full pose held): errors, limits, newton on
+// every step, and w at the end above the minimum-velocity-norm scheme's on the same path (the manipulability term
+// switched off), by at least 20 %.
+class PoseManipulability : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(PoseManipulability, HoldsThePoseWithinTheLimitsAndEndsWithAHigherW) {
+  const std::string file = std::string("configs/") + GetParam() + ".toml";
+  Scenario tvcmm = load_scenario(source_path(file));
+  Scenario mvn = load_scenario(source_path(file), {"objectives.1.active=false"});
+  ASSERT_EQ(tvcmm.robot->task_dim(), 6);
+  const RunResult a = simulate(tvcmm), b = simulate(mvn);
+  const RunSummary sa = summarise(tvcmm, a), sb = summarise(mvn, b);
+  for (const RunSummary* sum : {&sa, &sb}) {
+    EXPECT_EQ(sum->solver.failures, 0) << sum->solver.first_failure;
+    EXPECT_LT(sum->max_position_error, 1e-4);
+    const Metric* orientation = sum->metric("task_tracking", "max_orientation_error");
+    ASSERT_NE(orientation, nullptr);
+    EXPECT_LT(orientation->values.at(0), 1e-4);
+    EXPECT_LE(sum->max_joint_angle_violation, 0.0);
+    EXPECT_LE(sum->max_joint_velocity_violation, 0.0);
+  }
+  EXPECT_EQ(a.engine(), "newton");
+  RecordProperty("w_final_tvcmm", std::to_string(sa.manipulability.final));
+  RecordProperty("w_final_mvn", std::to_string(sb.manipulability.final));
+  EXPECT_GT(sa.manipulability.final, 1.2 * sb.manipulability.final);
+}
+
+INSTANTIATE_TEST_SUITE_P(Configs, PoseManipulability,
+                         ::testing::Values("panda_pose_manipulability", "iiwa_pose_manipulability"));
+
 }  // namespace
 }  // namespace redres

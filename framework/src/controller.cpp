@@ -1,5 +1,11 @@
 #include "redres/controller.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Geometry>
+
 namespace redres {
 
 Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine& engine, const Path* path, double T,
@@ -54,12 +60,29 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, 
       orientation_captured_ = true;
     }
     const int rest = robot_->task_dim() - p;
-    if (robot_->kind() == ChainKind::kPlanar) {
-      r_d_(2) = orientation_.z();
-    } else {
-      r_d_.tail(rest) = orientation_;
+    // The turn's progress s(t) in [0, 1] and its rate (zero when the orientation is held).
+    double progress = 0.0, rate = 0.0;
+    const double T = ctx_.T;
+    if (turn_.squaredNorm() > 0.0 && T > 0.0) {
+      const double u = std::clamp(t / T, 0.0, 1.0);
+      progress = u - std::sin(2.0 * std::numbers::pi * u) / (2.0 * std::numbers::pi);
+      rate = (1.0 - std::cos(2.0 * std::numbers::pi * u)) / T;
     }
-    r_d_dot_.tail(rest).setZero();
+    if (robot_->kind() == ChainKind::kPlanar) {
+      r_d_(2) = orientation_.z() + progress * turn_.z();
+      r_d_dot_(2) = rate * turn_.z();
+    } else {
+      if (progress == 0.0) {
+        r_d_.tail(rest) = orientation_;
+      } else {
+        const double angle0 = orientation_.norm(), angle = turn_.norm();
+        const Eigen::Matrix3d R0 = angle0 > 0.0 ? Eigen::AngleAxisd(angle0, orientation_ / angle0).toRotationMatrix()
+                                                : Eigen::Matrix3d::Identity();
+        const Eigen::AngleAxisd R(Eigen::AngleAxisd(progress * angle, turn_ / angle).toRotationMatrix() * R0);
+        r_d_.tail(rest) = R.angle() * R.axis();
+      }
+      r_d_dot_.tail(rest) = rate * turn_;  // the world angular velocity, as J's angular rows
+    }
   }
   solve(t, out);
 }

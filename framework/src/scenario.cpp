@@ -99,6 +99,23 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   } else {
     s.engine = make_engine("projection");
   }
+  if (auto orientation = r.optional_table("orientation")) {
+    const TableReader o(orientation->file_ptr(), orientation->raw(), "orientation");
+    const bool planar = s.robot->kind() == ChainKind::kPlanar;
+    if (s.robot->task_dim() <= (planar ? 2 : 3)) {
+      r.fail("orientation",
+             "the task has no orientation rows: set task = \"pose\" (in the scenario or the robot file)");
+    }
+    if (o.has("turn")) {
+      if (planar) {
+        s.orientation_turn = Eigen::Vector3d(0.0, 0.0, o.number("turn"));
+      } else {
+        const std::vector<double> w = o.numbers("turn", 3);
+        s.orientation_turn = Eigen::Vector3d(w[0], w[1], w[2]);
+      }
+    }
+    o.finish();
+  }
   if (auto out = r.optional_table("output")) {
     const TableReader o(out->file_ptr(), out->raw(), "output");
     s.plots = o.boolean("plots", false);

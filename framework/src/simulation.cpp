@@ -94,6 +94,7 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   run.engines.reserve(4);
 
   Controller ctrl(robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
+  ctrl.set_orientation_turn(s.orientation_turn);
   ctrl.set_kinematics_level(KinematicsLevel::kManipulability);
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
   Eigen::VectorXd theta = s.theta0, theta_pred(n), vlo(n), vhi(n);

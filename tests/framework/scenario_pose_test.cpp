@@ -96,6 +96,33 @@ TEST(PoseTask, RotationVectorColumnsHaveNoJumpsAtPi) {
   EXPECT_LT(worst_error, 1e-4);
 }
 
+// [orientation] turn: the flange turns by 0.6 rad about the world z axis over the run (slerp, cycloidal timing)
+// while it draws the circle: the actual orientation follows (error < 1e-4 rad at every step), is halfway at T/2,
+// and ends at Rz(0.6) R_0. A turn needs orientation rows.
+TEST(PoseTask, TheOrientationTurnsFromItsStartByTheGivenRotation) {
+  Scenario s =
+      load_scenario(source_path("configs/iiwa_pose_manipulability.toml"), {"orientation.turn=[0.0, 0.0, 0.6]"});
+  const RunResult run = simulate(s);
+  const RunSummary sum = summarise(s, run);
+  EXPECT_EQ(sum.solver.failures, 0) << sum.solver.first_failure;
+  const Trajectory& tr = run.trajectory;
+  const auto R = [&](std::size_t r) {
+    return rotation(Eigen::Vector3d(tr.at(r, "r_wx"), tr.at(r, "r_wy"), tr.at(r, "r_wz")));
+  };
+  double worst = 0.0;
+  for (std::size_t r = 0; r < tr.size(); ++r) worst = std::max(worst, tr.at(r, "orientation_error"));
+  EXPECT_LT(worst, 1e-4);
+  const Eigen::Matrix3d R0 = R(0);
+  const auto turned = [&](double angle) {
+    return Eigen::Matrix3d(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R0);
+  };
+  EXPECT_LT(Eigen::AngleAxisd(R(tr.size() - 1) * turned(0.6).transpose()).angle(), 1e-4);
+  EXPECT_LT(Eigen::AngleAxisd(R((tr.size() - 1) / 2) * turned(0.3).transpose()).angle(), 1e-4);  // s(T/2) = 1/2
+  EXPECT_GT(Eigen::AngleAxisd(R(tr.size() - 1) * R0.transpose()).angle(), 0.59);
+  EXPECT_THROW((void)load_scenario(source_path("configs/panda_helix.toml"), {"orientation.turn=[0.0, 0.0, 0.6]"}),
+               ConfigError);
+}
+
 // The shipped pose configs with manipulability maximisation (URDF robots, full pose held): errors, limits, newton on
 // every step, and w at the end above the minimum-velocity-norm scheme's on the same path (the manipulability term
 // switched off), by at least 20 %.

@@ -47,6 +47,11 @@ class Controller {
     orientation_ = rotation_vector;
     orientation_set_ = true;
   }
+  /// Makes the path's steps turn the orientation instead of holding it: from the reference R_0 at t = 0 to
+  /// Rot(turn) R_0 at t = T (a rotation about the fixed world axis turn / |turn| by |turn| rad: spherical linear
+  /// interpolation), with the cycloidal timing s(t) = t/T - sin(2 pi t/T) / (2 pi), so that the angular velocity
+  /// turn s'(t), fed forward, starts and ends at zero. Planar: only turn.z() is used (an angle about z).
+  void set_orientation_turn(const Eigen::Vector3d& turn) { turn_ = turn; }
   /// The orientation reference (meaningful once set or captured).
   [[nodiscard]] const Eigen::Vector3d& orientation_reference() const noexcept { return orientation_; }
   /// Computes at least this much kinematics each step (e.g. kManipulability to record w with any scheme).
@@ -74,8 +79,9 @@ class Controller {
   SolverResult result_;
   Eigen::VectorXd r_d_, r_d_dot_;
   Eigen::Vector3d orientation_ = Eigen::Vector3d::Zero();
-  bool orientation_set_ = false;       // by set_orientation_reference()
-  bool orientation_captured_ = false;  // from the first path-driven step
+  Eigen::Vector3d turn_ = Eigen::Vector3d::Zero();  // set_orientation_turn(); zero: hold
+  bool orientation_set_ = false;                    // by set_orientation_reference()
+  bool orientation_captured_ = false;               // from the first path-driven step
   KinematicsLevel level_ = KinematicsLevel::kPosition;
   Context ctx_;
 };

@@ -42,8 +42,11 @@ struct Scenario {
   std::unique_ptr<Path> path;                  //!< r_d(t)
   std::unique_ptr<Scheme> scheme;              //!< objectives and constraints
   std::unique_ptr<LviEngine> engine;           //!< solver
-  bool plots = false;                          //!< [output] plots
-  bool animate = false;                        //!< [output] animate
+  /// [orientation] turn: the rotation (a world-frame rotation vector, rad; planar: its z) the end effector turns
+  /// through over the run, from the orientation it has at t = 0 (Controller::set_orientation_turn); zero: hold it.
+  Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();
+  bool plots = false;    //!< [output] plots
+  bool animate = false;  //!< [output] animate
 
   /// Number of control steps N = round(T / tau); the run records N + 1 rows, t = 0 .. T.
   [[nodiscard]] int steps() const;

@@ -79,6 +79,20 @@ INSTANTIATE_TEST_SUITE_P(Shipped, UrdfRobots,
                          ::testing::Values(std::pair{"robots/franka_panda.toml", "robots/franka_panda_urdf.toml"},
                                            std::pair{"robots/kuka_iiwa14.toml", "robots/kuka_iiwa14_urdf.toml"}));
 
+// The UR5e (robots/ur5e.toml, from its URDF written from UR's DH table): six joints for a 3-D position task (three
+// degrees of redundancy); at theta = 0 its flange sits at (a2 + a3, -(d4 + d6), d1 - d5), the published zero pose.
+TEST(Urdf, TheUr5eIsRedundantForItsPositionTaskAndHasItsZeroPose) {
+  const RobotModel ur = load_robot(source_path("robots/ur5e.toml"));
+  ASSERT_EQ(ur.dof(), 6);
+  ASSERT_EQ(ur.task_dim(), 3);
+  KinematicsData k(ur);
+  compute_kinematics(ur, Eigen::VectorXd::Zero(6), k, KinematicsLevel::kPosition);
+  EXPECT_LE((k.f - Eigen::Vector3d(-0.425 - 0.3922, -(0.1333 + 0.0996), 0.1625 - 0.0997)).norm(), 1e-12);
+  compute_kinematics(ur, ur.home(), k, KinematicsLevel::kManipulability);
+  EXPECT_GT(k.w, 1e-3);
+  EXPECT_EQ(ur.link_shapes().size(), 6u);
+}
+
 // A scratch directory with a URDF and a robot file that names it.
 struct Files {
   std::filesystem::path dir;

@@ -303,6 +303,28 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
   impl_->unsigned_request = fcl::DistanceRequestd(true, false, 0.0, 0.0, 1e-8, fcl::GST_LIBCCD);
 }
 
+std::array<double, 3> rpy_of(const Eigen::Matrix3d& R) {
+  // atan2 of the cosine's two parts keeps pitch accurate near +-pi/2, where asin(-R(2, 0)) loses digits.
+  const double cos_pitch = std::hypot(R(2, 1), R(2, 2));
+  const double pitch = std::atan2(-R(2, 0), cos_pitch);
+  if (cos_pitch > 1e-12) return {std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0))};
+  return {0.0, pitch, std::atan2(-R(0, 1), R(1, 1))};
+}
+
+ShapeSpec ShapeSpec::placed(const Eigen::Isometry3d& at) const {
+  ShapeSpec out = *this;
+  if (from && to) {
+    const Eigen::Vector3d a = at * vec(*from), b = at * vec(*to);
+    out.from = std::array<double, 3>{a.x(), a.y(), a.z()};
+    out.to = std::array<double, 3>{b.x(), b.y(), b.z()};
+    return out;
+  }
+  const Eigen::Isometry3d t = at * pose();
+  out.xyz = {t.translation().x(), t.translation().y(), t.translation().z()};
+  out.rpy = rpy_of(t.linear());
+  return out;
+}
+
 DistanceQuery::~DistanceQuery() = default;
 
 int DistanceQuery::size() const noexcept { return static_cast<int>(impl_->geometry.size()); }

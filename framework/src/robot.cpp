@@ -279,25 +279,6 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
   return jt;
 }
 
-// A shape placed in a link's frame, moved into the joint's link frame the link rides on (`at`).
-ShapeSpec placed(ShapeSpec shape, const Isometry3d& at) {
-  if (shape.from && shape.to) {
-    const Vector3d a = at * Vector3d((*shape.from)[0], (*shape.from)[1], (*shape.from)[2]);
-    const Vector3d b = at * Vector3d((*shape.to)[0], (*shape.to)[1], (*shape.to)[2]);
-    shape.from = std::array<double, 3>{a.x(), a.y(), a.z()};
-    shape.to = std::array<double, 3>{b.x(), b.y(), b.z()};
-    return shape;
-  }
-  const Isometry3d t = at * shape.pose();
-  shape.xyz = {t.translation().x(), t.translation().y(), t.translation().z()};
-  const Eigen::Matrix3d& R = t.linear();
-  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-  shape.rpy = std::abs(std::cos(pitch)) > 1e-9
-                  ? std::array<double, 3>{std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0))}
-                  : std::array<double, 3>{0.0, pitch, std::atan2(-R(0, 1), R(1, 1))};
-  return shape;
-}
-
 // A robot file that names a URDF (`urdf`, `base_link`, `tip_link`): the chain comes from the URDF
 // (read_urdf_chain); `[[joints]]` entries, by joint name, may replace a joint's `limits` and `velocity_limit`;
 // `[[links]]` entries, by link name, give collision shapes that replace (`replace = true`, the default) or add to
@@ -370,9 +351,10 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
                         "' is invalid at theta = " + num(bad->theta) + ": " + bad->reason);
       }
     } else if (uj.velocity > 0.0) {
-      const auto law = parse_toml_string(
-          "type = \"constant\"\nlower = " + num(-uj.velocity) + "\nupper = " + num(uj.velocity) + "\n",
-          file.string() + " (joint '" + uj.name + "' velocity limit)");
+      std::ostringstream text;
+      text.precision(17);  // the URDF's double, unrounded
+      text << "type = \"constant\"\nlower = " << -uj.velocity << "\nupper = " << uj.velocity << "\n";
+      const auto law = parse_toml_string(text.str(), file.string() + " (joint '" + uj.name + "' velocity limit)");
       jt.velocity_limit = velocity_limit_registry().create(TableReader::root(law));
     } else {
       r.fail("urdf", "joint '" + uj.name + "' in " + file.string() +
@@ -415,7 +397,7 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
         }
         if (shapes[k].velocity)
           entry.fail("collision", "shape " + std::to_string(k + 1) + " has a velocity; only obstacles move");
-        jt.collision.push_back(placed(shapes[k], link.pose));
+        jt.collision.push_back(shapes[k].placed(link.pose));
       }
       entry.finish();
     }
@@ -426,7 +408,7 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
                          "'), which redres does not read: give the link's shapes in a [[links]] entry (replace = "
                          "true), e.g. capsules");
     }
-    for (const ShapeSpec& s : link.shapes) jt.collision.push_back(placed(s, link.pose));
+    for (const ShapeSpec& s : link.shapes) jt.collision.push_back(s.placed(link.pose));
   }
 }
 

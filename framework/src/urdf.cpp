@@ -21,8 +21,9 @@ class Collect final : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char* /*filename*/, int /*line*/) override {
     if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) messages += (messages.empty() ? "" : "; ") + text;
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) errors += (errors.empty() ? "" : "; ") + text;
   }
-  std::string messages;
+  std::string messages, errors;  // warnings and errors; errors only
 };
 
 Eigen::Isometry3d pose_of(const urdf::Pose& p) {
@@ -32,17 +33,51 @@ Eigen::Isometry3d pose_of(const urdf::Pose& p) {
   return t;
 }
 
-std::array<double, 3> xyz_of(const Eigen::Isometry3d& t) {
-  return {t.translation().x(), t.translation().y(), t.translation().z()};
+// The collision elements of `link`, whose frame is `at` in the frame of the UrdfLink `out` gathers shapes for.
+void add_shapes(const std::string& where, const urdf::Link& link, const Eigen::Isometry3d& at,
+                const std::string& messages, UrdfLink& out) {
+  for (const urdf::CollisionSharedPtr& c : link.collision_array) {
+    if (!c) continue;
+    if (!c->geometry) {
+      throw UrdfError(where + ": link '" + link.name + "' has a <collision> element whose geometry could not be read" +
+                      (messages.empty() ? std::string() : " (" + messages + ")"));
+    }
+    const Eigen::Isometry3d pose = at * pose_of(c->origin);
+    ShapeSpec s;
+    s.xyz = {pose.translation().x(), pose.translation().y(), pose.translation().z()};
+    s.rpy = rpy_of(pose.linear());
+    switch (c->geometry->type) {
+      case urdf::Geometry::SPHERE:
+        s.shape = ShapeSpec::Kind::kSphere;
+        s.radius = static_cast<const urdf::Sphere&>(*c->geometry).radius;
+        break;
+      case urdf::Geometry::BOX: {
+        const urdf::Vector3& d = static_cast<const urdf::Box&>(*c->geometry).dim;
+        s.shape = ShapeSpec::Kind::kBox;
+        s.size = std::array<double, 3>{d.x, d.y, d.z};
+        break;
+      }
+      case urdf::Geometry::CYLINDER: {
+        const auto& cyl = static_cast<const urdf::Cylinder&>(*c->geometry);
+        s.shape = ShapeSpec::Kind::kCylinder;
+        s.radius = cyl.radius;
+        s.length = cyl.length;
+        break;
+      }
+      case urdf::Geometry::MESH: out.meshes.push_back(static_cast<const urdf::Mesh&>(*c->geometry).filename); continue;
+    }
+    out.shapes.push_back(s);
+  }
 }
 
-// Roll, pitch, yaw of R = Rz(yaw) Ry(pitch) Rx(roll), the convention ShapeSpec reads.
-std::array<double, 3> rpy_of(const Eigen::Matrix3d& R) {
-  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-  const double roll = std::atan2(R(2, 1), R(2, 2));
-  const double yaw = std::atan2(R(1, 0), R(0, 0));
-  if (std::abs(std::cos(pitch)) > 1e-9) return {roll, pitch, yaw};
-  return {0.0, pitch, std::atan2(-R(0, 1), R(1, 1))};  // gimbal lock: put the whole turn in yaw
+// A side branch below `joint` (taken at position 0), its frames placed from `at`.
+void add_branch(const std::string& where, const urdf::ModelInterface& model, const urdf::Joint& joint,
+                const Eigen::Isometry3d& at, const std::string& messages, UrdfLink& out) {
+  const urdf::LinkConstSharedPtr link = model.getLink(joint.child_link_name);
+  if (!link) return;
+  const Eigen::Isometry3d frame = at * pose_of(joint.parent_to_joint_origin_transform);
+  add_shapes(where, *link, frame, messages, out);
+  for (const urdf::JointSharedPtr& child : link->child_joints) add_branch(where, model, *child, frame, messages, out);
 }
 
 }  // namespace
@@ -63,10 +98,19 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
     static std::mutex lock;
     const std::lock_guard<std::mutex> guard(lock);
     Collect collect;
+    struct Restore {  // the previous handler comes back however parseURDF leaves
+      ~Restore() { console_bridge::restorePreviousOutputHandler(); }
+    };
     console_bridge::useOutputHandler(&collect);
-    model = urdf::parseURDF(xml);
-    console_bridge::restorePreviousOutputHandler();
+    {
+      const Restore restore;
+      model = urdf::parseURDF(xml);
+    }
     messages = collect.messages;
+    // urdfdom drops an element it cannot read (a <collision> with a bad <cylinder>, say) and still returns a model:
+    // any error it reported fails the file, so that nothing is lost without a word.
+    if (model && !collect.errors.empty())
+      throw UrdfError(where + ": urdfdom could not read all of it (" + collect.errors + ")");
   }
   if (!model)
     throw UrdfError(where + ": not a valid URDF (" + (messages.empty() ? "urdfdom gave no reason" : messages) + ")");
@@ -132,33 +176,12 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
     l.name = links[k]->name;
     l.joint = static_cast<int>(chain.joints.size()) - 1;
     l.pose = fixed;
-    for (const urdf::CollisionSharedPtr& c : links[k]->collision_array) {
-      if (!c || !c->geometry) continue;
-      const Eigen::Isometry3d at = pose_of(c->origin);
-      ShapeSpec s;
-      s.xyz = xyz_of(at);
-      s.rpy = rpy_of(at.linear());
-      switch (c->geometry->type) {
-        case urdf::Geometry::SPHERE:
-          s.shape = ShapeSpec::Kind::kSphere;
-          s.radius = static_cast<const urdf::Sphere&>(*c->geometry).radius;
-          break;
-        case urdf::Geometry::BOX: {
-          const urdf::Vector3& d = static_cast<const urdf::Box&>(*c->geometry).dim;
-          s.shape = ShapeSpec::Kind::kBox;
-          s.size = std::array<double, 3>{d.x, d.y, d.z};
-          break;
-        }
-        case urdf::Geometry::CYLINDER: {
-          const auto& cyl = static_cast<const urdf::Cylinder&>(*c->geometry);
-          s.shape = ShapeSpec::Kind::kCylinder;
-          s.radius = cyl.radius;
-          s.length = cyl.length;
-          break;
-        }
-        case urdf::Geometry::MESH: l.meshes.push_back(static_cast<const urdf::Mesh&>(*c->geometry).filename); continue;
-      }
-      l.shapes.push_back(s);
+    add_shapes(where, *links[k], Eigen::Isometry3d::Identity(), messages, l);
+    // Side branches hanging from this link by fixed joints (a hand, a camera) ride on it; joints that could move
+    // in them are taken at position 0 (they are not part of the chain).
+    for (const urdf::JointSharedPtr& child : links[k]->child_joints) {
+      if (k + 1 < links.size() && child->child_link_name == links[k + 1]->name) continue;  // the chain itself
+      add_branch(where, *model, *child, Eigen::Isometry3d::Identity(), messages, l);
     }
     chain.links.push_back(std::move(l));
   }

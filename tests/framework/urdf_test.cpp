@@ -4,6 +4,7 @@
 // The URDF's own primitive collision elements are read when no [[links]] entry replaces them. Every kind of bad URDF
 // is a ConfigError naming the robot file's `urdf` key, the URDF file and the element.
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -58,6 +59,7 @@ TEST_P(UrdfRobots, TheUrdfRobotIsItsDhTwin) {
     }
     for (std::size_t s = 0; s < dh.link_shapes().size(); ++s) {
       ASSERT_EQ(urdf.link_shapes()[s].link, dh.link_shapes()[s].link);
+      ASSERT_EQ(urdf.link_shapes()[s].spec.radius, dh.link_shapes()[s].spec.radius);
       const auto [p0, p1] = capsule_in_world(dh, a, s);
       const auto [q0, q1] = capsule_in_world(urdf, b, s);
       worst_shape = std::max({worst_shape, (p0 - q0).norm(), (p1 - q1).norm()});
@@ -152,6 +154,21 @@ TEST(Urdf, PrimitivesLimitsAndTheFoldedToolComeFromTheUrdf) {
   EXPECT_EQ(lo(0), -2.0);
   // Three shapes: l1's cylinder and l2's box ride on joints a and b; the tool's sphere rides on b, 0.1 m out.
   ASSERT_EQ(robot.link_shapes().size(), 3u);
+  const auto& cylinder = robot.link_shapes()[0];
+  EXPECT_EQ(cylinder.spec.shape, ShapeSpec::Kind::kCylinder);
+  EXPECT_EQ(cylinder.link, 0);
+  EXPECT_EQ(*cylinder.spec.radius, 0.03);
+  EXPECT_EQ(*cylinder.spec.length, 0.2);
+  EXPECT_LE(
+      (cylinder.pose.matrix() - Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.1)).matrix()).cwiseAbs().maxCoeff(),
+      1e-15);
+  // The box is turned by pitch pi/2 (rpy through the gimbal-lock branch): its local x axis points along -z.
+  const auto& box = robot.link_shapes()[1];
+  EXPECT_EQ(box.spec.shape, ShapeSpec::Kind::kBox);
+  EXPECT_EQ(box.link, 1);
+  EXPECT_LE((box.pose.translation() - Eigen::Vector3d(0.05, 0, 0)).norm(), 1e-15);
+  EXPECT_LE((box.pose.linear() * Eigen::Vector3d::UnitX() - Eigen::Vector3d(0, 0, -1)).norm(), 1e-12);
+  EXPECT_LE((box.pose.linear() * Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitY()).norm(), 1e-12);
   EXPECT_EQ(robot.link_shapes()[2].link, 1);
   EXPECT_LE((robot.link_shapes()[2].pose.translation() - Eigen::Vector3d(0.1, 0, 0)).norm(), 1e-15);
   KinematicsData k(robot);
@@ -206,6 +223,10 @@ TEST(Urdf, BadUrdfsAreErrorsNamingTheFileAndTheElement) {
        {"joint 'b'", "has no velocity limit"}},
       {"unknown joint override", good, "[[joints]]\nname = \"zz\"\n", {"no moving joint named 'zz'"}},
       {"unknown link override", good, "[[links]]\nname = \"base\"\n", {"no link named 'base' that moves"}},
+      {"unreadable collision geometry",
+       replace(good, R"(<cylinder radius="0.03" length="0.2"/>)", R"(<cylinder radius="q"/>)"),
+       "",
+       {"two.urdf: urdfdom could not read all of it", "Link [l1]"}},
   };
   for (const BadUrdf& c : cases) {
     SCOPED_TRACE(c.what);
@@ -229,6 +250,40 @@ TEST(Urdf, BadUrdfsAreErrorsNamingTheFileAndTheElement) {
         EXPECT_NE(what.find(s), std::string::npos) << "missing '" << s << "' in: " << what;
     }
   }
+}
+
+// A side branch (a camera on a fixed joint, and a finger on a prismatic joint, both hanging from l2 beside the tool)
+// rides on the link it hangs from: its shapes are placed there, the finger at its joint's position 0.
+TEST(Urdf, SideBranchesRideOnTheLinkTheyHangFrom) {
+  const Files f("branch");
+  const std::string branch = R"(  <link name="camera">
+    <collision><origin xyz="0 0 0.01" rpy="0 0 0"/><geometry><sphere radius="0.015"/></geometry></collision>
+  </link>
+  <link name="finger">
+    <collision><origin xyz="0 0 0.02" rpy="0 0 0"/><geometry><sphere radius="0.01"/></geometry></collision>
+  </link>
+  <joint name="cam" type="fixed">
+    <parent link="l2"/><child link="camera"/><origin xyz="0 0.05 0" rpy="0 0 0"/>
+  </joint>
+  <joint name="fing" type="prismatic">
+    <parent link="camera"/><child link="finger"/><origin xyz="0.03 0 0" rpy="0 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="0" upper="0.04" velocity="0.1" effort="1"/>
+  </joint>
+</robot>)";
+  f.write("two.urdf", replace(kTwoLinkUrdf, "</robot>", branch));
+  const RobotModel robot = load_robot(f.write("two.toml", kRobot));
+  ASSERT_EQ(robot.dof(), 2);  // the finger's joint is not part of the chain
+  ASSERT_EQ(robot.link_shapes().size(), 5u);
+  std::vector<Eigen::Vector3d> on_l2;
+  for (const auto& shape : robot.link_shapes()) {
+    if (shape.link == 1 && shape.spec.shape == ShapeSpec::Kind::kSphere) on_l2.push_back(shape.pose.translation());
+  }
+  ASSERT_EQ(on_l2.size(), 3u);  // the tool's sphere, the camera's and the finger's
+  const auto has = [&](const Eigen::Vector3d& p) {
+    return std::any_of(on_l2.begin(), on_l2.end(), [&](const Eigen::Vector3d& q) { return (q - p).norm() < 1e-15; });
+  };
+  EXPECT_TRUE(has(Eigen::Vector3d(0.0, 0.05, 0.01)));
+  EXPECT_TRUE(has(Eigen::Vector3d(0.03, 0.05, 0.02)));
 }
 
 TEST(Urdf, JointOverridesReplaceLimitsAndLaws) {

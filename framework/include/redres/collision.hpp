@@ -47,11 +47,18 @@ struct ShapeSpec {
 
   /// The pose of the shape in its owner's frame (from xyz/rpy, or from `from`/`to` for a capsule).
   [[nodiscard]] Eigen::Isometry3d pose() const;
+  /// The same shape moved by `at` (a pose in the owner's frame becomes at * pose): a `from`/`to` capsule moves its
+  /// end points, any other shape gets the xyz/rpy of at * pose().
+  [[nodiscard]] ShapeSpec placed(const Eigen::Isometry3d& at) const;
   /// The capsule's axis length (from `length`, or |to - from|).
   [[nodiscard]] double axis_length() const;
   /// One line, e.g. "capsule(r = 0.05 m, l = 0.3 m)".
   [[nodiscard]] std::string describe() const;
 };
+
+/// Roll, pitch, yaw of R = Rz(yaw) Ry(pitch) Rx(roll) (ShapeSpec's and URDF's convention); at pitch = +-pi/2 the
+/// whole turn about z goes into yaw.
+[[nodiscard]] std::array<double, 3> rpy_of(const Eigen::Matrix3d& R);
 
 inline auto enum_names(ShapeSpec::Kind) {
   using K = ShapeSpec::Kind;

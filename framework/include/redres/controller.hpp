@@ -48,8 +48,9 @@ class Controller {
     orientation_set_ = true;
   }
   /// Makes the path's steps turn the orientation instead of holding it: from the reference R_0 at t = 0 to
-  /// Rot(turn) R_0 at t = T (a rotation about the fixed world axis turn / |turn| by |turn| rad: spherical linear
-  /// interpolation), with the cycloidal timing s(t) = t/T - sin(2 pi t/T) / (2 pi), so that the angular velocity
+  /// Rot(turn) R_0 at t = T, by a rotation about the fixed world axis turn / |turn| through |turn| rad (for
+  /// |turn| <= pi the spherical linear interpolation; a larger |turn| goes the long way round, as asked), with the
+  /// cycloidal timing s(t) = t/T - sin(2 pi t/T) / (2 pi), so that the angular velocity
   /// turn s'(t), fed forward, starts and ends at zero. Planar: only turn.z() is used (an angle about z).
   void set_orientation_turn(const Eigen::Vector3d& turn) { turn_ = turn; }
   /// The orientation reference (meaningful once set or captured).

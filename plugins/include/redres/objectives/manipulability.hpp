@@ -4,8 +4,9 @@
 /// `min_velocity_norm` (W = I) it is the paper's index |x - p q|^2 / 2 up to a constant (eq. 4). The measure is
 /// w = det(J J') (`det`, the paper), Yoshikawa's sqrt(det(J J')) (`yoshikawa`), or log det(J J') (`log_det`); the
 /// gradients come from the kinematics (adjugate / SVD forms, exact at singularities; grad log w = grad w / w, with w
-/// floored at 1e-300). `log_det` is scale-free: its gradient does not change when the arm's lengths are scaled, so
-/// one p serves arms whose w is 1e-2 (spatial 7-DOF arms) and 1 alike; docs/paper.md says how to choose p.
+/// floored at 1e-300: below the floor the potential is flat but the gradient still points away from the singularity).
+/// `log_det` is scale-free: its gradient does not change when the arm's lengths are scaled, so one p serves arms whose
+/// w is 1e-2 (spatial 7-DOF arms) and 1 alike; docs/paper.md says how to choose p.
 ///
 /// Coefficient schedules p(t), t in [0, T]:
 /// - `constant`: p(t) = p;

@@ -2,9 +2,11 @@
 
 #include "redres/plugin_loader.hpp"
 #include "redres/urdf.hpp"
+#include "redres/velocity_limits/constant.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -209,6 +211,46 @@ Isometry3d read_pose(const TableReader& t, bool planar) {
   return trans(p[0], p[1], p[2]) * rpy_rotation(rpy);
 }
 
+// A joint's `limits` = [lower, upper], lower < upper, into jt.
+void read_limits(const TableReader& r, JointSpec& jt) {
+  const std::vector<double> lim = r.numbers("limits", 2);
+  jt.lower = lim[0];
+  jt.upper = lim[1];
+  if (!(jt.lower < jt.upper)) {
+    r.fail("limits",
+           "expected [lower, upper] with lower < upper, got lower " + num(jt.lower) + " >= upper " + num(jt.upper));
+  }
+}
+
+// A joint's `velocity_limit` table into jt, checked over the joint's range (jt.lower, jt.upper set before).
+void read_velocity_law(const TableReader& r, JointSpec& jt) {
+  const TableReader law_table = r.table("velocity_limit");
+  const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' velocity_limit");
+  jt.velocity_limit = make_velocity_limit(law_reader);
+  law_reader.finish();
+  if (auto bad = check_velocity_law(*jt.velocity_limit, jt.lower, jt.upper)) {
+    law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() + "' is invalid at theta = " + num(bad->theta) +
+                    (jt.type == JointType::kRevolute ? " rad" : " m") + " (joint range [" + num(jt.lower) + ", " +
+                    num(jt.upper) + "]): " + bad->reason);
+  }
+}
+
+// The entries of the array of tables `key` (absent: none), by their `name`: each must name a `noun` that `known`
+// accepts and appear once. An unknown name reads "no <what> named '<name>'<where>".
+std::map<std::string, TableReader> named_entries(const TableReader& r, const char* key,
+                                                 const std::function<bool(const std::string&)>& known,
+                                                 const std::string& noun, const std::string& what,
+                                                 const std::string& where) {
+  std::map<std::string, TableReader> out;
+  if (!r.has(key)) return out;
+  for (const TableReader& entry : r.tables(key)) {
+    const std::string name = entry.string("name");
+    if (!known(name)) entry.fail("name", "no " + what + " named '" + name + "'" + where);
+    if (!out.emplace(name, entry).second) entry.fail("name", "a second entry for " + noun + " '" + name + "'");
+  }
+  return out;
+}
+
 JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention convention, std::set<std::string>& names) {
   JointSpec jt;
   jt.name = entry.string("name");
@@ -243,13 +285,7 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
     jt.theta_offset = r.number("theta_offset", 0.0);
   }
 
-  const std::vector<double> lim = r.numbers("limits", 2);
-  jt.lower = lim[0];
-  jt.upper = lim[1];
-  if (!(jt.lower < jt.upper)) {
-    r.fail("limits",
-           "expected [lower, upper] with lower < upper, got lower " + num(jt.lower) + " >= upper " + num(jt.upper));
-  }
+  read_limits(r, jt);
 
   if (r.has("collision")) {
     config_io::read(r, "collision", jt.collision);
@@ -266,15 +302,7 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
     }
   }
 
-  const TableReader law_table = r.table("velocity_limit");
-  const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' velocity_limit");
-  jt.velocity_limit = make_velocity_limit(law_reader);
-  law_reader.finish();
-  if (auto bad = check_velocity_law(*jt.velocity_limit, jt.lower, jt.upper)) {
-    law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() + "' is invalid at theta = " + num(bad->theta) +
-                    (jt.type == JointType::kRevolute ? " rad" : " m") + " (joint range [" + num(jt.lower) + ", " +
-                    num(jt.upper) + "]): " + bad->reason);
-  }
+  read_velocity_law(r, jt);
   r.finish();
   return jt;
 }
@@ -303,18 +331,13 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
   spec.end_effector = chain.tip;
 
   // Overrides by joint name.
-  std::map<std::string, TableReader> overrides;
-  if (r.has("joints")) {
-    for (const TableReader& entry : r.tables("joints")) {
-      const std::string name = entry.string("name");
-      const bool known =
-          std::any_of(chain.joints.begin(), chain.joints.end(), [&](const UrdfJoint& j) { return j.name == name; });
-      if (!known)
-        entry.fail("name", "no moving joint named '" + name + "' between '" + base_link + "' and '" + tip_link +
-                               "' in " + file.string());
-      if (!overrides.emplace(name, entry).second) entry.fail("name", "a second entry for joint '" + name + "'");
-    }
-  }
+  const std::map<std::string, TableReader> overrides = named_entries(
+      r, "joints",
+      [&](const std::string& name) {
+        return std::any_of(chain.joints.begin(), chain.joints.end(),
+                           [&](const UrdfJoint& j) { return j.name == name; });
+      },
+      "joint", "moving joint", " between '" + base_link + "' and '" + tip_link + "' in " + file.string());
   for (const UrdfJoint& uj : chain.joints) {
     JointSpec jt;
     jt.name = uj.name;
@@ -330,10 +353,7 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
             : std::optional<TableReader>(TableReader(o->second.file_ptr(), o->second.raw(), "joint '" + uj.name + "'"));
     if (entry) (void)entry->has("name");
     if (entry && entry->has("limits")) {
-      const std::vector<double> lim = entry->numbers("limits", 2);
-      jt.lower = lim[0];
-      jt.upper = lim[1];
-      if (!(jt.lower < jt.upper)) entry->fail("limits", "expected [lower, upper] with lower < upper");
+      read_limits(*entry, jt);
     } else if (uj.continuous) {
       r.fail("urdf", "joint '" + uj.name + "' is continuous in " + file.string() +
                          ", which gives it no position limits: give its `limits` in a [[joints]] entry");
@@ -342,20 +362,10 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
                          " >= upper " + num(uj.upper) + ": fix the URDF or give its `limits` in a [[joints]] entry");
     }
     if (entry && entry->has("velocity_limit")) {
-      const TableReader law_table = entry->table("velocity_limit");
-      const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' velocity_limit");
-      jt.velocity_limit = make_velocity_limit(law_reader);
-      law_reader.finish();
-      if (auto bad = check_velocity_law(*jt.velocity_limit, jt.lower, jt.upper)) {
-        law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() +
-                        "' is invalid at theta = " + num(bad->theta) + ": " + bad->reason);
-      }
+      read_velocity_law(*entry, jt);
     } else if (uj.velocity > 0.0) {
-      std::ostringstream text;
-      text.precision(17);  // the URDF's double, unrounded
-      text << "type = \"constant\"\nlower = " << -uj.velocity << "\nupper = " << uj.velocity << "\n";
-      const auto law = parse_toml_string(text.str(), file.string() + " (joint '" + uj.name + "' velocity limit)");
-      jt.velocity_limit = velocity_limit_registry().create(TableReader::root(law));
+      jt.velocity_limit =
+          velocity_limit_registry().create("constant", ConstantLawConfig{.lower = -uj.velocity, .upper = uj.velocity});
     } else {
       r.fail("urdf", "joint '" + uj.name + "' in " + file.string() +
                          " has no velocity limit: give one in the URDF (<limit velocity=...>) or a `velocity_limit` "
@@ -366,19 +376,12 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
   }
 
   // Collision shapes: the URDF's, per link, unless [[links]] replaces them.
-  std::map<std::string, TableReader> link_entries;
-  if (r.has("links")) {
-    for (const TableReader& entry : r.tables("links")) {
-      const std::string name = entry.string("name");
-      const bool known =
-          std::any_of(chain.links.begin(), chain.links.end(), [&](const UrdfLink& l) { return l.name == name; });
-      if (!known) {
-        entry.fail("name", "no link named '" + name + "' that moves with the chain from '" + base_link + "' to '" +
-                               tip_link + "' in " + file.string());
-      }
-      if (!link_entries.emplace(name, entry).second) entry.fail("name", "a second entry for link '" + name + "'");
-    }
-  }
+  const std::map<std::string, TableReader> link_entries = named_entries(
+      r, "links",
+      [&](const std::string& name) {
+        return std::any_of(chain.links.begin(), chain.links.end(), [&](const UrdfLink& l) { return l.name == name; });
+      },
+      "link", "link", " that moves with the chain from '" + base_link + "' to '" + tip_link + "' in " + file.string());
   for (const UrdfLink& link : chain.links) {
     JointSpec& jt = spec.joints[static_cast<std::size_t>(link.joint)];
     const auto e = link_entries.find(link.name);

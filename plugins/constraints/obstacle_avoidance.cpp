@@ -39,7 +39,7 @@ const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
 }
 
 ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& robot)
-    : Configured(kType, config), robot_(&robot) {
+    : PairConstraint(kType, config), robot_(&robot) {
   const auto& links = robot.link_shapes();
   if (links.empty()) {
     throw FieldError(
@@ -157,20 +157,6 @@ std::string ObstacleAvoidance::describe_inequality_row(int row) const {
   s << "link '" << robot_->joint(shape.link).name << "' " << shape.spec.describe() << " vs obstacle " << o + 1 << " "
     << config_.obstacles[static_cast<std::size_t>(o)].describe() << " at distance " << distances_[row] << " m";
   return s.str();
-}
-
-bool ObstacleAvoidance::violated() const { return distances_.violated(); }
-
-std::string ObstacleAvoidance::describe_violation() const {
-  return distances_.describe_violation([this](int row) { return describe_inequality_row(row); });
-}
-
-std::vector<std::string> ObstacleAvoidance::recorded_columns() const { return distances_.columns(); }
-
-void ObstacleAvoidance::record(double* values) const { distances_.record(values); }
-
-void ObstacleAvoidance::summarise(const RobotModel& /*robot*/, const Trajectory& run, std::vector<Metric>& out) const {
-  distances_.summarise(run, name(), out);
 }
 
 void ObstacleAvoidance::scene_obstacles(std::vector<ShapeSpec>& out) const {

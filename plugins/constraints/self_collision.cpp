@@ -21,7 +21,7 @@ const Schema<SelfCollisionConfig>& SelfCollisionConfig::schema() {
 }
 
 SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
-    : Configured(kType, config), robot_(&robot) {
+    : PairConstraint(kType, config), robot_(&robot) {
   const auto& links = robot.link_shapes();
   if (links.empty()) {
     throw FieldError("", "robot '" + robot.name() +
@@ -83,20 +83,6 @@ std::string SelfCollision::describe_inequality_row(int row) const {
   s << "link '" << robot_->joint(sa.link).name << "' " << sa.spec.describe() << " vs link '"
     << robot_->joint(sb.link).name << "' " << sb.spec.describe() << " at distance " << distances_[row] << " m";
   return s.str();
-}
-
-bool SelfCollision::violated() const { return distances_.violated(); }
-
-std::string SelfCollision::describe_violation() const {
-  return distances_.describe_violation([this](int row) { return describe_inequality_row(row); });
-}
-
-std::vector<std::string> SelfCollision::recorded_columns() const { return distances_.columns(); }
-
-void SelfCollision::record(double* values) const { distances_.record(values); }
-
-void SelfCollision::summarise(const RobotModel& /*robot*/, const Trajectory& run, std::vector<Metric>& out) const {
-  distances_.summarise(run, name(), out);
 }
 
 namespace {

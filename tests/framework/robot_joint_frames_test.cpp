@@ -13,15 +13,6 @@
 namespace redres {
 namespace {
 
-Eigen::VectorXd random_inside(const RobotModel& robot, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  Eigen::VectorXd theta(robot.dof());
-  for (int j = 0; j < robot.dof(); ++j) {
-    theta(j) = robot.lower_limits()(j) + u(rng) * (robot.upper_limits()(j) - robot.lower_limits()(j));
-  }
-  return theta;
-}
-
 TEST(JointFrameChains, ThePandaFromItsUrdfOriginsIsThePandaFromItsDhTable) {
   const RobotModel dh = load_robot(source_path("robots/franka_panda.toml"));
   const RobotModel frames = load_robot(data_path("franka_panda_joints.toml"));

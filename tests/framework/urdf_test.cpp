@@ -17,15 +17,6 @@
 namespace redres {
 namespace {
 
-Eigen::VectorXd random_inside(const RobotModel& robot, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  Eigen::VectorXd theta(robot.dof());
-  for (int j = 0; j < robot.dof(); ++j) {
-    theta(j) = robot.lower_limits()(j) + u(rng) * (robot.upper_limits()(j) - robot.lower_limits()(j));
-  }
-  return theta;
-}
-
 // The world end points of a capsule of `robot` at the configuration in `k`.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> capsule_in_world(const RobotModel& robot, const KinematicsData& k,
                                                              std::size_t s) {

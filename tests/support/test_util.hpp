@@ -3,9 +3,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <string>
 
 #include <Eigen/Core>
+
+#include "redres/robot.hpp"
 
 namespace redres {
 
@@ -24,6 +27,16 @@ inline Eigen::VectorXd paper_theta0() {
   Eigen::VectorXd t(6);
   t << M_PI / 4, M_PI / 12, M_PI / 12, M_PI / 12, M_PI / 36, M_PI / 36;
   return t;
+}
+
+/// A random configuration inside the robot's limits, away from each by `margin` of the joint's range.
+inline Eigen::VectorXd random_inside(const RobotModel& robot, std::mt19937& rng, double margin = 0.0) {
+  std::uniform_real_distribution<double> u(margin, 1.0 - margin);
+  Eigen::VectorXd theta(robot.dof());
+  for (int j = 0; j < robot.dof(); ++j) {
+    theta(j) = robot.lower_limits()(j) + u(rng) * (robot.upper_limits()(j) - robot.lower_limits()(j));
+  }
+  return theta;
 }
 
 }  // namespace redres

@@ -21,6 +21,7 @@
 
 #include "redres/collision.hpp"
 #include "redres/kinematics.hpp"
+#include "redres/plugin.hpp"
 
 namespace redres {
 
@@ -75,6 +76,28 @@ class PairDistances {
   Damper damper_;
   std::string minimum_, active_;
   int failures_ = 0;
+};
+
+/// The base of a collision constraint with Config C: its pairs' distances (`distances_`, one per row, filled by the
+/// derived add_to() through PairDistances::take/beyond) and what follows from them: the violation (a pair that
+/// overlaps or could not be measured, described by the derived describe_inequality_row()), the recorded columns and
+/// the run summary's figures.
+template <class C>
+class PairConstraint : public Configured<Constraint, C> {
+ public:
+  [[nodiscard]] bool violated() const override { return distances_.violated(); }
+  [[nodiscard]] std::string describe_violation() const override {
+    return distances_.describe_violation([this](int row) { return this->describe_inequality_row(row); });
+  }
+  [[nodiscard]] std::vector<std::string> recorded_columns() const override { return distances_.columns(); }
+  void record(double* values) const override { distances_.record(values); }
+  void summarise(const RobotModel& /*robot*/, const Trajectory& run, std::vector<Metric>& out) const override {
+    distances_.summarise(run, this->name(), out);
+  }
+
+ protected:
+  using Configured<Constraint, C>::Configured;
+  mutable PairDistances distances_{0, {}, "", ""};  // per row, at the last contribution
 };
 
 /// Checks the damper's keys of a collision constraint's Config: d_s >= 0 and d_i > d_s (FieldError naming the key).

@@ -33,16 +33,6 @@ ShapeSpec obstacle(ShapeSpec::Kind kind, std::array<double, 3> xyz, std::optiona
   return s;
 }
 
-// A random configuration inside the limits (away from them by 10 % of the range).
-Eigen::VectorXd random_theta(const RobotModel& robot, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(0.1, 0.9);
-  Eigen::VectorXd theta(robot.dof());
-  for (int j = 0; j < robot.dof(); ++j) {
-    theta(j) = robot.lower_limits()(j) + u(rng) * (robot.upper_limits()(j) - robot.lower_limits()(j));
-  }
-  return theta;
-}
-
 // Signed distance between two shapes of `query` on the robot at theta (b < 0: b is obstacle -b-1 at time t).
 struct Independent {
   const RobotModel& robot;
@@ -113,7 +103,7 @@ TEST_P(CollisionRows, ObstacleRowsAreTheRateOfTheDistance) {
   const int L = static_cast<int>(robot.link_shapes().size());
   int checked = 0;
   for (int rep = 0; rep < 12; ++rep) {
-    const Eigen::VectorXd theta = random_theta(robot, rng);
+    const Eigen::VectorXd theta = random_inside(robot, rng, 0.1);
     Eigen::VectorXd x(robot.dof());
     for (int j = 0; j < robot.dof(); ++j) x(j) = g(rng);
     const double t = 3.0;
@@ -157,7 +147,7 @@ TEST_P(CollisionRows, SelfCollisionRowsAreTheRateOfTheDistance) {
   std::normal_distribution<double> g;
   int checked = 0;
   for (int rep = 0; rep < 12; ++rep) {
-    const Eigen::VectorXd theta = random_theta(robot, rng);
+    const Eigen::VectorXd theta = random_inside(robot, rng, 0.1);
     Eigen::VectorXd x(robot.dof());
     for (int j = 0; j < robot.dof(); ++j) x(j) = g(rng);
     compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
@@ -286,7 +276,7 @@ TEST(CollisionRows, TheBroadphaseWritesTheRowsOfBruteForce) {
   KinematicsData kin(robot);
   int live = 0;
   for (int trial = 0; trial < 40; ++trial) {
-    const Eigen::VectorXd theta = random_theta(robot, rng);
+    const Eigen::VectorXd theta = random_inside(robot, rng, 0.1);
     compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
     const double t = 0.5 * trial;  // the moving obstacles wander
     Context ctx{t, 20.0, 0.01, &robot, &kin, nullptr, nullptr};

@@ -52,7 +52,7 @@ inline auto enum_names(ObstacleAvoidanceConfig::Broadphase) {
 /// Above this many (link shape, obstacle) pairs, `broadphase = "auto"` uses FCL's tree.
 inline constexpr int kBroadphasePairs = 256;
 
-class ObstacleAvoidance final : public Configured<Constraint, ObstacleAvoidanceConfig> {
+class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig> {
  public:
   static constexpr const char* kType = "obstacle_avoidance";
   ObstacleAvoidance(const Config& config, const RobotModel& robot);
@@ -60,31 +60,24 @@ class ObstacleAvoidance final : public Configured<Constraint, ObstacleAvoidanceC
 
   [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
   [[nodiscard]] std::string describe_inequality_row(int row) const override;
-  /// A pair overlaps (signed distance < 0) at the last contribution.
-  [[nodiscard]] bool violated() const override;
-  [[nodiscard]] std::string describe_violation() const override;
-  [[nodiscard]] std::vector<std::string> recorded_columns() const override;
-  void record(double* values) const override;
-  void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const override;
   /// Its obstacles, as configured (summary.json's `obstacles`).
   void scene_obstacles(std::vector<ShapeSpec>& out) const override;
 
   /// The obstacle's world pose at time t (its pose moved by velocity * t).
   [[nodiscard]] Eigen::Isometry3d obstacle_pose(int k, double t) const;
+
+ private:
+  void add_to(const Context& ctx, QpBuilder& builder) const override;
   // The row of link shape l (at Tl) against obstacle o (at To): measured, then a damper or a slack row.
   void pair_row(const KinematicsData& kin, int l, const Eigen::Isometry3d& Tl, int o, const Eigen::Isometry3d& To,
                 Eigen::Block<Eigen::MatrixXd>& A, Eigen::VectorBlock<Eigen::VectorXd>& b) const;
   // The broadphase path of add_to(): only the pairs the tree finds near are measured.
   void add_near_pairs(const Context& ctx, QpBuilder& builder) const;
 
- private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override;
-
   const RobotModel* robot_;
   std::unique_ptr<DistanceQuery> query_;  // link shapes first, then the obstacles
   int links_ = 0, obstacles_ = 0;
   mutable Eigen::Matrix3Xd jacobian_;
-  mutable PairDistances distances_{0, {}, "", ""};  // per row, at the last contribution
   // Broadphase: whether it is used, whether an obstacle moves, whether the tree holds the obstacles' poses yet, the
   // obstacles' poses this step, and the candidates near() returns for one link shape.
   bool broadphase_ = false, moving_ = false;

@@ -27,7 +27,7 @@ struct SelfCollisionConfig {
 };
 
 /// The self-collision constraint.
-class SelfCollision final : public Configured<Constraint, SelfCollisionConfig> {
+class SelfCollision final : public PairConstraint<SelfCollisionConfig> {
  public:
   static constexpr const char* kType = "self_collision";
   SelfCollision(const Config& config, const RobotModel& robot);
@@ -35,12 +35,6 @@ class SelfCollision final : public Configured<Constraint, SelfCollisionConfig> {
 
   [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
   [[nodiscard]] std::string describe_inequality_row(int row) const override;
-  /// A pair overlaps (signed distance < 0) at the last contribution.
-  [[nodiscard]] bool violated() const override;
-  [[nodiscard]] std::string describe_violation() const override;
-  [[nodiscard]] std::vector<std::string> recorded_columns() const override;
-  void record(double* values) const override;
-  void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const override;
   /// The checked pairs (indices into RobotModel::link_shapes()).
   [[nodiscard]] const std::vector<std::pair<int, int>>& pairs() const noexcept { return pairs_; }
 
@@ -51,7 +45,6 @@ class SelfCollision final : public Configured<Constraint, SelfCollisionConfig> {
   std::unique_ptr<DistanceQuery> query_;
   std::vector<std::pair<int, int>> pairs_;
   mutable Eigen::Matrix3Xd ja_, jb_;
-  mutable PairDistances distances_{0, {}, "", ""};
 };
 
 }  // namespace redres

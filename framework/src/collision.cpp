@@ -25,12 +25,6 @@ namespace {
 
 bool positive(double v) { return std::isfinite(v) && v > 0.0; }
 
-Eigen::Matrix3d rpy_matrix(const std::array<double, 3>& rpy) {
-  return (Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
-}
-
 Eigen::Vector3d vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
 }  // namespace
@@ -229,7 +223,6 @@ struct DistanceQuery::Impl {
   };
   std::vector<Round> round;
   std::vector<std::optional<Eigen::Vector3d>> box_half;  // a box's half sides
-  std::vector<std::shared_ptr<fcl::CollisionGeometryd>> geometry;
   // One CollisionObject per shape: FCL's object overload of distance() allocates nothing for analytic pairs, while
   // its geometry-and-transform overload allocates once per call (measured: one per query).
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
@@ -280,27 +273,32 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
         {round, round ? radius : 0.0, s.shape == ShapeSpec::Kind::kCapsule ? 0.5 * s.axis_length() : 0.0});
     impl_->box_half.push_back(s.shape == ShapeSpec::Kind::kBox ? std::optional<Eigen::Vector3d>(0.5 * vec(*s.size))
                                                                : std::nullopt);
+    std::shared_ptr<fcl::CollisionGeometryd> geometry;
     switch (s.shape) {
-      case ShapeSpec::Kind::kSphere: impl_->geometry.push_back(std::make_shared<fcl::Sphered>(radius)); break;
+      case ShapeSpec::Kind::kSphere: geometry = std::make_shared<fcl::Sphered>(radius); break;
       case ShapeSpec::Kind::kCapsule:
         // A capsule of zero length is a sphere (FCL's capsule code divides by its length in places).
         if (s.axis_length() <= 1e-12) {
-          impl_->geometry.push_back(std::make_shared<fcl::Sphered>(radius));
+          geometry = std::make_shared<fcl::Sphered>(radius);
         } else {
-          impl_->geometry.push_back(std::make_shared<fcl::Capsuled>(radius, s.axis_length()));
+          geometry = std::make_shared<fcl::Capsuled>(radius, s.axis_length());
         }
         break;
-      case ShapeSpec::Kind::kCylinder:
-        impl_->geometry.push_back(std::make_shared<fcl::Cylinderd>(radius, *s.length));
-        break;
+      case ShapeSpec::Kind::kCylinder: geometry = std::make_shared<fcl::Cylinderd>(radius, *s.length); break;
       case ShapeSpec::Kind::kBox:
-        impl_->geometry.push_back(std::make_shared<fcl::Boxd>((*s.size)[0], (*s.size)[1], (*s.size)[2]));
+        geometry = std::make_shared<fcl::Boxd>((*s.size)[0], (*s.size)[1], (*s.size)[2]);
         break;
     }
+    impl_->objects.push_back(std::make_unique<fcl::CollisionObjectd>(geometry));  // it keeps the geometry
   }
-  for (const auto& g : impl_->geometry) impl_->objects.push_back(std::make_unique<fcl::CollisionObjectd>(g));
-  // Both requests use the libccd solver: signed distance with the independent solver aborts on penetration.
+  // The libccd solver (unsigned queries only: signed ones are never made, see collision.hpp).
   impl_->unsigned_request = fcl::DistanceRequestd(true, false, 0.0, 0.0, 1e-8, fcl::GST_LIBCCD);
+}
+
+Eigen::Matrix3d rpy_matrix(const std::array<double, 3>& rpy) {
+  return (Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
 }
 
 std::array<double, 3> rpy_of(const Eigen::Matrix3d& R) {
@@ -327,19 +325,15 @@ ShapeSpec ShapeSpec::placed(const Eigen::Isometry3d& at) const {
 
 DistanceQuery::~DistanceQuery() = default;
 
-int DistanceQuery::size() const noexcept { return static_cast<int>(impl_->geometry.size()); }
+int DistanceQuery::size() const noexcept { return static_cast<int>(impl_->objects.size()); }
 
 ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb) const {
   ShapeDistance out;
-  const auto n = static_cast<int>(impl_->geometry.size());
+  const int n = size();
   if (a < 0 || a >= n || b < 0 || b >= n) {
     out.error = "shape index out of range";
     return out;
   }
-  fcl::CollisionObjectd* oa = impl_->objects[static_cast<std::size_t>(a)].get();
-  fcl::CollisionObjectd* ob = impl_->objects[static_cast<std::size_t>(b)].get();
-  oa->setTransform(fcl::Transform3d(Ta.matrix()));
-  ob->setTransform(fcl::Transform3d(Tb.matrix()));
   {
     const Impl::Round& ra = impl_->round[static_cast<std::size_t>(a)];
     const Impl::Round& rb = impl_->round[static_cast<std::size_t>(b)];
@@ -362,6 +356,10 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
       return out;
     }
   }
+  fcl::CollisionObjectd* oa = impl_->objects[static_cast<std::size_t>(a)].get();
+  fcl::CollisionObjectd* ob = impl_->objects[static_cast<std::size_t>(b)].get();
+  oa->setTransform(fcl::Transform3d(Ta.matrix()));
+  ob->setTransform(fcl::Transform3d(Tb.matrix()));
   fcl::DistanceResultd& r = impl_->result;
   try {
     r.clear();  // a stale negative result would be kept: FCL only lowers min_distance

@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include <Eigen/Geometry>
+
+#include "redres/path.hpp"
 
 namespace redres {
 
@@ -20,7 +21,7 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
   REDRES_REQUIRE(&scheme.robot() == &robot, "Controller", "the scheme was built for this robot");
   REDRES_REQUIRE(T > 0.0 && tau > 0.0, "Controller", "T > 0 and tau > 0");
   if (path != nullptr) {
-    const int position_rows = robot.kind() == ChainKind::kPlanar ? 2 : 3;
+    const int position_rows = robot.position_rows();
     REDRES_REQUIRE(path->dim() == position_rows, "Controller",
                    "the path has one row per task position row (" + std::to_string(position_rows) + ")");
   }
@@ -64,9 +65,9 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, 
     double progress = 0.0, rate = 0.0;
     const double T = ctx_.T;
     if (turn_.squaredNorm() > 0.0 && T > 0.0) {
-      const double u = std::clamp(t / T, 0.0, 1.0);
-      progress = u - std::sin(2.0 * std::numbers::pi * u) / (2.0 * std::numbers::pi);
-      rate = (1.0 - std::cos(2.0 * std::numbers::pi * u)) / T;
+      double dprogress = 0.0;  // d progress / du, u = t / T
+      timing(TimingLaw::kCycloidal, std::clamp(t / T, 0.0, 1.0), progress, dprogress);
+      rate = dprogress / T;
     }
     if (robot_->kind() == ChainKind::kPlanar) {
       r_d_(2) = orientation_.z() + progress * turn_.z();
@@ -75,10 +76,9 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, 
       if (progress == 0.0) {
         r_d_.tail(rest) = orientation_;
       } else {
-        const double angle0 = orientation_.norm(), angle = turn_.norm();
-        const Eigen::Matrix3d R0 = angle0 > 0.0 ? Eigen::AngleAxisd(angle0, orientation_ / angle0).toRotationMatrix()
-                                                : Eigen::Matrix3d::Identity();
-        const Eigen::AngleAxisd R(Eigen::AngleAxisd(progress * angle, turn_ / angle).toRotationMatrix() * R0);
+        const double angle = turn_.norm();
+        const Eigen::AngleAxisd R(Eigen::AngleAxisd(progress * angle, turn_ / angle).toRotationMatrix() *
+                                  rotation_from_vector(orientation_));
         r_d_.tail(rest) = R.angle() * R.axis();
       }
       r_d_dot_.tail(rest) = rate * turn_;  // the world angular velocity, as J's angular rows

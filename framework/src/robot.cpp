@@ -192,11 +192,6 @@ bool RobotModel::self_collision_pair(int i, int j) const {
 
 namespace {
 
-Isometry3d rpy_rotation(const std::vector<double>& rpy) {
-  return Isometry3d(AngleAxisd(rpy[2], Vector3d::UnitZ()) * AngleAxisd(rpy[1], Vector3d::UnitY()) *
-                    AngleAxisd(rpy[0], Vector3d::UnitX()));
-}
-
 // A pose table: spatial `xyz` (m) and `rpy` (rad, roll-pitch-yaw about the fixed x, y, z axes); planar `xyz`
 // ([x, y], m) and `angle` (rad, about z). `position` is accepted for `xyz` (the end effector's older key).
 Isometry3d read_pose(const TableReader& t, bool planar) {
@@ -208,7 +203,7 @@ Isometry3d read_pose(const TableReader& t, bool planar) {
   }
   const std::vector<double> p = t.has(key) ? t.numbers(key, 3) : std::vector<double>{0.0, 0.0, 0.0};
   const std::vector<double> rpy = t.has("rpy") ? t.numbers("rpy", 3) : std::vector<double>{0.0, 0.0, 0.0};
-  return trans(p[0], p[1], p[2]) * rpy_rotation(rpy);
+  return trans(p[0], p[1], p[2]) * Isometry3d(rpy_matrix({rpy[0], rpy[1], rpy[2]}));
 }
 
 // A joint's `limits` = [lower, upper], lower < upper, into jt.

@@ -102,7 +102,7 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   if (auto orientation = r.optional_table("orientation")) {
     const TableReader o(orientation->file_ptr(), orientation->raw(), "orientation");
     const bool planar = s.robot->kind() == ChainKind::kPlanar;
-    if (s.robot->task_dim() <= (planar ? 2 : 3)) {
+    if (!s.robot->has_orientation_rows()) {
       r.fail("orientation",
              "the task has no orientation rows: set task = \"pose\" (in the scenario or the robot file)");
     }

@@ -11,10 +11,6 @@ namespace redres {
 
 namespace {
 
-bool has_orientation_rows(const RobotModel& robot) {
-  return robot.task_dim() > (robot.kind() == ChainKind::kPlanar ? 2 : 3);
-}
-
 // The rotation vector w (|w| <= pi) written as the equivalent w + 2 pi k w/|w| closest to `previous`, so that the
 // recorded columns have no 2 pi jumps where the rotation angle passes pi.
 Eigen::Vector3d continuous_rotation_vector(const Eigen::Vector3d& w, const Eigen::Vector3d& previous) {
@@ -27,11 +23,6 @@ Eigen::Vector3d continuous_rotation_vector(const Eigen::Vector3d& w, const Eigen
     if ((candidate - previous).squaredNorm() < (best - previous).squaredNorm()) best = candidate;
   }
   return best;
-}
-
-Eigen::Matrix3d rotation_of(const Eigen::Vector3d& w) {
-  const double angle = w.norm();
-  return angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
 }
 
 std::vector<std::string> trajectory_columns(const RobotModel& robot) {
@@ -48,7 +39,7 @@ std::vector<std::string> trajectory_columns(const RobotModel& robot) {
   for (const auto& name : robot.task_names()) cols.push_back("rd_" + name);
   for (const auto& name : robot.task_names()) cols.push_back("r_" + name);
   cols.emplace_back("position_error");
-  if (has_orientation_rows(robot)) cols.emplace_back("orientation_error");
+  if (robot.has_orientation_rows()) cols.emplace_back("orientation_error");
   for (const char* c : {"manipulability", "solver_iterations", "solver_residual"}) cols.emplace_back(c);
   add("vel_lo_");
   add("vel_hi_");
@@ -71,7 +62,7 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   const RobotModel& robot = *s.robot;
   const int n = robot.dof();
   const int m = robot.task_dim();
-  const int position_rows = robot.kind() == ChainKind::kPlanar ? 2 : 3;
+  const int position_rows = robot.position_rows();
   const int steps = s.steps();
   RunResult run;
   // The plugins' own columns (e.g. collision distances) follow the standard ones.
@@ -98,7 +89,7 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   ctrl.set_kinematics_level(KinematicsLevel::kManipulability);
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
   Eigen::VectorXd theta = s.theta0, theta_pred(n), vlo(n), vhi(n);
-  const bool orientation_rows = has_orientation_rows(robot);
+  const bool orientation_rows = robot.has_orientation_rows();
   const bool spatial_orientation = orientation_rows && robot.kind() == ChainKind::kSpatial;
   Eigen::Vector3d wd_prev = Eigen::Vector3d::Zero(), w_prev = Eigen::Vector3d::Zero();
   const auto start = std::chrono::steady_clock::now();
@@ -156,9 +147,10 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
     if (orientation_rows) {
       // The angle between the desired and the actual orientation: planar |phi_d - phi|; spatial the angle of
       // R_d R' (from the rotations themselves).
-      row[c++] = spatial_orientation
-                     ? Eigen::AngleAxisd(rotation_of(ctrl.r_d().tail<3>()) * kin.ee_pose.linear().transpose()).angle()
-                     : std::abs(ctrl.r_d()(2) - kin.f(2));
+      row[c++] =
+          spatial_orientation
+              ? Eigen::AngleAxisd(rotation_from_vector(ctrl.r_d().tail<3>()) * kin.ee_pose.linear().transpose()).angle()
+              : std::abs(ctrl.r_d()(2) - kin.f(2));
     }
     row[c++] = kin.w;
     row[c++] = out.info.iterations;

@@ -9,12 +9,6 @@
 
 namespace redres {
 
-namespace {
-
-Eigen::Vector3d vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
-
-}  // namespace
-
 const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
   using C = ObstacleAvoidanceConfig;
   static const Schema<C> s{
@@ -67,7 +61,12 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
   using B = Config::Broadphase;
   broadphase_ =
       config_.broadphase == B::kAlways || (config_.broadphase == B::kAuto && links_ * obstacles_ > kBroadphasePairs);
-  for (const ShapeSpec& o : config_.obstacles) moving_ = moving_ || o.velocity.has_value();
+  planar_ = robot.kind() == ChainKind::kPlanar;
+  for (const ShapeSpec& o : config_.obstacles) {
+    start_poses_.push_back(o.pose());
+    velocities_.push_back(o.velocity ? Eigen::Vector3d(o.velocity->data()) : Eigen::Vector3d::Zero());
+    moving_ = moving_ || o.velocity.has_value();
+  }
   if (broadphase_) {
     query_->build_broadphase(links_, obstacles_);
     poses_.resize(static_cast<std::size_t>(obstacles_));
@@ -80,9 +79,8 @@ ObstacleAvoidance::~ObstacleAvoidance() = default;
 int ObstacleAvoidance::inequality_rows(const RobotModel& /*robot*/) const { return links_ * obstacles_; }
 
 Eigen::Isometry3d ObstacleAvoidance::obstacle_pose(int k, double t) const {
-  const ShapeSpec& o = config_.obstacles[static_cast<std::size_t>(k)];
-  Eigen::Isometry3d T = o.pose();
-  if (o.velocity) T.translation() += t * vec(*o.velocity);
+  Eigen::Isometry3d T = start_poses_[static_cast<std::size_t>(k)];
+  T.translation() += t * velocities_[static_cast<std::size_t>(k)];
   return T;
 }
 
@@ -108,16 +106,15 @@ void ObstacleAvoidance::pair_row(const KinematicsData& kin, int l, const Eigen::
                                  const Eigen::Isometry3d& To, Eigen::Block<Eigen::MatrixXd>& A,
                                  Eigen::VectorBlock<Eigen::VectorXd>& b) const {
   const int row = o * links_ + l;
-  const auto& v = config_.obstacles[static_cast<std::size_t>(o)].velocity;
-  const Eigen::Vector3d v_b = v ? vec(*v) : Eigen::Vector3d::Zero();
   const ShapeDistance d = query_->distance(l, Tl, links_ + o, To);
   Eigen::Vector3d n;
-  if (!distances_.take(row, d, robot_->kind() == ChainKind::kPlanar, Tl.translation() - To.translation(), n)) {
+  if (!distances_.take(row, d, planar_, Tl.translation() - To.translation(), n)) {
     slack_row(A.row(row), b(row));
     return;
   }
   point_jacobian(*robot_, kin, robot_->link_shapes()[static_cast<std::size_t>(l)].link, d.point_a, jacobian_);
-  damper_row(distances_.damper(), d.distance, n, jacobian_, v_b, A.row(row), b(row));
+  damper_row(distances_.damper(), d.distance, n, jacobian_, velocities_[static_cast<std::size_t>(o)], A.row(row),
+             b(row));
 }
 
 void ObstacleAvoidance::add_near_pairs(const Context& ctx, QpBuilder& builder) const {
@@ -125,9 +122,9 @@ void ObstacleAvoidance::add_near_pairs(const Context& ctx, QpBuilder& builder) c
   auto A = builder.inequality_matrix();
   auto b = builder.inequality_rhs();
   const auto& links = robot_->link_shapes();
-  for (int o = 0; o < obstacles_; ++o) poses_[static_cast<std::size_t>(o)] = obstacle_pose(o, ctx.t);
-  // The tree holds the obstacles' boxes: static ones are placed once, moving ones refitted every step.
+  // The tree holds the obstacles' boxes: static ones are placed once, moving ones moved and refitted every step.
   if (moving_ || !placed_) {
+    for (int o = 0; o < obstacles_; ++o) poses_[static_cast<std::size_t>(o)] = obstacle_pose(o, ctx.t);
     query_->move_group(poses_.data());
     placed_ = true;
   }

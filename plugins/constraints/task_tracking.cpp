@@ -9,14 +9,6 @@
 
 namespace redres {
 
-namespace {
-Eigen::Matrix3d rotation_of(const Eigen::Vector3d& v) {
-  const double angle = v.norm();
-  if (angle == 0.0) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, v / angle).toRotationMatrix();
-}
-}  // namespace
-
 const Schema<TaskTrackingConfig>& TaskTrackingConfig::schema() {
   using C = TaskTrackingConfig;
   static const Schema<C> s{
@@ -40,38 +32,17 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
   const Eigen::Index np = spatial_pose ? 3 : m;
   d.head(np) = ctx.r_d_dot->head(np) + gain_.head(np).cwiseProduct(ctx.r_d->head(np) - k.f.head(np));
   if (spatial_pose) {
-    const Eigen::AngleAxisd err(rotation_of(ctx.r_d->tail<3>()) * k.ee_pose.linear().transpose());
+    const Eigen::AngleAxisd err(rotation_from_vector(ctx.r_d->tail<3>()) * k.ee_pose.linear().transpose());
     d.tail(3) = ctx.r_d_dot->tail<3>() + gain_.tail<3>().cwiseProduct(err.angle() * err.axis());
   }
 }
 
-namespace {
-// The angle between two orientations: planar, the difference of the angles phi; spatial, the angle of R_d R'.
-double orientation_error(const RobotModel& robot, const Eigen::Vector3d& desired, const Eigen::Vector3d& actual) {
-  if (robot.kind() == ChainKind::kPlanar) return std::abs(desired.z() - actual.z());
-  return Eigen::AngleAxisd(rotation_of(desired) * rotation_of(actual).transpose()).angle();
-}
-}  // namespace
-
 void TaskTracking::summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const {
-  const auto& names = robot.task_names();
-  const std::size_t position_rows = robot.kind() == ChainKind::kPlanar ? 2 : 3;
-  if (names.size() <= position_rows) return;  // no orientation rows
-  std::vector<std::size_t> rd, r;
-  for (std::size_t k = position_rows; k < names.size(); ++k) {
-    rd.push_back(run.column("rd_" + names[k]));
-    r.push_back(run.column("r_" + names[k]));
-  }
+  if (!robot.has_orientation_rows()) return;
+  // The run records the angle between the desired and the actual orientation at every step.
+  const std::size_t c = run.column("orientation_error");
   double worst = 0.0;
-  for (std::size_t row = 0; row < run.size(); ++row) {
-    Eigen::Vector3d want = Eigen::Vector3d::Zero(), got = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k < rd.size(); ++k) {
-      const auto i = static_cast<Eigen::Index>(rd.size() == 1 ? 2 : k);
-      want(i) = run(row, rd[k]);
-      got(i) = run(row, r[k]);
-    }
-    worst = std::max(worst, orientation_error(robot, want, got));
-  }
+  for (std::size_t row = 0; row < run.size(); ++row) worst = std::max(worst, run(row, c));
   out.push_back({"max_orientation_error", {worst}, "rad"});
 }
 

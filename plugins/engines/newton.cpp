@@ -367,7 +367,7 @@ class Newton final : public LviEngine {
   bool general_solve(const QpProblem& qp, SolverResult& result) {
     const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
     const double varpi = settings().varpi;
-    M_.setZero();
+    // M's blocks that hold data are written here; the zero block [y; z] x [y; z] stays as setup left it.
     M_.topLeftCorner(n, n) = qp.W;
     M_.block(0, n, n, me) = -qp.J.transpose();
     M_.block(0, n + me, n, mi) = qp.A.transpose();

@@ -56,6 +56,8 @@ struct ShapeSpec {
   [[nodiscard]] std::string describe() const;
 };
 
+/// R = Rz(yaw) Ry(pitch) Rx(roll) from {roll, pitch, yaw} (rad): ShapeSpec's and URDF's convention.
+[[nodiscard]] Eigen::Matrix3d rpy_matrix(const std::array<double, 3>& rpy);
 /// Roll, pitch, yaw of R = Rz(yaw) Ry(pitch) Rx(roll) (ShapeSpec's and URDF's convention); at pitch = +-pi/2 the
 /// whole turn about z goes into yaw.
 [[nodiscard]] std::array<double, 3> rpy_of(const Eigen::Matrix3d& R);

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
 
 #include "redres/robot.hpp"
@@ -43,8 +44,8 @@ class KinematicsData {
 
   Eigen::VectorXd theta;                       //!< configuration the results belong to (n)
   Eigen::VectorXd f;                           //!< task coordinates f(theta) (m): m, rad (planar phi), rotation vector
-  Eigen::Isometry3d ee_pose;                   //!< end-effector pose in the base frame
-  Eigen::Matrix3Xd axes;                       //!< z_j, joint axes in the base frame (3 x n)
+  Eigen::Isometry3d ee_pose;                   //!< end-effector pose in the world frame (the base pose applied)
+  Eigen::Matrix3Xd axes;                       //!< z_j, joint axes in the world frame (3 x n)
   Eigen::Matrix3Xd origins;                    //!< p_j, points on the joint axes (3 x n), m
   std::vector<Eigen::Isometry3d> link_frames;  //!< frame of each link: joint j's frame after its motion (n)
   Eigen::MatrixXd J;                           //!< task Jacobian (m x n)
@@ -79,5 +80,12 @@ void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::V
 /// eigen-decomposition otherwise, using `eig` as scratch). Allocation-free when `adj` is sized.
 double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> adj,
                               TaskEigenSolver& eig);
+
+/// The rotation matrix of rotation vector w (angle |w| about w / |w|; the identity for w = 0): how f's orientation
+/// rows and the desired orientation of a spatial pose task read as rotations.
+[[nodiscard]] inline Eigen::Matrix3d rotation_from_vector(const Eigen::Vector3d& w) {
+  const double angle = w.norm();
+  return angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+}
 
 }  // namespace redres

@@ -24,7 +24,7 @@
 ///
 /// Task rows (`task`): planar "position" = (x, y), planar "pose" = (x, y, phi) with phi the end-effector angle;
 /// spatial "position" = (x, y, z), spatial "pose" = (x, y, z, wx, wy, wz) where the last three rows of J are the
-/// geometric angular velocity in the base frame (so they are not the derivative of f's rotation-vector entries).
+/// geometric angular velocity in the world frame (so they are not the derivative of f's rotation-vector entries).
 
 #include <filesystem>
 #include <memory>
@@ -103,6 +103,10 @@ class RobotModel {
   [[nodiscard]] int dof() const noexcept { return static_cast<int>(spec_.joints.size()); }
   /// Number of task rows m (2 or 3 planar, 3 or 6 spatial).
   [[nodiscard]] int task_dim() const noexcept { return task_dim_; }
+  /// Number of position rows: 2 (planar) or 3 (spatial); the task's first rows.
+  [[nodiscard]] int position_rows() const noexcept { return spec_.kind == ChainKind::kPlanar ? 2 : 3; }
+  /// Whether the task has orientation rows after the position rows (a pose task).
+  [[nodiscard]] bool has_orientation_rows() const noexcept { return task_dim_ > position_rows(); }
   /// Names of the task rows, e.g. {"x", "y"}.
   [[nodiscard]] const std::vector<std::string>& task_names() const noexcept { return task_names_; }
   /// Joint j (0-based).

@@ -15,7 +15,7 @@ inline constexpr std::size_t kFramesMaxRows = 500;
 
 /// The arm's joint frames over a recorded run, by forward kinematics of its `theta_<j>` columns, for drawing the
 /// arm and its collision shapes (frames.csv): columns `t`, then per joint j = 1..n `joint_<j>_x`, `_y`, `_z` (the
-/// origin of joint j's frame after its motion, in the base frame) and `joint_<j>_r11` .. `_r33` (its rotation,
+/// origin of joint j's frame after its motion, in the world frame) and `joint_<j>_r11` .. `_r33` (its rotation,
 /// row by row), then `ee_x`, `ee_y`, `ee_z` (the end effector). Every row of `run` when it has at most `max_rows`
 /// (>= 2) rows; else every k-th row, k the smallest stride that keeps at most `max_rows` rows with the last row
 /// always kept.

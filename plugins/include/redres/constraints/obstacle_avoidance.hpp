@@ -80,7 +80,10 @@ class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig> {
   mutable Eigen::Matrix3Xd jacobian_;
   // Broadphase: whether it is used, whether an obstacle moves, whether the tree holds the obstacles' poses yet, the
   // obstacles' poses this step, and the candidates near() returns for one link shape.
-  bool broadphase_ = false, moving_ = false;
+  bool broadphase_ = false, moving_ = false, planar_ = false;
+  // Each obstacle's pose at t = 0 and its velocity (zero when it stands still).
+  std::vector<Eigen::Isometry3d> start_poses_;
+  std::vector<Eigen::Vector3d> velocities_;
   mutable bool placed_ = false;
   mutable std::vector<Eigen::Isometry3d> poses_;
   mutable std::vector<int> candidates_;

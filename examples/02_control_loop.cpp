@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
     KinematicsData k(robot);
     compute_kinematics(robot, theta, k, KinematicsLevel::kPosition);
     const Eigen::VectorXd start = k.f;
-    Eigen::VectorXd r_d = start, r_d_dot = Eigen::VectorXd::Zero(robot.task_dim());
+    Eigen::VectorXd r_d = start, r_d_dot = Eigen::VectorXd::Zero(robot.reference_dim());
     constexpr double two_pi = 2.0 * std::numbers::pi;
     for (int i = 0; i <= 500; ++i) {  // the control loop
       const double t = i * tau, u = t / T;

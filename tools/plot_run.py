@@ -77,9 +77,10 @@ def profiles(ax_v, ax_q, data, n):
     ax_q.grid(alpha=0.3)
 
 
-def load_frames(run_dir):
-    """frames.csv as (t, points, rotations): points (rows, n + 2, 3) is the base origin, the n joint frames' origins
-    and the end effector; rotations (rows, n, 3, 3) the joint frames' rotations. None for a run without the file."""
+def load_frames(run_dir, summary):
+    """frames.csv as (t, points, rotations): points (rows, n + 2, 3) is the base origin (summary.json's
+    robot.base_position), the n joint frames' origins and the end effector; rotations (rows, n, 3, 3) the joint
+    frames' rotations. None for a run without the file."""
     path = os.path.join(run_dir, "frames.csv")
     if not os.path.exists(path):
         return None
@@ -88,6 +89,7 @@ def load_frames(run_dir):
     rows = len(f)
     points = np.zeros((rows, n + 2, 3))
     rotations = np.zeros((rows, n, 3, 3))
+    points[:, 0] = summary["robot"].get("base_position", [0.0, 0.0, 0.0])
     for j in range(1, n + 1):
         points[:, j] = np.column_stack([f[f"joint_{j}_{a}"] for a in "xyz"])
         for a in range(3):
@@ -542,7 +544,7 @@ def plot_run(run_dir, quiet):
     n = joints(summary)
     name = summary.get("name", os.path.basename(os.path.normpath(run_dir)))
     fig_profiles(run_dir, data, n, name)
-    fig_task(run_dir, data, summary, load_frames(run_dir), n, name)
+    fig_task(run_dir, data, summary, load_frames(run_dir, summary), n, name)
     fig_angles(run_dir, data, summary, n, name)
     fig_velocities(run_dir, data, n, name)
     fig_error(run_dir, data, name)
@@ -563,7 +565,7 @@ def animate_run(run_dir, quiet):
     """The arm, its collision shapes (when there are obstacles), the obstacles where they are, the end-effector
     trail and the desired path, over the run: animation.mp4 or animation.gif in run_dir."""
     data, summary = load(run_dir)
-    frames = load_frames(run_dir)
+    frames = load_frames(run_dir, summary)
     if frames is None:
         raise SystemExit(f"plot_run.py: --animate: no frames.csv in {run_dir} (runs of redres before it wrote one)")
     name = summary.get("name", os.path.basename(os.path.normpath(run_dir)))

@@ -61,6 +61,7 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
           {"kind", to_string(model.kind())},
           {"dof", model.dof()},
           {"task", model.task_names()},
+          {"reference", model.reference_names()},
           {"source", model.source()},
           {"joints", joints},
           {"theta", to_vector(k.theta)},

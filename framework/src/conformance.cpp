@@ -157,7 +157,7 @@ void check_scheme_plugin(const Entry& e, const std::vector<RobotModel>& robots, 
     QpProblem qp;
     scheme.setup(qp);
     KinematicsData kin(robot);
-    Eigen::VectorXd r_d = Eigen::VectorXd::Zero(robot.task_dim()), r_d_dot = r_d;
+    Eigen::VectorXd r_d = Eigen::VectorXd::Zero(robot.reference_dim()), r_d_dot = r_d;
     Context ctx{0.0, 10.0, 0.01, &robot, &kin, &r_d, &r_d_dot};
     Lcg lcg;
     std::string finite_error, gradient_error;
@@ -170,7 +170,7 @@ void check_scheme_plugin(const Entry& e, const std::vector<RobotModel>& robots, 
       }
       ctx.t = lcg.next(0.0, ctx.T);
       compute_kinematics(robot, theta, kin, KinematicsLevel::kAll);
-      for (int r = 0; r < robot.task_dim(); ++r) {
+      for (int r = 0; r < robot.reference_dim(); ++r) {
         r_d(r) = kin.f(r) + lcg.next(-0.01, 0.01);
         r_d_dot(r) = lcg.next(-0.05, 0.05);
       }

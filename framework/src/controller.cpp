@@ -16,8 +16,8 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
       engine_(&engine),
       path_(path),
       kin_(robot),
-      r_d_(Eigen::VectorXd::Zero(robot.task_dim())),
-      r_d_dot_(Eigen::VectorXd::Zero(robot.task_dim())) {
+      r_d_(Eigen::VectorXd::Zero(robot.reference_dim())),
+      r_d_dot_(Eigen::VectorXd::Zero(robot.reference_dim())) {
   REDRES_REQUIRE(&scheme.robot() == &robot, "Controller", "the scheme was built for this robot");
   REDRES_REQUIRE(T > 0.0 && tau > 0.0, "Controller", "T > 0 and tau > 0");
   if (path != nullptr) {
@@ -53,14 +53,14 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, 
   compute_kinematics(*robot_, theta, kin_, level_);
   const int p = path_->dim();
   path_->evaluate(t, r_d_.head(p), r_d_dot_.head(p));
-  if (robot_->task_dim() > p) {
+  if (robot_->reference_dim() > p) {
     if (!orientation_set_ && !orientation_captured_) {
       // Hold the orientation the end effector has at the start.
       orientation_ = robot_->kind() == ChainKind::kPlanar ? Eigen::Vector3d(0.0, 0.0, kin_.f(2))
                                                           : Eigen::Vector3d(kin_.f.tail<3>());
       orientation_captured_ = true;
     }
-    const int rest = robot_->task_dim() - p;
+    const int rest = robot_->reference_dim() - p;
     // The turn's progress s(t) in [0, 1] and its rate (zero when the orientation is held).
     double progress = 0.0, rate = 0.0;
     const double T = ctx_.T;
@@ -90,8 +90,10 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, 
 void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
                       const Eigen::Ref<const Eigen::VectorXd>& r_d, const Eigen::Ref<const Eigen::VectorXd>& r_d_dot,
                       StepOutput& out) {
-  REDRES_REQUIRE(r_d.size() == robot_->task_dim() && r_d_dot.size() == robot_->task_dim(), "Controller::step",
-                 "r_d and r_d_dot have task_dim() = " + std::to_string(robot_->task_dim()) + " entries");
+  const int m = robot_->reference_dim();
+  REDRES_REQUIRE(r_d.size() == m && r_d_dot.size() == m, "Controller::step",
+                 "r_d and r_d_dot have reference_dim() = " + std::to_string(m) + " entries (got " +
+                     std::to_string(r_d.size()) + " and " + std::to_string(r_d_dot.size()) + ")");
   REDRES_REQUIRE(r_d.allFinite() && r_d_dot.allFinite(), "Controller::step", "r_d and r_d_dot are finite");
   compute_kinematics(*robot_, theta, kin_, level_);
   r_d_ = r_d;

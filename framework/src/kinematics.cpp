@@ -14,16 +14,13 @@ Vector3d joint_motion(bool revolute, const Vector3d& z_i, const Vector3d& p_i, c
   return revolute ? Vector3d(z_i.cross(p - p_i)) : z_i;
 }
 
-// Writes the selected task rows of a spatial 6-vector (linear; angular) into column `col` of `out`.
+// Writes the task rows of a spatial 6-vector (linear; angular) into column `col` of `out`.
 void put_rows(const RobotModel& model, const Vector3d& lin, const Vector3d& ang, Eigen::Ref<Eigen::MatrixXd> out,
               Eigen::Index col) {
-  if (model.kind() == ChainKind::kPlanar) {
-    out(0, col) = lin.x();
-    out(1, col) = lin.y();
-    if (model.task() == TaskRows::kPose) out(2, col) = ang.z();
-  } else {
-    out.block<3, 1>(0, col) = lin;
-    if (model.task() == TaskRows::kPose) out.block<3, 1>(3, col) = ang;
+  const int m = model.task_dim();
+  for (int i = 0; i < m; ++i) {
+    const int r = model.twist_row(i);
+    out(i, col) = r < 3 ? lin(r) : ang(r - 3);
   }
 }
 
@@ -31,7 +28,7 @@ void put_rows(const RobotModel& model, const Vector3d& lin, const Vector3d& ang,
 
 KinematicsData::KinematicsData(const RobotModel& model)
     : theta(Eigen::VectorXd::Zero(model.dof())),
-      f(Eigen::VectorXd::Zero(model.task_dim())),
+      f(Eigen::VectorXd::Zero(model.reference_dim())),
       ee_pose(Eigen::Isometry3d::Identity()),
       axes(Eigen::Matrix3Xd::Zero(3, model.dof())),
       origins(Eigen::Matrix3Xd::Zero(3, model.dof())),

@@ -28,6 +28,18 @@ const char* to_string(TaskRows rows) { return rows == TaskRows::kPosition ? "pos
 
 namespace {
 
+// The rows of a pose task, in order; a position task has the first two (planar) or three (spatial).
+const std::vector<std::string>& pose_row_names(ChainKind kind) {
+  static const std::vector<std::string> planar{"x", "y", "phi"}, spatial{"x", "y", "z", "wx", "wy", "wz"};
+  return kind == ChainKind::kPlanar ? planar : spatial;
+}
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
 using Eigen::AngleAxisd;
 using Eigen::Isometry3d;
 using Eigen::Vector3d;
@@ -157,14 +169,34 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
     REDRES_REQUIRE(a >= 0 && a < n && b >= 0 && b < n && a != b, "RobotModel",
                    "collision_exclude pairs name two different joints of the chain");
   }
-  if (spec_.kind == ChainKind::kPlanar) {
-    task_names_ = {"x", "y"};
-    if (spec_.task == TaskRows::kPose) task_names_.emplace_back("phi");
-  } else {
-    task_names_ = {"x", "y", "z"};
-    if (spec_.task == TaskRows::kPose) task_names_.insert(task_names_.end(), {"wx", "wy", "wz"});
+  // The pose's rows; a position task is their first position_rows(). A subset picks rows of them, in order.
+  const std::vector<std::string>& all = pose_row_names(spec_.kind);
+  if (!spec_.task_axes.empty()) {
+    int previous = -1;
+    bool orientation = false;
+    for (const std::string& name : spec_.task_axes) {
+      const auto it = std::find(all.begin(), all.end(), name);
+      REDRES_REQUIRE(it != all.end(), "RobotModel",
+                     "task_axes name rows of the " + std::string(to_string(spec_.kind)) + " pose (got '" + name + "')");
+      const int r = static_cast<int>(it - all.begin());
+      REDRES_REQUIRE(r > previous, "RobotModel",
+                     "task_axes name each row once, in the pose's order (" + join(all) + "): '" + name + "' is out of place");
+      previous = r;
+      orientation = orientation || r >= position_rows();
+    }
+    spec_.task = orientation ? TaskRows::kPose : TaskRows::kPosition;
   }
-  task_dim_ = static_cast<int>(task_names_.size());
+  const std::size_t rows = spec_.task == TaskRows::kPose ? all.size() : static_cast<std::size_t>(position_rows());
+  reference_names_.assign(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(rows));
+  for (std::size_t r = 0; r < rows; ++r) {
+    const bool selected = spec_.task_axes.empty() || std::find(spec_.task_axes.begin(), spec_.task_axes.end(),
+                                                               reference_names_[r]) != spec_.task_axes.end();
+    if (!selected) continue;
+    task_names_.push_back(reference_names_[r]);
+    task_rows_.push_back(static_cast<int>(r));
+    twist_rows_.push_back(spec_.kind == ChainKind::kPlanar && r == 2 ? 5 : static_cast<int>(r));
+    tracked_ |= 1U << r;
+  }
 }
 
 void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
@@ -412,6 +444,31 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
 
 }  // namespace
 
+void read_task(const TableReader& r, RobotSpec& spec) {
+  if (!r.has("task")) return;
+  if (!r.raw()["task"].is_array()) {
+    spec.task = r.choice("task", {"position", "pose"}) == "position" ? TaskRows::kPosition : TaskRows::kPose;
+    spec.task_axes.clear();
+    return;
+  }
+  const std::vector<std::string>& all = pose_row_names(spec.kind);
+  std::vector<std::string> axes = r.strings("task");
+  if (axes.empty()) r.fail("task", "expected \"position\", \"pose\" or a non-empty array of rows from " + join(all));
+  std::ptrdiff_t previous = -1;
+  for (const std::string& name : axes) {
+    const auto it = std::find(all.begin(), all.end(), name);
+    if (it == all.end()) {
+      r.fail("task", "expected rows of the " + std::string(to_string(spec.kind)) + " pose (" + join(all) + "), got '" +
+                         name + "'");
+    }
+    if (it - all.begin() <= previous) {
+      r.fail("task", "expected each row once, in the order " + join(all) + " ('" + name + "' is out of place)");
+    }
+    previous = it - all.begin();
+  }
+  spec.task_axes = std::move(axes);
+}
+
 RobotModel load_robot(const std::filesystem::path& file) {
   return load_robot(TableReader::root(parse_toml_file(file), "robot"));
 }
@@ -434,7 +491,7 @@ RobotModel load_robot(const TableReader& r) {
                                              : DhConvention::kJointFrames;
     }
   }
-  spec.task = r.choice("task", {"position", "pose"}, "position") == "position" ? TaskRows::kPosition : TaskRows::kPose;
+  read_task(r, spec);
 
   if (!from_urdf) {
     std::set<std::string> names;

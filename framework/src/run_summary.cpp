@@ -88,6 +88,9 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   out.wall_time_s = run.wall_time_s;
   out.robot.name = robot.name();
   out.robot.kind = to_string(robot.kind());
+  out.robot.task_rows = robot.task_names();
+  const Eigen::Vector3d base = robot.base().translation();
+  out.robot.base_position = {base.x(), base.y(), base.z()};
   for (int j = 0; j < n; ++j) {
     out.robot.joint_names.push_back(robot.joint(j).name);
     out.robot.lower_limits.push_back(robot.lower_limits()(j));
@@ -192,6 +195,8 @@ std::string to_json(const RunSummary& s) {
        {{"name", s.robot.name},
         {"kind", s.robot.kind},
         {"joint_names", s.robot.joint_names},
+        {"task_rows", s.robot.task_rows},
+        {"base_position", s.robot.base_position},
         {"lower_limits", s.robot.lower_limits},
         {"upper_limits", s.robot.upper_limits},
         {"link_lengths", s.robot.link_lengths},

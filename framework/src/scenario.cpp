@@ -70,7 +70,7 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
     // The scenario chooses the task rows (the robot file's `task` is only the default), so that one robot file
     // serves position and pose scenarios alike.
     RobotSpec spec = s.robot->spec();
-    spec.task = r.choice("task", {"position", "pose"}) == "position" ? TaskRows::kPosition : TaskRows::kPose;
+    read_task(r, spec);
     s.robot = std::make_unique<RobotModel>(std::move(spec));
   }
   s.theta0 = read_theta0(r, *s.robot);

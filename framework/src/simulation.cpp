@@ -36,8 +36,8 @@ std::vector<std::string> trajectory_columns(const RobotModel& robot) {
   add("theta_dot_");
   add("lo_");
   add("hi_");
-  for (const auto& name : robot.task_names()) cols.push_back("rd_" + name);
-  for (const auto& name : robot.task_names()) cols.push_back("r_" + name);
+  for (const auto& name : robot.reference_names()) cols.push_back("rd_" + name);
+  for (const auto& name : robot.reference_names()) cols.push_back("r_" + name);
   cols.emplace_back("position_error");
   if (robot.has_orientation_rows()) cols.emplace_back("orientation_error");
   for (const char* c : {"manipulability", "solver_iterations", "solver_residual"}) cols.emplace_back(c);
@@ -61,7 +61,7 @@ std::string RunResult::engine() const {
 RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   const RobotModel& robot = *s.robot;
   const int n = robot.dof();
-  const int m = robot.task_dim();
+  const int m = robot.reference_dim();
   const int position_rows = robot.position_rows();
   const int steps = s.steps();
   RunResult run;
@@ -91,6 +91,16 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   Eigen::VectorXd theta = s.theta0, theta_pred(n), vlo(n), vhi(n);
   const bool orientation_rows = robot.has_orientation_rows();
   const bool spatial_orientation = orientation_rows && robot.kind() == ChainKind::kSpatial;
+  bool all_position_rows = true, all_orientation_rows = true;
+  for (int r = 0; r < m; ++r) (r < position_rows ? all_position_rows : all_orientation_rows) &= robot.tracks(r);
+  // The norm of v's entries that are task rows; v(i) is reference row first + i (a subset leaves some rows free).
+  const auto tracked_norm = [&robot](const auto& v, int first, int count) {
+    double sum = 0.0;
+    for (int i = 0; i < count; ++i) {
+      if (robot.tracks(first + i)) sum += v(i) * v(i);
+    }
+    return std::sqrt(sum);
+  };
   Eigen::Vector3d wd_prev = Eigen::Vector3d::Zero(), w_prev = Eigen::Vector3d::Zero();
   const auto start = std::chrono::steady_clock::now();
   const int report_every = std::max(1, steps / 200);
@@ -143,14 +153,18 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
       for (int r = 0; r < m; ++r) row[c++] = ctrl.r_d()(r);
       for (int r = 0; r < m; ++r) row[c++] = kin.f(r);
     }
-    row[c++] = (ctrl.r_d().head(position_rows) - kin.f.head(position_rows)).norm();
+    row[c++] = all_position_rows ? (ctrl.r_d().head(position_rows) - kin.f.head(position_rows)).norm()
+                                 : tracked_norm(ctrl.r_d() - kin.f, 0, position_rows);
     if (orientation_rows) {
       // The angle between the desired and the actual orientation: planar |phi_d - phi|; spatial the angle of
-      // R_d R' (from the rotations themselves).
-      row[c++] =
-          spatial_orientation
-              ? Eigen::AngleAxisd(rotation_from_vector(ctrl.r_d().tail<3>()) * kin.ee_pose.linear().transpose()).angle()
-              : std::abs(ctrl.r_d()(2) - kin.f(2));
+      // R_d R' (from the rotations themselves). A subset of the orientation rows: the norm of those rows of the
+      // rotation vector of R_d R'.
+      if (spatial_orientation) {
+        const Eigen::AngleAxisd err(rotation_from_vector(ctrl.r_d().tail<3>()) * kin.ee_pose.linear().transpose());
+        row[c++] = all_orientation_rows ? err.angle() : tracked_norm(err.angle() * err.axis(), 3, 3);
+      } else {
+        row[c++] = std::abs(ctrl.r_d()(2) - kin.f(2));
+      }
     }
     row[c++] = kin.w;
     row[c++] = out.info.iterations;

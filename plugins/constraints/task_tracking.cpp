@@ -22,18 +22,25 @@ TaskTracking::TaskTracking(const Config& config, const RobotModel& robot)
 void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
   REDRES_REQUIRE(ctx.r_d != nullptr && ctx.r_d_dot != nullptr, "task_tracking",
                  "the context carries the desired r_d and r_d_dot");
-  const Eigen::Index m = gain_.size();
-  REDRES_REQUIRE(ctx.r_d->size() == m && ctx.r_d_dot->size() == m, "task_tracking",
-                 "r_d and r_d_dot have one entry per task row (" + std::to_string(m) + ")");
+  const RobotModel& robot = *ctx.robot;
+  const Eigen::Index rows = robot.reference_dim();
+  REDRES_REQUIRE(ctx.r_d->size() == rows && ctx.r_d_dot->size() == rows, "task_tracking",
+                 "r_d and r_d_dot have one entry per reference row (" + std::to_string(rows) + ")");
   const KinematicsData& k = *ctx.kinematics;
   builder.equality_matrix() = k.J;
-  auto d = builder.equality_rhs();
-  const bool spatial_pose = ctx.robot->kind() == ChainKind::kSpatial && ctx.robot->task() == TaskRows::kPose;
-  const Eigen::Index np = spatial_pose ? 3 : m;
-  d.head(np) = ctx.r_d_dot->head(np) + gain_.head(np).cwiseProduct(ctx.r_d->head(np) - k.f.head(np));
-  if (spatial_pose) {
+  // The error e = r_d - f in every reference row; a spatial orientation's is the rotation vector of R_d R'.
+  Eigen::Matrix<double, 6, 1> e;
+  e.head(rows) = *ctx.r_d - k.f;
+  if (robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows()) {
     const Eigen::AngleAxisd err(rotation_from_vector(ctx.r_d->tail<3>()) * k.ee_pose.linear().transpose());
-    d.tail(3) = ctx.r_d_dot->tail<3>() + gain_.tail<3>().cwiseProduct(err.angle() * err.axis());
+    e.segment<3>(3) = err.angle() * err.axis();
+  }
+  // d = S (r_d_dot + K e): the task rows only (all of them unless the task names a subset).
+  auto d = builder.equality_rhs();
+  const std::vector<int>& task_rows = robot.task_rows();
+  for (Eigen::Index i = 0; i < gain_.size(); ++i) {
+    const int r = task_rows[static_cast<std::size_t>(i)];
+    d(i) = (*ctx.r_d_dot)(r) + gain_(i) * e(r);
   }
 }
 

@@ -26,18 +26,31 @@ RobotModel random_model() {
   const bool planar = *rc::gen::arbitrary<bool>();
   const int n = *rc::gen::inRange(2, 10);
   const TaskRows task = *rc::gen::element(TaskRows::kPosition, TaskRows::kPose);
-  return RobotModel(planar ? random_planar(n, task) : random_spatial(n, task));
+  RobotSpec spec = planar ? random_planar(n, task) : random_spatial(n, task);
+  if (*rc::gen::inRange(0, 3) == 0) {
+    // A random non-empty subset of the pose's rows (a selection matrix S on J).
+    const std::vector<std::string> all = planar ? std::vector<std::string>{"x", "y", "phi"}
+                                                : std::vector<std::string>{"x", "y", "z", "wx", "wy", "wz"};
+    const int mask = *rc::gen::inRange(1, 1 << all.size());
+    for (std::size_t r = 0; r < all.size(); ++r) {
+      if ((mask >> r) & 1) spec.task_axes.push_back(all[r]);
+    }
+  }
+  return RobotModel(std::move(spec));
 }
 
 // Central difference of the task coordinates: f for position rows and the planar angle; for spatial orientation
-// rows the rotation vector of R(theta + h) R(theta - h)' (which the geometric Jacobian's angular rows match).
+// rows the rotation vector of R(theta + h) R(theta - h)' (which the geometric Jacobian's angular rows match). Only
+// the task rows (a subset keeps some rows of the reference).
 Eigen::VectorXd task_difference(const RobotModel& model, const KinematicsData& plus, const KinematicsData& minus) {
   Eigen::VectorXd d = (plus.f - minus.f) / (2 * kStep);
   if (model.kind() == ChainKind::kSpatial && model.task() == TaskRows::kPose) {
     const Eigen::AngleAxisd aa(plus.ee_pose.linear() * minus.ee_pose.linear().transpose());
     d.tail<3>() = aa.angle() * aa.axis() / (2 * kStep);
   }
-  return d;
+  Eigen::VectorXd rows(model.task_dim());
+  for (int i = 0; i < model.task_dim(); ++i) rows(i) = d(model.task_rows()[static_cast<std::size_t>(i)]);
+  return rows;
 }
 
 // |a - b|_inf <= tol (1 + |b|_inf), with a message naming the worst entry.

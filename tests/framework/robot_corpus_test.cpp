@@ -3,8 +3,11 @@
 // as formulas and CSV tables load and evaluate as written.
 
 #include <cmath>
+#include <random>
 
 #include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 
 #include "redres/kinematics.hpp"
 #include "test_util.hpp"
@@ -122,6 +125,45 @@ TEST(RobotFiles, PandaFlangeAtTheReadyPose) {
   EXPECT_NEAR(k.f(0), 0.3069, 1e-3);
   EXPECT_NEAR(k.f(1), 0.0, 1e-9);
   EXPECT_NEAR(k.f(2), 0.5903, 1e-3);
+}
+
+// The Kinova Gen3's published classic DH table starts with a fixed row 0 (alpha_0 = pi), which the robot file
+// gives as its [base] pose. Checked against the table multiplied out here, row 0 included, at random angles; the
+// arm stands upright at q = 0; and Kinova's "Home" pose puts the tool interface at the position and the
+// orientation (Euler x-y-z angles 90, 0, 90 deg) that Kinova's web application shows there.
+TEST(RobotFiles, KinovaGen3MatchesItsPublishedDhTableWithItsBaseRow) {
+  const RobotModel gen3 = load_robot(source_path("robots/kinova_gen3.toml"));
+  ASSERT_EQ(gen3.dof(), 7);
+  const auto dh = [](double alpha, double d, double theta) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.rotate(Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitZ()));
+    T.translate(Eigen::Vector3d(0.0, 0.0, d));
+    T.rotate(Eigen::AngleAxisd(alpha, Eigen::Vector3d::UnitX()));
+    return T;
+  };
+  const double d[7] = {-(0.1564 + 0.1284), -(0.0054 + 0.0064), -(0.2104 + 0.2104), -(0.0064 + 0.0064),
+                       -(0.2084 + 0.1059), 0.0, -(0.1059 + 0.0615)};
+  const auto table = [&](const Eigen::VectorXd& q) {
+    Eigen::Isometry3d T = dh(M_PI, 0.0, 0.0);  // row 0
+    for (int i = 0; i < 7; ++i) T = T * dh(i == 6 ? M_PI : M_PI / 2, d[i], q(i) + (i == 0 ? 0.0 : M_PI));
+    return T;
+  };
+  KinematicsData k(gen3);
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::VectorXd q = random_inside(gen3, rng);
+    compute_kinematics(gen3, q, k, KinematicsLevel::kPosition);
+    EXPECT_LT((k.ee_pose.matrix() - table(q).matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  }
+  compute_kinematics(gen3, Eigen::VectorXd::Zero(7), k, KinematicsLevel::kPosition);
+  EXPECT_LT((k.f - Eigen::Vector3d(0.0, -0.0246, 1.1873)).norm(), 1e-12) << "upright at q = 0";
+  compute_kinematics(gen3, gen3.home(), k, KinematicsLevel::kPosition);
+  EXPECT_LT((k.f - Eigen::Vector3d(0.457, 0.001, 0.434)).cwiseAbs().maxCoeff(), 5e-4) << k.f.transpose();
+  const Eigen::Matrix3d shown = (Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()) *
+                                 Eigen::AngleAxisd(0.0, Eigen::Vector3d::UnitY()) *
+                                 Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()))
+                                    .toRotationMatrix();
+  EXPECT_LT(Eigen::AngleAxisd(shown * k.ee_pose.linear().transpose()).angle(), 1e-9) << k.ee_pose.linear();
 }
 
 TEST(RobotFiles, FormulaAndTableLawsEvaluateAsWritten) {

@@ -52,7 +52,7 @@ auto round_trip(const toml::table& config, const RobotModel& robot, Make make) {
 
 // Random state inside the limits, with a random desired task point near f and a random desired velocity.
 struct State {
-  explicit State(const RobotModel& robot) : kin(robot), r_d(robot.task_dim()), r_d_dot(robot.task_dim()) {}
+  explicit State(const RobotModel& robot) : kin(robot), r_d(robot.reference_dim()), r_d_dot(robot.reference_dim()) {}
   KinematicsData kin;
   Eigen::VectorXd r_d, r_d_dot;
   Context ctx;
@@ -64,7 +64,7 @@ struct State {
     }
     if (theta_in != nullptr) theta = *theta_in;
     compute_kinematics(robot, theta, kin, KinematicsLevel::kAll);
-    for (int r = 0; r < robot.task_dim(); ++r) {
+    for (int r = 0; r < robot.reference_dim(); ++r) {
       r_d(r) = kin.f(r) + 0.01 * (u(rng) - 0.5);
       r_d_dot(r) = 0.1 * (u(rng) - 0.5);
     }

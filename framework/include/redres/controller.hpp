@@ -37,7 +37,8 @@ class Controller {
   /// orientation reference: the one set with set_orientation_reference(), or else the end effector's orientation
   /// at the first such step after construction or reset().
   void step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out);
-  /// One step with caller-supplied r_d and r_d_dot (size task_dim()).
+  /// One step with caller-supplied r_d and r_d_dot (size reference_dim(): every row of the position or pose, also
+  /// those a subset of task rows leaves free, which are not used).
   void step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, const Eigen::Ref<const Eigen::VectorXd>& r_d,
             const Eigen::Ref<const Eigen::VectorXd>& r_d_dot, StepOutput& out);
 

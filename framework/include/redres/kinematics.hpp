@@ -43,7 +43,7 @@ class KinematicsData {
   explicit KinematicsData(const RobotModel& model);
 
   Eigen::VectorXd theta;                       //!< configuration the results belong to (n)
-  Eigen::VectorXd f;                           //!< task coordinates f(theta) (m): m, rad (planar phi), rotation vector
+  Eigen::VectorXd f;                           //!< reference coordinates f(theta) (reference_dim()): m, rad, rot. vector
   Eigen::Isometry3d ee_pose;                   //!< end-effector pose in the world frame (the base pose applied)
   Eigen::Matrix3Xd axes;                       //!< z_j, joint axes in the world frame (3 x n)
   Eigen::Matrix3Xd origins;                    //!< p_j, points on the joint axes (3 x n), m

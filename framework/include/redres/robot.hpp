@@ -25,6 +25,9 @@
 /// Task rows (`task`): planar "position" = (x, y), planar "pose" = (x, y, phi) with phi the end-effector angle;
 /// spatial "position" = (x, y, z), spatial "pose" = (x, y, z, wx, wy, wz) where the last three rows of J are the
 /// geometric angular velocity in the world frame (so they are not the derivative of f's rotation-vector entries).
+/// `task` may also name a subset of these rows, in this order, e.g. ["x", "y", "z", "wz"]: the reference (f, r_d)
+/// keeps every row of the position or pose task it belongs to, while J, the task constraint and w = det(J J') use
+/// the named rows only (a selection matrix S: S J x = S (r_d_dot + K e)).
 
 #include <filesystem>
 #include <memory>
@@ -76,6 +79,9 @@ struct RobotSpec {
   ChainKind kind = ChainKind::kPlanar;                             //!< planar or spatial
   DhConvention convention = DhConvention::kStandard;               //!< spatial only
   TaskRows task = TaskRows::kPosition;                             //!< task rows
+  /// A subset of the task's rows by name, in row order (empty: every row of `task`). When given it decides `task`:
+  /// pose when it names an orientation row (phi, wx, wy or wz), position otherwise.
+  std::vector<std::string> task_axes;
   std::vector<JointSpec> joints;                                   //!< the chain, base to tip
   Eigen::Isometry3d base = Eigen::Isometry3d::Identity();          //!< P, the base in the world (planar: in-plane)
   Eigen::Isometry3d end_effector = Eigen::Isometry3d::Identity();  //!< E, in the last joint's frame
@@ -97,18 +103,29 @@ class RobotModel {
   [[nodiscard]] ChainKind kind() const noexcept { return spec_.kind; }
   /// DH convention (spatial chains).
   [[nodiscard]] DhConvention convention() const noexcept { return spec_.convention; }
-  /// Task rows.
+  /// Which reference the task follows: position, or position and orientation (pose).
   [[nodiscard]] TaskRows task() const noexcept { return spec_.task; }
   /// Number of joints n.
   [[nodiscard]] int dof() const noexcept { return static_cast<int>(spec_.joints.size()); }
-  /// Number of task rows m (2 or 3 planar, 3 or 6 spatial).
-  [[nodiscard]] int task_dim() const noexcept { return task_dim_; }
-  /// Number of position rows: 2 (planar) or 3 (spatial); the task's first rows.
+  /// Number of task rows m: the rows of J and of the task constraint (2 or 3 planar, 3 or 6 spatial, fewer when
+  /// `task_axes` names a subset).
+  [[nodiscard]] int task_dim() const noexcept { return static_cast<int>(task_rows_.size()); }
+  /// Number of reference rows: the size of f, r_d and r_d_dot (position rows, then orientation rows for a pose).
+  [[nodiscard]] int reference_dim() const noexcept { return static_cast<int>(reference_names_.size()); }
+  /// Number of position rows of the reference: 2 (planar) or 3 (spatial); its first rows.
   [[nodiscard]] int position_rows() const noexcept { return spec_.kind == ChainKind::kPlanar ? 2 : 3; }
-  /// Whether the task has orientation rows after the position rows (a pose task).
-  [[nodiscard]] bool has_orientation_rows() const noexcept { return task_dim_ > position_rows(); }
+  /// Whether the reference has orientation rows after the position rows (a pose task, or a subset of one).
+  [[nodiscard]] bool has_orientation_rows() const noexcept { return spec_.task == TaskRows::kPose; }
   /// Names of the task rows, e.g. {"x", "y"}.
   [[nodiscard]] const std::vector<std::string>& task_names() const noexcept { return task_names_; }
+  /// Names of the reference rows (every task row, and the rows a subset leaves free).
+  [[nodiscard]] const std::vector<std::string>& reference_names() const noexcept { return reference_names_; }
+  /// The reference row of each task row (size task_dim(); 0, 1, ..., m-1 unless `task_axes` names a subset).
+  [[nodiscard]] const std::vector<int>& task_rows() const noexcept { return task_rows_; }
+  /// Whether reference row r is a task row (false for the rows a subset leaves free).
+  [[nodiscard]] bool tracks(int r) const noexcept { return (tracked_ >> r) & 1U; }
+  /// The row of the spatial 6-vector (linear velocity; angular velocity) that task row i takes (planar phi: 5).
+  [[nodiscard]] int twist_row(int i) const { return twist_rows_[static_cast<std::size_t>(i)]; }
   /// Joint j (0-based).
   [[nodiscard]] const JointSpec& joint(int j) const { return spec_.joints.at(static_cast<std::size_t>(j)); }
   /// All joints.
@@ -153,8 +170,9 @@ class RobotModel {
 
  private:
   RobotSpec spec_;
-  int task_dim_ = 0;
-  std::vector<std::string> task_names_;
+  std::vector<std::string> task_names_, reference_names_;
+  std::vector<int> task_rows_, twist_rows_;
+  unsigned tracked_ = 0;  // bit r: reference row r is a task row
   Eigen::VectorXd lower_, upper_;
   std::vector<Eigen::Isometry3d> before_, after_;
   std::vector<Eigen::Vector3d> axes_;
@@ -167,6 +185,10 @@ class RobotModel {
 
 /// Loads a robot from a table (the root of a robot file, or a table embedded in another file).
 [[nodiscard]] RobotModel load_robot(const TableReader& table);
+
+/// Reads the key `task` of a robot or scenario table into spec.task and spec.task_axes: "position", "pose", or an
+/// array naming a subset of the pose's rows in order (e.g. ["x", "y", "z", "wz"]). spec.kind must be set.
+void read_task(const TableReader& table, RobotSpec& spec);
 
 /// Text name of an enum value ("planar", "revolute", "dh", "position", ...).
 [[nodiscard]] const char* to_string(ChainKind kind);

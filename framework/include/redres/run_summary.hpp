@@ -39,7 +39,9 @@ struct RobotFacts {
   std::string name;
   std::string kind;  //!< "planar" or "spatial"
   std::vector<std::string> joint_names;
+  std::vector<std::string> task_rows;  //!< the task's rows, e.g. {"x", "y", "z", "wx", "wy"}
   std::vector<double> lower_limits, upper_limits, link_lengths;
+  std::vector<double> base_position;  //!< the base pose's origin in the world (3)
   std::vector<LinkShapeFacts> link_shapes;  //!< the links' collision shapes, in joint order
 };
 

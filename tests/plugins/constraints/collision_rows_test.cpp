@@ -171,11 +171,34 @@ TEST_P(CollisionRows, SelfCollisionRowsAreTheRateOfTheDistance) {
 
 INSTANTIATE_TEST_SUITE_P(Robots, CollisionRows,
                          ::testing::Values("robots/paper_pushrod_6dof.toml", "robots/planar_4link.toml",
-                                           "robots/franka_panda.toml", "robots/kuka_iiwa14.toml"),
+                                           "robots/franka_panda.toml", "robots/kuka_iiwa14.toml",
+                                           "robots/kinova_gen3.toml", "robots/ur5e.toml"),
                          [](const ::testing::TestParamInfo<const char*>& p) {
                            std::string n = std::filesystem::path(p.param).stem().string();
                            return n;
                          });
+
+// Every shipped robot starts apart from itself: at its home configuration every checked pair of shapes (links not
+// adjacent and not excluded by the robot file) is apart, so self_collision can be switched on from home.
+TEST(CollisionRows, EveryShippedRobotIsApartFromItselfAtHome) {
+  int robots = 0;
+  for (const auto& e : std::filesystem::directory_iterator(source_path("robots"))) {
+    if (e.path().extension() != ".toml") continue;
+    const RobotModel robot = load_robot(e.path());
+    const auto& shapes = robot.link_shapes();
+    if (shapes.empty()) continue;
+    ++robots;
+    const Independent ind(robot, {});
+    for (std::size_t a = 0; a < shapes.size(); ++a) {
+      for (std::size_t b = a + 1; b < shapes.size(); ++b) {
+        if (!robot.self_collision_pair(shapes[a].link, shapes[b].link)) continue;
+        EXPECT_GT(ind.link_link(robot.home(), static_cast<int>(a), static_cast<int>(b)), 0.0)
+            << e.path().filename() << ": links " << shapes[a].link + 1 << " and " << shapes[b].link + 1;
+      }
+    }
+  }
+  EXPECT_GE(robots, 6);
+}
 
 TEST(CollisionRows, PairsBeyondTheInfluenceDistanceGetSlackRowsAndTheDamperBoundsTheRest) {
   const RobotModel robot = load_robot(source_path("robots/paper_pushrod_6dof.toml"));

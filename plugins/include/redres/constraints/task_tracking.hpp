@@ -3,9 +3,11 @@
 /// `task_tracking`: the end-effector task with position-error feedback (eq. 6), m equality rows
 ///   J x = r_d_dot + K (r_d - f(theta)),
 /// where m is the robot's number of task rows and K = diag(gain). For spatial `pose` tasks the orientation rows use
-/// the rotation-vector error log(R_d R') (r_d's orientation entries are a rotation vector).
-/// Reports to the run summary, for tasks with orientation rows: `max_orientation_error` (rad), the largest angle
-/// between the desired and the actual orientation over the run.
+/// the rotation-vector error log(R_d R') (r_d's orientation entries are a rotation vector). A task that names a subset
+/// of rows (`task = ["x", "y", "z", "wz"]`) keeps those rows of the error and of J: S J x = S (r_d_dot + K e).
+/// Reports to the run summary, for tasks with orientation rows: `max_orientation_error` (rad), the largest
+/// orientation error over the run (the angle between the desired and the actual orientation; for a subset, the norm
+/// of the rotation-vector error's task rows).
 
 #include "redres/plugin.hpp"
 

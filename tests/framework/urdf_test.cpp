@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <random>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -38,7 +40,7 @@ TEST_P(UrdfRobots, TheUrdfRobotIsItsDhTwin) {
   ASSERT_EQ(urdf.link_shapes().size(), dh.link_shapes().size());
   KinematicsData a(dh), b(urdf);
   std::mt19937 rng(21);
-  double worst_f = 0.0, worst_j = 0.0, worst_w = 0.0, worst_shape = 0.0;
+  double worst_f = 0.0, worst_j = 0.0, worst_w = 0.0, worst_w_abs = 0.0, worst_shape = 0.0;
   for (int k = 0; k < 1000; ++k) {
     const Eigen::VectorXd theta = random_inside(dh, rng);
     compute_kinematics(dh, theta, a, KinematicsLevel::kManipulability);
@@ -47,6 +49,7 @@ TEST_P(UrdfRobots, TheUrdfRobotIsItsDhTwin) {
     worst_j = std::max(worst_j, (a.J.topRows(3) - b.J.topRows(3)).cwiseAbs().maxCoeff());
     if (dh.task() == urdf.task() && dh.task() == TaskRows::kPosition) {
       worst_w = std::max(worst_w, std::abs(a.w - b.w) / (1e-12 + a.w));
+      worst_w_abs = std::max(worst_w_abs, std::abs(a.w - b.w));
     }
     for (std::size_t s = 0; s < dh.link_shapes().size(); ++s) {
       ASSERT_EQ(urdf.link_shapes()[s].link, dh.link_shapes()[s].link);
@@ -56,11 +59,19 @@ TEST_P(UrdfRobots, TheUrdfRobotIsItsDhTwin) {
       worst_shape = std::max({worst_shape, (p0 - q0).norm(), (p1 - q1).norm()});
     }
   }
-  RecordProperty("max_f_difference", std::to_string(worst_f));
-  RecordProperty("max_J_difference", std::to_string(worst_j));
-  RecordProperty("max_capsule_end_difference", std::to_string(worst_shape));
+  const auto sci = [](double v) {
+    std::ostringstream out;
+    out << std::scientific << std::setprecision(2) << v;
+    return out.str();
+  };
+  RecordProperty("max_f_difference", sci(worst_f));
+  RecordProperty("max_J_difference", sci(worst_j));
+  RecordProperty("max_w_difference", sci(worst_w_abs));
+  RecordProperty("max_w_relative_difference", sci(worst_w));
+  RecordProperty("max_capsule_end_difference", sci(worst_shape));
   EXPECT_LE(worst_f, 1e-12);
   EXPECT_LE(worst_j, 1e-12);
+  EXPECT_LE(worst_w_abs, 1e-12);
   EXPECT_LE(worst_w, 1e-10);
   EXPECT_LE(worst_shape, 1e-12);
   for (int i = 0; i < dh.dof(); ++i) {

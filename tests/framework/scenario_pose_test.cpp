@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "redres/run_summary.hpp"
+#include "run_checks.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -24,10 +25,7 @@ TEST(PoseTask, IiwaHoldsItsOrientationWhileItDrawsACircle) {
   ASSERT_EQ(s.robot->task_dim(), 6);
   const RunResult run = simulate(s);
   const RunSummary sum = summarise(s, run);
-  EXPECT_EQ(sum.solver.failures, 0) << sum.solver.first_failure;
-  EXPECT_LT(sum.max_position_error, 1e-4);
-  EXPECT_LE(sum.max_joint_angle_violation, 0.0);
-  EXPECT_LE(sum.max_joint_velocity_violation, 0.0);
+  expect_clean_run(sum, 1e-4);
 
   const Trajectory& tr = run.trajectory;
   KinematicsData k(*s.robot);
@@ -40,7 +38,7 @@ TEST(PoseTask, IiwaHoldsItsOrientationWhileItDrawsACircle) {
     for (int i = 0; i < 3; ++i) rd(i) = tr(row, tr.column(std::string("rd_") + "w" + "xyz"[i]));
     EXPECT_LT((rotation(rd) - R0).norm(), 1e-12) << "the reference is the orientation at t = 0";
     // The actual orientation, from the recorded joint angles (independent of the recorded r_ columns).
-    for (int j = 0; j < s.robot->dof(); ++j) theta(j) = tr(row, tr.column("theta_" + std::to_string(j + 1)));
+    theta = recorded_theta(*s.robot, tr, row);
     compute_kinematics(*s.robot, theta, k, KinematicsLevel::kPosition);
     worst = std::max(worst, Eigen::AngleAxisd(R0 * k.ee_pose.linear().transpose()).angle());
     moved = std::max(moved, (theta - s.theta0).cwiseAbs().maxCoeff());

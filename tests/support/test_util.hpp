@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "redres/robot.hpp"
+#include "redres/trajectory.hpp"
 
 namespace redres {
 
@@ -36,6 +37,13 @@ inline Eigen::VectorXd random_inside(const RobotModel& robot, std::mt19937& rng,
   for (int j = 0; j < robot.dof(); ++j) {
     theta(j) = robot.lower_limits()(j) + u(rng) * (robot.upper_limits()(j) - robot.lower_limits()(j));
   }
+  return theta;
+}
+
+/// theta at one row of a recorded run (its `theta_1` .. `theta_n` columns).
+inline Eigen::VectorXd recorded_theta(const RobotModel& robot, const Trajectory& run, std::size_t row) {
+  Eigen::VectorXd theta(robot.dof());
+  for (int j = 0; j < robot.dof(); ++j) theta(j) = run(row, run.column("theta_" + std::to_string(j + 1)));
   return theta;
 }
 

@@ -28,7 +28,7 @@ double min_distance(const Scenario& s, const Trajectory& tr, const std::vector<S
   double low = 1e9;
   const int L = static_cast<int>(robot.link_shapes().size());
   for (std::size_t r = 0; r < tr.size(); ++r) {
-    for (int j = 0; j < robot.dof(); ++j) theta(j) = tr(r, tr.column("theta_" + std::to_string(j + 1)));
+    theta = recorded_theta(robot, tr, r);
     compute_kinematics(robot, theta, k, KinematicsLevel::kPosition);
     const double t = tr(r, tr.column("t"));
     for (int l = 0; l < L; ++l) {
@@ -63,7 +63,7 @@ double min_self_distance(const Scenario& s, const Trajectory& tr) {
   double low = 1e9;
   const auto& ls = robot.link_shapes();
   for (std::size_t r = 0; r < tr.size(); ++r) {
-    for (int j = 0; j < robot.dof(); ++j) theta(j) = tr(r, tr.column("theta_" + std::to_string(j + 1)));
+    theta = recorded_theta(robot, tr, r);
     compute_kinematics(robot, theta, k, KinematicsLevel::kPosition);
     for (std::size_t a = 0; a < ls.size(); ++a) {
       for (std::size_t b = a + 1; b < ls.size(); ++b) {

@@ -125,6 +125,19 @@ class Registry : public RegistryBase {
         std::move(example));
   }
 
+  /// Registers an entry made at run time rather than from a C++ Config type (e.g. a plugin class defined in Python):
+  /// the caller fills in type, summary, keys, config_type, defaults, read, write and make; `origin` names where it
+  /// came from. A name that exists already is a std::invalid_argument naming both origins.
+  void add_entry(Entry e, std::string origin) {
+    if (const auto it = entries_.find(e.type); it != entries_.end()) {
+      throw std::invalid_argument("duplicate " + kind() + " type '" + e.type + "': already registered by " +
+                                  it->second.origin);
+    }
+    e.origin = std::move(origin);
+    const std::string name = e.type;
+    entries_.emplace(name, std::move(e));
+  }
+
   /// The entry for `type`, or nullptr.
   [[nodiscard]] const Entry* find(const std::string& type) const {
     auto it = entries_.find(type);

@@ -1,0 +1,391 @@
+"""redres: redundancy resolution of redundant robot manipulators, from Python.
+
+The library is C++; this module exposes it (not the command line):
+
+    import redres
+    robot = redres.Robot.load("robots/paper_pushrod_6dof.toml")
+    k = robot.kinematics(robot.home)            # k.f, k.J, k.w, k.grad_w as numpy arrays
+    s = redres.Scenario.load("configs/paper_r_tvcmm.toml", overrides={"objectives.1.p": 1.0})
+    result = s.run()                            # result["manipulability"], result.summary, result.final_theta
+    cmp = redres.compare(["configs/paper_r_tvcmm.toml", "configs/paper_r_mvn.toml"])
+
+Per-step use in your own loop: redres.Controller (help(redres.Controller)). Plugins are built from their typed
+configurations, e.g. redres.objectives.Manipulability(p=2.0, schedule="sine"); redres.plugins() lists every
+registered plugin with its keys. Objectives and constraints can be written in Python by subclassing
+redres.Objective or redres.Constraint (help(redres.Objective)); register() makes them available to scenario files.
+
+Errors: a bad file or configuration raises redres.ConfigError (a ValueError) whose message starts with
+file:line:col; a wrong size or a NaN raises ValueError naming the condition. A failed control step is not an
+exception: it is a status (StepInfo.status, Result.failures and Result.first_failure).
+"""
+
+import atexit as _atexit
+import inspect as _inspect
+import json as _json
+import keyword as _keyword
+import math as _math
+import os as _os
+import sys as _sys
+import tomllib as _tomllib
+import types as _types
+from concurrent.futures import ThreadPoolExecutor as _ThreadPoolExecutor
+
+from . import _redres
+from ._redres import (  # noqa: F401  (re-exported)
+    ConfigError,
+    Kinematics,
+    Result,
+    Robot,
+    Scenario,
+    StepContext,
+    StepInfo,
+    StepQp,
+    check_plugins,
+)
+
+__version__ = "0.1.0"
+__all__ = [
+    "ConfigError", "Constraint", "Controller", "Kinematics", "Objective", "Result", "Robot", "Scenario", "StepContext",
+    "StepInfo", "StepQp", "Comparison", "check_plugins", "compare", "constraints", "engines", "objectives", "paths",
+    "plugins", "register",
+]
+
+
+# --- TOML text of Python values (for overrides) -------------------------------------------------------------------
+
+def _toml(value):
+    """A Python value as TOML text, as `--set key=value` takes it."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if _math.isnan(value):
+            return "nan"
+        if _math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return _json.dumps(value)
+    if isinstance(value, _os.PathLike):
+        return _json.dumps(_os.fspath(value))
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + "}"
+    if hasattr(value, "tolist"):
+        return _toml(value.tolist())
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    raise TypeError(f"cannot write a value of type {type(value).__name__} as TOML")
+
+
+def _load_scenario(path, overrides=None):
+    """Loads a scenario TOML file. `overrides` maps keys to values as `redres run --set` does, e.g.
+    {"objectives.1.p": 1.0, "solver.engine": "newton", "task": ["x", "y", "z", "wz"]} (array entries by 0-based
+    index). A bad file or override raises redres.ConfigError with file:line:col."""
+    items = None
+    if overrides:
+        items = [(str(k), _toml(v)) for k, v in dict(overrides).items()]
+    return Scenario._load(_os.fspath(path), items)
+
+
+Scenario.load = staticmethod(_load_scenario)
+Scenario.__doc__ = """A loaded scenario: a robot, theta(0), T and tau, a path, objectives, constraints and an engine.
+
+redres.Scenario.load(path, overrides={...}) reads a scenario TOML file; scenario.run() runs it and returns a
+redres.Result (the GIL is released while it runs); scenario.controller() gives a redres.Controller for its scheme."""
+
+
+# --- typed plugin configurations -----------------------------------------------------------------------------------
+
+def _camel(type_name):
+    return "".join(part[:1].upper() + part[1:] for part in type_name.split("_"))
+
+
+def _default_value(key):
+    if key["presence"] != "optional" or key["default"] == "":
+        return _inspect.Parameter.empty
+    if key["default"] == "(none)":
+        return None
+    try:
+        return _tomllib.loads("v = " + key["default"])["v"]
+    except _tomllib.TOMLDecodeError:
+        return key["default"]
+
+
+class PluginConfig:
+    """A plugin's typed configuration: its type and keys, checked when it is made (types and rules; checks that need
+    the robot, such as one value per joint, run when a Controller is built). Passed to redres.Controller."""
+
+    kind = None
+    type = None
+
+    def __init__(self, **keys):
+        self._keys = dict(keys)
+        _redres._check_config(self.kind, self._spec_table, self._spec_where)
+
+    @property
+    def _spec_table(self):
+        table = {"engine" if self.kind == "engine" else "type": self.type}
+        table.update(self._keys)
+        return table
+
+    @property
+    def _spec_where(self):
+        return f"redres.{self.kind}s.{type(self).__name__}"
+
+    @property
+    def config(self):
+        """The keys given (the rest take their defaults)."""
+        return dict(self._keys)
+
+    def __repr__(self):
+        args = ", ".join(f"{k}={v!r}" for k, v in self._keys.items())
+        return f"redres.{self.kind}s.{type(self).__name__}({args})"
+
+
+def _describe(entry):
+    lines = [entry["summary"], "", "Keys:"]
+    for key in entry["keys"] + entry["common_keys"]:
+        presence = key["presence"] if key["presence"] != "optional" else f"default {key['default']}"
+        unit = f" [{key['unit']}]" if key["unit"] else ""
+        rule = f", {key['rule']}" if key["rule"] else ""
+        lines.append(f"  {key['name']} ({key['type']}{unit}, {presence}{rule}): {key['help']}")
+    for group, what in entry["groups"]:
+        lines.append(f"  group '{group}': {what}")
+    return "\n".join(lines)
+
+
+def _config_class(entry):
+    params = []
+    seen = set()
+    others = False  # keys that are not Python names (e.g. `lambda`): given as **{"lambda": ...}
+    for key in entry["keys"] + entry["common_keys"]:
+        if key["name"] in seen:
+            continue
+        seen.add(key["name"])
+        if _keyword.iskeyword(key["name"]) or not key["name"].isidentifier():
+            others = True
+            continue
+        params.append(_inspect.Parameter(key["name"], _inspect.Parameter.KEYWORD_ONLY, default=_default_value(key)))
+    if others:
+        params.append(_inspect.Parameter("keys", _inspect.Parameter.VAR_KEYWORD))
+    cls = type(_camel(entry["type"]), (PluginConfig,), {
+        "kind": entry["kind"], "type": entry["type"], "__doc__": _describe(entry),
+        "__module__": f"redres.{entry['kind']}s",
+    })
+    cls.__signature__ = _inspect.Signature(params)
+    return cls
+
+
+def _namespace(kind, title):
+    module = _types.ModuleType(f"redres.{kind}s", f"{title}: typed configurations of the registered {kind}s.")
+    _sys.modules[module.__name__] = module
+    return module
+
+
+objectives = _namespace("objective", "Objectives")
+constraints = _namespace("constraint", "Constraints")
+paths = _namespace("path", "Paths")
+engines = _namespace("engine", "LVI engines")
+_namespaces = {"objective": objectives, "constraint": constraints, "path": paths, "engine": engines}
+
+
+def _refresh_namespaces():
+    for entry in _redres._registry():
+        module = _namespaces.get(entry["kind"])
+        if module is None or entry["origin"].startswith("python:"):
+            continue
+        name = _camel(entry["type"])
+        if not hasattr(module, name):
+            setattr(module, name, _config_class(entry))
+
+
+def plugins(kind=None):
+    """Every registered plugin (objective, constraint, path, engine, velocity_limit) as a dict: kind, type, summary,
+    origin, keys (name, default, unit, help, rule, type, presence, group), common_keys and groups. `kind` filters."""
+    return [e for e in _redres._registry() if kind is None or e["kind"] == kind]
+
+
+# --- plugins written in Python -------------------------------------------------------------------------------------
+
+class _PythonPlugin:
+    type = None          # the name under which register() files the class (default: the class name)
+    keys = {}            # key -> default value; its type fixes how a scenario file's value is read
+    help = {}            # key -> one line of help
+    summary = ""         # one line, for redres.plugins() and `redres plugins`
+    kinematics = "all"   # what contribute() reads: 'position', 'jacobian', 'manipulability' or 'all'
+    name = None          # instance name in diagnoses (default: the type)
+    active = True
+
+    def __init__(self, **config):
+        for key, default in self.keys.items():
+            setattr(self, key, config.pop(key, default))
+        for key in ("name", "weight", "active"):
+            if key in config:
+                setattr(self, key, config.pop(key))
+        if config:
+            raise TypeError(f"{type(self).__name__}: unknown keys {sorted(config)}; its keys are {sorted(self.keys)}")
+
+    def contribute(self, ctx, qp):
+        raise NotImplementedError(f"{type(self).__name__}.contribute(ctx, qp)")
+
+
+class Objective(_PythonPlugin):
+    """Base of an objective written in Python: subclass it and define contribute(self, ctx, qp).
+
+    contribute is called from the C++ step with the step's redres.StepContext (ctx.t, ctx.theta, ctx.J, ctx.w,
+    ctx.grad_w, ctx.r_d, ... as read-only numpy views, valid during the call) and the objective's share of the QP,
+    a redres.StepQp: qp.add_identity(scale), qp.add_diagonal(v), qp.add_hessian(H), qp.add_linear(z); the
+    objective's weight scales what it adds. Optionally define potential(self, ctx) -> float, a P(theta) whose
+    gradient is the linear term per unit weight: the conformance checks (redres.check_plugins) then compare the two
+    by central differences.
+
+    Class attributes: keys (key -> default), help, summary, kinematics, type; instance attributes name, weight
+    and active. Use an instance in redres.Controller(objectives=[...]), or redres.register(MyObjective) to name it
+    in scenario files ([[objectives]] type = "...", its keys read as the defaults' types).
+
+    Cost: each step calls into Python once per Python plugin (the GIL is taken, the views are made); measured
+    against the same objective in C++ in docs/python.md."""
+
+    weight = 1.0
+
+
+class Constraint(_PythonPlugin):
+    """Base of a constraint written in Python: subclass it and define contribute(self, ctx, qp).
+
+    Its rows are fixed at setup: equality_rows and inequality_rows (ints, or methods of the robot). contribute
+    writes them with qp.set_equality(J, d) (J x = d) and qp.set_inequality(A, b) (A x <= b), and may narrow the
+    bounds with qp.intersect_bounds(lower, upper) or qp.intersect_bound(joint, lower, upper). Optionally:
+    describe_inequality_row(i) for diagnoses, violated() and describe_violation() to fail a step. Constraints
+    are hard and have no weight. See redres.Objective for ctx, keys, register() and the cost."""
+
+    equality_rows = 0
+    inequality_rows = 0
+
+
+def register(cls, type=None, replace=False):
+    """Makes a redres.Objective or redres.Constraint subclass available to scenario files and the registries under
+    `type` (default: cls.type or the class name). Its keys are read from the TOML table with the types of its
+    defaults; instances are made as cls(**keys). replace=True first drops a class registered before from the same
+    module and name (e.g. when a notebook cell runs again). Returns the origin, 'python:<module>.<qualname>', for
+    check_plugins(origin)."""
+    if issubclass(cls, Constraint):
+        kind = "constraint"
+    elif issubclass(cls, Objective):
+        kind = "objective"
+    else:
+        raise TypeError("register: expected a subclass of redres.Objective or redres.Constraint")
+    name = type or cls.type or cls.__name__
+    if replace:
+        _redres._unregister(f"python:{cls.__module__}.{cls.__qualname__}")
+    return _redres._register_class(kind, name, cls, dict(cls.keys), dict(cls.help), cls.summary or cls.__doc__ or "")
+
+
+_atexit.register(_redres._unregister_all)
+
+
+# --- controllers ---------------------------------------------------------------------------------------------------
+
+class Controller(_redres.Controller):
+    """The per-step API for your own control loop (e.g. one that drives a physics simulator).
+
+        ctrl = redres.Controller(robot,
+                                 objectives=[redres.objectives.MinVelocityNorm(),
+                                             redres.objectives.Manipulability(p=2.0, schedule="sine")],
+                                 constraints=[redres.constraints.TaskTracking(gain=8.0),
+                                              redres.constraints.JointVelocityLimits()],
+                                 engine="newton",                  # or redres.engines.Newton(tolerance=1e-8)
+                                 path=redres.paths.Circle(radius=0.05),   # optional
+                                 T=10.0, tau=0.01, theta0=theta)
+        theta_dot, info = ctrl.step(theta, t)                 # r_d, r_d_dot from the path
+        theta_dot, info = ctrl.step(theta, t, r_d, r_d_dot)   # or your own (reference_dim entries)
+
+    Objectives and constraints are typed configurations (redres.objectives.*, redres.constraints.*) or instances of
+    Python subclasses of redres.Objective / redres.Constraint. The path is placed at the end effector's position at
+    theta0 (default: the robot's home). info is a redres.StepInfo: a step that does not solve has info.ok False and
+    a diagnosis; it does not raise. Controller.from_scenario(s) steps a loaded scenario's scheme. ctrl.qp is the last
+    step's QP; ctrl.f, ctrl.r_d and ctrl.w its task values. The GIL is released during a step (taken again only for
+    Python plugins)."""
+
+    def __init__(self, robot, objectives=(), constraints=(), engine="newton", path=None, T=1.0, tau=0.01,
+                 theta0=None):
+        super().__init__(robot, list(objectives), list(constraints), engine, path, T, tau, theta0)
+
+    @staticmethod
+    def from_scenario(scenario):
+        """A controller for a loaded redres.Scenario (same as scenario.controller())."""
+        return scenario.controller()
+
+
+# --- comparisons ---------------------------------------------------------------------------------------------------
+
+class Comparison:
+    """Several runs side by side: results (redres.Result, in the given order), table() (one dict per run with the
+    columns of `redres compare`'s comparison.csv) and markdown()."""
+
+    columns = ("scenario", "engine", "max_position_error", "w_initial", "w_final", "w_min", "w_mean",
+               "initial_joint_velocity_norm", "final_joint_velocity_norm", "mean_iterations", "failures",
+               "wall_time_s")
+
+    def __init__(self, results):
+        self.results = list(results)
+
+    def __getitem__(self, name):
+        for r in self.results:
+            if r.name == name:
+                return r
+        raise KeyError(name)
+
+    def table(self):
+        rows = []
+        for r in self.results:
+            s = r.summary
+            w = s["manipulability"]
+            rows.append({
+                "scenario": s["name"], "engine": s["solver"]["engine"],
+                "max_position_error": s["max_position_error"], "w_initial": w["initial"], "w_final": w["final"],
+                "w_min": w["min"], "w_mean": w["mean"],
+                "initial_joint_velocity_norm": s["initial_joint_velocity_norm"],
+                "final_joint_velocity_norm": s["final_joint_velocity_norm"],
+                "mean_iterations": s["solver"]["mean_iterations"], "failures": s["solver"]["failures"],
+                "wall_time_s": s["wall_time_s"],
+            })
+        return rows
+
+    def markdown(self):
+        lines = ["| " + " | ".join(self.columns) + " |", "|" + "---|" * len(self.columns)]
+        for row in self.table():
+            cells = [f"{v:.4g}" if isinstance(v, float) else str(v) for v in row.values()]
+            lines.append("| " + " | ".join(cells) + " |")
+        return "\n".join(lines) + "\n"
+
+    def __repr__(self):
+        return f"<redres.Comparison of {len(self.results)} runs>"
+
+
+def compare(scenarios, overrides=None, jobs=None):
+    """Runs several scenarios (paths or loaded redres.Scenario objects; `overrides` apply to those given as paths)
+    on `jobs` threads (default: one per core, at most one per scenario) and returns a redres.Comparison. Every file
+    is loaded before any run starts, so a bad one raises before anything runs."""
+    loaded = [s if isinstance(s, Scenario) else Scenario.load(s, overrides) for s in scenarios]
+    if jobs is None:
+        jobs = max(1, min(len(loaded), _os.cpu_count() or 1))
+    with _ThreadPoolExecutor(max_workers=jobs) as pool:
+        results = list(pool.map(lambda s: s.run(), loaded))
+    return Comparison(results)
+
+
+def _result_summary(self):
+    """summary.json of the run, as a dict (docs/output_formats.md)."""
+    return _json.loads(self.summary_json)
+
+
+def _result_trajectory(self):
+    """Every column as a dict of numpy arrays (views of the run's row-major table, no copy)."""
+    return {name: self[name] for name in self.columns}
+
+
+Result.summary = property(_result_summary)
+Result.trajectory = property(_result_trajectory)
+
+_refresh_namespaces()

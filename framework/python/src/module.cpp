@@ -1,0 +1,465 @@
+// redres._redres: the C++ side of the Python module. The pure-Python package (redres/__init__.py) builds on it:
+// typed plugin configurations, compare(), and the base classes of Python-defined plugins.
+
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "python_plugins.hpp"
+#include "redres/kinematics.hpp"
+#include "redres/lvi.hpp"
+#include "redres/path.hpp"
+#include "redres/run_output.hpp"
+#include "redres/run_summary.hpp"
+#include "redres/scenario.hpp"
+#include "redres/simulation.hpp"
+#include "redres/velocity_limit.hpp"
+#include "types.hpp"
+
+namespace redres::python {
+namespace {
+
+// --- robots -----------------------------------------------------------------------------------------------------
+
+// The kinematics at one configuration, copied out of KinematicsData.
+struct KinematicsResult {
+  Eigen::VectorXd theta, f, grad_w, grad_mu;
+  Eigen::MatrixXd J;
+  double w = 0.0, mu = 0.0;
+  Eigen::Matrix4d ee_pose = Eigen::Matrix4d::Identity();
+  std::vector<Eigen::Matrix4d> link_frames;
+};
+
+Eigen::VectorXd checked_theta(const RobotModel& robot, const Eigen::VectorXd& theta, const char* who) {
+  if (theta.size() != robot.dof()) {
+    throw std::invalid_argument(std::string(who) + ": theta has " + std::to_string(theta.size()) +
+                                " entries, expected dof = " + std::to_string(robot.dof()));
+  }
+  return theta;
+}
+
+KinematicsResult kinematics_of(const RobotModel& robot, const Eigen::VectorXd& theta) {
+  KinematicsData k(robot);
+  compute_kinematics(robot, checked_theta(robot, theta, "Robot.kinematics"), k, KinematicsLevel::kAll);
+  KinematicsResult out;
+  out.theta = k.theta;
+  out.f = k.f;
+  out.J = k.J;
+  out.w = k.w;
+  out.grad_w = k.grad_w;
+  out.mu = k.mu;
+  out.grad_mu = k.grad_mu;
+  out.ee_pose = k.ee_pose.matrix();
+  for (const auto& frame : k.link_frames) out.link_frames.push_back(frame.matrix());
+  return out;
+}
+
+// --- scenarios and runs ------------------------------------------------------------------------------------------
+
+// redres.Scenario: a loaded scenario; one run at a time (a lock), any number of Python threads.
+struct PyScenario {
+  std::shared_ptr<Scenario> scenario;
+  std::shared_ptr<std::mutex> lock = std::make_shared<std::mutex>();
+};
+
+// redres.Result: a finished run, its summary, and the scenario it came from (for write()).
+struct PyResult {
+  std::shared_ptr<const RunResult> run;
+  std::shared_ptr<const RunSummary> summary;
+  std::shared_ptr<Scenario> scenario;
+};
+
+// One column of the row-major trajectory as a strided numpy view (no copy), kept alive by `owner`.
+py::array column_view(const Trajectory& tr, std::size_t col, py::handle owner) {
+  const double* base = tr.values().empty() ? nullptr : tr.values().data() + col;
+  py::array a(py::dtype::of<double>(), {static_cast<py::ssize_t>(tr.size())},
+              {static_cast<py::ssize_t>(sizeof(double) * tr.width())}, base, owner);
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return a;
+}
+
+PyResult run_scenario(PyScenario& s, const py::object& progress) {
+  // Calls the progress function (if any) and lets Ctrl-C stop a long run: both need the GIL, taken about 200
+  // times per run.
+  const ProgressCallback callback = [&progress](double fraction, double t) {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (!progress.is_none()) progress(fraction, t);
+  };
+  PyResult out;
+  {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> guard(*s.lock);
+    auto run = std::make_shared<RunResult>(simulate(*s.scenario, callback));
+    out.summary = std::make_shared<RunSummary>(summarise(*s.scenario, *run));
+    out.run = std::move(run);
+  }
+  out.scenario = s.scenario;
+  return out;
+}
+
+// "key=value" overrides from a dict whose values were already rendered as TOML text (by the Python package).
+std::vector<std::string> override_strings(const std::optional<std::vector<std::pair<std::string, std::string>>>& o) {
+  std::vector<std::string> out;
+  if (o) {
+    for (const auto& [k, v] : *o) out.push_back(k + "=" + v);
+  }
+  return out;
+}
+
+// --- controllers -------------------------------------------------------------------------------------------------
+
+// One step's SolverInfo, with the engine's name owned.
+struct StepInfo {
+  std::string status, engine, diagnosis;
+  int iterations = 0;
+  double residual = 0.0;
+  [[nodiscard]] bool ok() const { return status == "solved"; }
+};
+
+StepInfo info_of(const SolverInfo& i) {
+  return StepInfo{to_string(i.status), std::string(i.engine), i.diagnosis, i.iterations, i.residual};
+}
+
+// redres.Controller: the per-step API for a caller's own loop, owning (or sharing) what the C++ Controller needs.
+struct PyController {
+  std::shared_ptr<const RobotModel> robot;
+  std::shared_ptr<Scenario> scenario;  // when built from a scenario (it owns the scheme, engine and path)
+  std::unique_ptr<Scheme> scheme;
+  std::unique_ptr<LviEngine> engine;
+  std::unique_ptr<Path> path;
+  std::unique_ptr<Controller> controller;
+  StepOutput out;
+};
+
+bool is_spec(py::handle item) { return py::hasattr(item, "_spec_table"); }
+
+toml::table spec_table(py::handle item, std::string& where) {
+  where = py::str(item.attr("_spec_where")).cast<std::string>();
+  return to_table(item.attr("_spec_table").cast<py::dict>(), where);
+}
+
+std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::list& objectives,
+                                              const py::list& constraints, py::object engine, py::object path,
+                                              double T, double tau, std::optional<Eigen::VectorXd> theta0) {
+  auto c = std::make_unique<PyController>();
+  c->robot = robot.model;
+  const RobotModel& model = *c->robot;
+  std::vector<std::unique_ptr<Objective>> objs;
+  std::vector<std::unique_ptr<Constraint>> cons;
+  for (py::handle item : objectives) {
+    std::string where;
+    objs.push_back(is_spec(item) ? make_objective_from(spec_table(item, where), where, model)
+                                 : wrap_objective(py::reinterpret_borrow<py::object>(item), model));
+  }
+  for (py::handle item : constraints) {
+    std::string where;
+    cons.push_back(is_spec(item) ? make_constraint_from(spec_table(item, where), where, model)
+                                 : wrap_constraint(py::reinterpret_borrow<py::object>(item), model));
+  }
+  c->scheme = std::make_unique<Scheme>(model, std::move(objs), std::move(cons));
+  if (py::isinstance<py::str>(engine)) {
+    c->engine = make_engine(engine.cast<std::string>());
+  } else {
+    std::string where;
+    const toml::table t = spec_table(engine, where);
+    auto file = std::make_shared<TomlFile>();
+    file->path = where;
+    file->root = t;
+    c->engine = make_engine(TableReader::root(file));
+  }
+  if (!path.is_none()) {
+    const Eigen::VectorXd start_theta = theta0 ? checked_theta(model, *theta0, "Controller") : model.home();
+    KinematicsData k(model);
+    compute_kinematics(model, start_theta, k, KinematicsLevel::kPosition);
+    PathContext pc;
+    pc.dim = model.kind() == ChainKind::kPlanar ? 2 : 3;
+    pc.start.head(pc.dim) = k.f.head(pc.dim);
+    pc.duration = T;
+    std::string where;
+    const toml::table t = spec_table(path, where);
+    auto file = std::make_shared<TomlFile>();
+    file->path = where;
+    file->root = t;
+    c->path = make_path(TableReader::root(file), pc);
+  }
+  c->controller = std::make_unique<Controller>(model, *c->scheme, *c->engine, c->path.get(), T, tau);
+  c->out = c->controller->make_output();
+  return c;
+}
+
+std::unique_ptr<PyController> controller_of(const PyScenario& s) {
+  auto c = std::make_unique<PyController>();
+  c->scenario = s.scenario;
+  Scenario& sc = *s.scenario;
+  c->robot = std::shared_ptr<const RobotModel>(s.scenario, sc.robot.get());
+  c->controller = std::make_unique<Controller>(*sc.robot, *sc.scheme, *sc.engine, sc.path.get(), sc.duration, sc.tau);
+  c->controller->set_orientation_turn(sc.orientation_turn);
+  c->controller->set_kinematics_level(KinematicsLevel::kManipulability);
+  c->out = c->controller->make_output();
+  return c;
+}
+
+py::tuple step_result(const PyController& c) { return py::make_tuple(Eigen::VectorXd(c.out.theta_dot), info_of(c.out.info)); }
+
+// --- the registries' listing ---------------------------------------------------------------------------------------
+
+py::dict key_dict(const KeyInfo& k) {
+  py::dict d;
+  d["name"] = k.name;
+  d["default"] = k.default_text;
+  d["unit"] = k.unit;
+  d["help"] = k.help;
+  d["rule"] = k.rule;
+  d["type"] = k.type;
+  d["presence"] = k.presence == Presence::kOptional ? "optional" : k.presence == Presence::kRequired ? "required" : "group";
+  d["group"] = k.group;
+  return d;
+}
+
+template <class Reg>
+void list_registry(const Reg& registry, const std::string& kind, const std::vector<KeyInfo>& common, py::list& out) {
+  for (const auto* e : registry.entries()) {
+    py::dict d;
+    d["kind"] = kind;
+    d["type"] = e->type;
+    d["summary"] = e->summary;
+    d["origin"] = e->origin;
+    py::list keys, common_keys;
+    for (const auto& k : e->keys) keys.append(key_dict(k));
+    for (const auto& k : common) common_keys.append(key_dict(k));
+    d["keys"] = keys;
+    d["common_keys"] = common_keys;
+    py::list groups;
+    for (const auto& [g, what] : e->groups) groups.append(py::make_tuple(g, what));
+    d["groups"] = groups;
+    out.append(d);
+  }
+}
+
+py::list registry_listing() {
+  py::list out;
+  list_registry(objective_registry(), "objective", objective_common_keys(), out);
+  list_registry(constraint_registry(), "constraint", constraint_common_keys(), out);
+  list_registry(path_registry(), "path", describe_keys(PathPlacement::schema()), out);
+  list_registry(engine_registry(), "engine", solver_common_keys(), out);
+  list_registry(velocity_limit_registry(), "velocity_limit", {}, out);
+  return out;
+}
+
+}  // namespace
+}  // namespace redres::python
+
+PYBIND11_MODULE(_redres, m) {
+  using namespace redres;
+  using namespace redres::python;
+  m.doc() = "redres: redundancy resolution of redundant manipulators (the C++ core; use the `redres` package)";
+
+  auto& config_error = py::register_exception<ConfigError>(m, "ConfigError", PyExc_ValueError);
+  config_error.doc() = "A bad robot or scenario file, or a bad plugin configuration: the message starts with file:line:col.";
+
+  py::class_<KinematicsResult>(m, "Kinematics", "Kinematics at one configuration (copies).")
+      .def_readonly("theta", &KinematicsResult::theta, "the configuration (n,)")
+      .def_readonly("f", &KinematicsResult::f, "task coordinates f(theta): position, then orientation for a pose")
+      .def_readonly("J", &KinematicsResult::J, "task Jacobian (m, n)")
+      .def_readonly("w", &KinematicsResult::w, "manipulability w = det(J J')")
+      .def_readonly("grad_w", &KinematicsResult::grad_w, "d w / d theta (n,)")
+      .def_readonly("mu", &KinematicsResult::mu, "Yoshikawa's sqrt(det(J J'))")
+      .def_readonly("grad_mu", &KinematicsResult::grad_mu, "d mu / d theta (n,)")
+      .def_readonly("ee_pose", &KinematicsResult::ee_pose, "end-effector pose in the world frame (4, 4)")
+      .def_readonly("link_frames", &KinematicsResult::link_frames, "each joint's frame after its motion (4, 4)")
+      .def("__repr__", [](const KinematicsResult& k) { return "<redres.Kinematics w=" + std::to_string(k.w) + ">"; });
+
+  py::class_<PyRobot>(m, "Robot", "A robot model (redres.Robot.load(path) reads a robot TOML file, DH or URDF).")
+      .def_static(
+          "load", [](const std::string& path) { return PyRobot{std::make_shared<const RobotModel>(load_robot(path))}; },
+          py::arg("path"), "Loads a robot TOML file; a bad file raises redres.ConfigError with file:line:col.")
+      .def_property_readonly("name", [](const PyRobot& r) { return r.model->name(); })
+      .def_property_readonly("kind", [](const PyRobot& r) { return std::string(to_string(r.model->kind())); },
+                             "'planar' or 'spatial'")
+      .def_property_readonly("dof", [](const PyRobot& r) { return r.model->dof(); }, "number of joints n")
+      .def_property_readonly("task_dim", [](const PyRobot& r) { return r.model->task_dim(); }, "task rows m")
+      .def_property_readonly("task_names", [](const PyRobot& r) { return r.model->task_names(); })
+      .def_property_readonly("reference_names", [](const PyRobot& r) { return r.model->reference_names(); })
+      .def_property_readonly("joint_names",
+                             [](const PyRobot& r) {
+                               std::vector<std::string> names;
+                               for (const auto& j : r.model->joints()) names.push_back(j.name);
+                               return names;
+                             })
+      .def_property_readonly("lower_limits", [](const PyRobot& r) { return Eigen::VectorXd(r.model->lower_limits()); },
+                             "theta^- (n,)")
+      .def_property_readonly("upper_limits", [](const PyRobot& r) { return Eigen::VectorXd(r.model->upper_limits()); },
+                             "theta^+ (n,)")
+      .def_property_readonly("home", [](const PyRobot& r) { return Eigen::VectorXd(r.model->home()); })
+      .def_property_readonly("source", [](const PyRobot& r) { return r.model->source(); })
+      .def(
+          "kinematics",
+          [](const PyRobot& r, const Eigen::VectorXd& theta) { return kinematics_of(*r.model, theta); },
+          py::arg("theta"), "f, J, w, grad w, mu, grad mu and the end-effector pose at theta (numpy arrays).")
+      .def(
+          "velocity_limits",
+          [](const PyRobot& r, const Eigen::VectorXd& theta) {
+            const RobotModel& model = *r.model;
+            Eigen::VectorXd lo(model.dof()), hi(model.dof());
+            model.velocity_limits(checked_theta(model, theta, "Robot.velocity_limits"), lo, hi);
+            return py::make_tuple(lo, hi);
+          },
+          py::arg("theta"), "(lower, upper): each joint's velocity-limit law at theta (e.g. the push-rod law)")
+      .def("__repr__", [](const PyRobot& r) {
+        return "<redres.Robot '" + r.model->name() + "' " + to_string(r.model->kind()) + ", " +
+               std::to_string(r.model->dof()) + " joints>";
+      });
+
+  py::class_<PyResult>(m, "Result",
+                       "A finished run: the trajectory's columns as numpy arrays (views, no copy) and its summary.\n\n"
+                       "result['theta_1'] is one column; result.columns lists them; result.summary is summary.json "
+                       "as a dict; result.failures counts failed steps (a failed step is a status, not an exception).")
+      .def_property_readonly("columns", [](const PyResult& r) { return r.run->trajectory.columns(); })
+      .def("__getitem__",
+           [](py::object self, const std::string& name) {
+             const PyResult& r = self.cast<const PyResult&>();
+             const auto& cols = r.run->trajectory.columns();
+             const auto it = std::find(cols.begin(), cols.end(), name);
+             if (it == cols.end()) throw py::key_error("no column '" + name + "' in the trajectory");
+             return column_view(r.run->trajectory, static_cast<std::size_t>(it - cols.begin()), self);
+           })
+      .def("__contains__",
+           [](const PyResult& r, const std::string& name) {
+             const auto& cols = r.run->trajectory.columns();
+             return std::find(cols.begin(), cols.end(), name) != cols.end();
+           })
+      .def_property_readonly(
+          "values",
+          [](py::object self) {
+            const Trajectory& tr = self.cast<const PyResult&>().run->trajectory;
+            py::array a(py::dtype::of<double>(),
+                        {static_cast<py::ssize_t>(tr.size()), static_cast<py::ssize_t>(tr.width())},
+                        {static_cast<py::ssize_t>(sizeof(double) * tr.width()), static_cast<py::ssize_t>(sizeof(double))},
+                        tr.values().data(), self);
+            py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+            return a;
+          },
+          "every column, (rows, columns), row-major, a view")
+      .def_property_readonly("summary_json", [](const PyResult& r) { return to_json(*r.summary); })
+      .def_property_readonly("failures", [](const PyResult& r) { return r.run->failures; })
+      .def_property_readonly("first_failure", [](const PyResult& r) { return r.run->first_failure; })
+      .def_property_readonly("status", [](const PyResult& r) { return r.run->failures == 0 ? "ok" : "failed_steps"; })
+      .def_property_readonly("engine", [](const PyResult& r) { return r.run->engine(); })
+      .def_property_readonly("name", [](const PyResult& r) { return r.summary->name; })
+      .def_property_readonly("final_theta",
+                             [](const PyResult& r) {
+                               return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
+                                   r.summary->final_theta.data(), static_cast<Eigen::Index>(r.summary->final_theta.size())));
+                             })
+      .def_property_readonly("wall_time_s", [](const PyResult& r) { return r.run->wall_time_s; })
+      .def(
+          "write",
+          [](const PyResult& r, const std::string& dir) { write_run(*r.scenario->robot, *r.run, *r.summary, dir); },
+          py::arg("out_dir"), "Writes trajectory.csv, frames.csv and summary.json, as `redres run --out` does.")
+      .def("__repr__", [](const PyResult& r) {
+        return "<redres.Result '" + r.summary->name + "' " + std::to_string(r.run->trajectory.size()) + " rows, " +
+               (r.run->failures == 0 ? std::string("ok") : std::to_string(r.run->failures) + " failed steps") + ">";
+      });
+
+  py::class_<PyScenario>(m, "Scenario")
+      .def_static(
+          "_load",
+          [](const std::string& path, const std::optional<std::vector<std::pair<std::string, std::string>>>& o) {
+            return PyScenario{std::make_shared<Scenario>(load_scenario(path, override_strings(o)))};
+          },
+          py::arg("path"), py::arg("overrides") = py::none())
+      .def_property_readonly("name", [](const PyScenario& s) { return s.scenario->name; })
+      .def_property_readonly("source", [](const PyScenario& s) { return s.scenario->source; })
+      .def_property_readonly("robot", [](const PyScenario& s) {
+        return PyRobot{std::shared_ptr<const RobotModel>(s.scenario, s.scenario->robot.get())};
+      })
+      .def_property_readonly("theta0", [](const PyScenario& s) { return Eigen::VectorXd(s.scenario->theta0); })
+      .def_property_readonly("duration", [](const PyScenario& s) { return s.scenario->duration; }, "T (s)")
+      .def_property_readonly("step", [](const PyScenario& s) { return s.scenario->tau; }, "tau (s)")
+      .def_property_readonly("steps", [](const PyScenario& s) { return s.scenario->steps(); }, "N = T / tau")
+      .def_property_readonly("engine", [](const PyScenario& s) { return std::string(s.scenario->engine->name()); })
+      .def("run", &run_scenario, py::arg("progress") = py::none(),
+           "Runs the scenario from theta0 over [0, T] and returns a redres.Result. The GIL is released while it "
+           "runs (Python threads can run other scenarios meanwhile); progress(fraction, t), if given, is called "
+           "about 200 times. Failed steps are counted in the result, not raised.")
+      .def("controller", &controller_of,
+           "A redres.Controller for this scenario's robot, scheme, engine and path (sharing them: do not run the "
+           "scenario while stepping the controller).")
+      .def("__repr__", [](const PyScenario& s) {
+        return "<redres.Scenario '" + s.scenario->name + "' " + std::to_string(s.scenario->steps()) + " steps>";
+      });
+
+  py::class_<StepInfo>(m, "StepInfo", "One step's solver outcome.")
+      .def_readonly("status", &StepInfo::status, "'solved', 'max_iterations', 'infeasible' or 'numerical_error'")
+      .def_property_readonly("ok", &StepInfo::ok, "status == 'solved'")
+      .def_readonly("iterations", &StepInfo::iterations)
+      .def_readonly("residual", &StepInfo::residual, "||e(u)||_2 of the LVI at the answer")
+      .def_readonly("engine", &StepInfo::engine, "the engine that ran (a fallback names itself)")
+      .def_readonly("diagnosis", &StepInfo::diagnosis, "empty when solved; else which joint, bound, row and plugin")
+      .def("__repr__", [](const StepInfo& i) {
+        return "<redres.StepInfo " + i.status + ", " + std::to_string(i.iterations) + " iterations>";
+      });
+
+  py::class_<PyController>(m, "Controller")
+      .def(py::init(&make_controller), py::arg("robot"), py::arg("objectives"), py::arg("constraints"),
+           py::arg("engine") = "newton", py::arg("path") = py::none(), py::arg("T") = 1.0, py::arg("tau") = 0.01,
+           py::arg("theta0") = py::none())
+      .def(
+          "step",
+          [](PyController& c, const Eigen::VectorXd& theta, double t) {
+            {
+              py::gil_scoped_release release;
+              c.controller->step(theta, t, c.out);
+            }
+            return step_result(c);
+          },
+          py::arg("theta"), py::arg("t"),
+          "One control step at (theta, t) with r_d and r_d_dot from the path: returns (theta_dot, StepInfo).")
+      .def(
+          "step",
+          [](PyController& c, const Eigen::VectorXd& theta, double t, const Eigen::VectorXd& r_d,
+             const Eigen::VectorXd& r_d_dot) {
+            {
+              py::gil_scoped_release release;
+              c.controller->step(theta, t, r_d, r_d_dot, c.out);
+            }
+            return step_result(c);
+          },
+          py::arg("theta"), py::arg("t"), py::arg("r_d"), py::arg("r_d_dot"),
+          "One control step with the caller's r_d and r_d_dot (reference_dim entries): returns (theta_dot, StepInfo).")
+      .def("reset", [](PyController& c) { c.controller->reset(); }, "Forgets the engine's warm start.")
+      .def_property_readonly("robot", [](const PyController& c) { return PyRobot{c.robot}; })
+      .def_property_readonly("r_d", [](const PyController& c) { return Eigen::VectorXd(c.controller->r_d()); },
+                             "the last step's desired task coordinates")
+      .def_property_readonly("r_d_dot", [](const PyController& c) { return Eigen::VectorXd(c.controller->r_d_dot()); })
+      .def_property_readonly("f", [](const PyController& c) { return Eigen::VectorXd(c.controller->kinematics().f); },
+                             "the last step's task coordinates f(theta)")
+      .def_property_readonly("w", [](const PyController& c) { return c.controller->kinematics().w; })
+      .def_property_readonly(
+          "qp",
+          [](const PyController& c) {
+            const QpProblem& qp = c.controller->qp();
+            py::dict d;
+            d["W"] = Eigen::MatrixXd(qp.W);
+            d["zeta"] = Eigen::VectorXd(qp.zeta);
+            d["J"] = Eigen::MatrixXd(qp.J);
+            d["d"] = Eigen::VectorXd(qp.d);
+            d["A"] = Eigen::MatrixXd(qp.A);
+            d["b"] = Eigen::VectorXd(qp.b);
+            d["lo"] = Eigen::VectorXd(qp.lo);
+            d["hi"] = Eigen::VectorXd(qp.hi);
+            return d;
+          },
+          "the last step's QP (copies): W, zeta, J, d, A, b, lo, hi");
+
+  m.def("_registry", &registry_listing);
+  bind_python_plugins(m);
+}

@@ -1,0 +1,39 @@
+"""The GIL is released while a scenario runs: another Python thread runs meanwhile, and runs on several threads give
+the results of one thread."""
+
+import threading
+import time
+
+import redres
+from conftest import source
+
+
+def test_python_threads_run_while_a_scenario_runs():
+    # 40 s at tau = 1 ms: 40,000 steps, long enough to watch.
+    s = redres.Scenario.load(source("configs/paper_r_tvcmm.toml"), overrides={"step": 0.001})
+    span = {}
+
+    def work():
+        span["start"] = time.perf_counter()
+        s.run()
+        span["end"] = time.perf_counter()
+
+    worker = threading.Thread(target=work)
+    worker.start()
+    ticks = []
+    while worker.is_alive():
+        ticks.append(time.perf_counter())
+        time.sleep(0.0005)
+    worker.join()
+    inside = [t for t in ticks if span["start"] + 0.02 < t < span["end"] - 0.02]
+    assert span["end"] - span["start"] > 0.06, "the run was too short to tell"
+    assert len(inside) >= 5, f"the main thread ran {len(inside)} times during a {span['end'] - span['start']:.3f} s run"
+
+
+def test_parallel_runs_give_the_results_of_sequential_runs():
+    files = [source(f"configs/paper_r_{n}.toml") for n in ("tvcmm", "constant_p", "mvn", "fast")]
+    one = redres.compare(files, jobs=1)
+    two = redres.compare(files, jobs=2)
+    for a, b in zip(one.results, two.results):
+        assert a.final_theta.tolist() == b.final_theta.tolist()
+        assert (a.values == b.values).all()

@@ -85,7 +85,7 @@ def _load_scenario(path, overrides=None):
     items = None
     if overrides:
         items = [(str(k), _toml(v)) for k, v in dict(overrides).items()]
-    return Scenario._load(_os.fspath(path), items)
+    return Scenario._load(path, items)
 
 
 Scenario.load = staticmethod(_load_scenario)

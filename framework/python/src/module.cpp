@@ -11,6 +11,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include "python_plugins.hpp"
 #include "redres/kinematics.hpp"
@@ -279,7 +280,8 @@ PYBIND11_MODULE(_redres, m) {
 
   py::class_<PyRobot>(m, "Robot", "A robot model (redres.Robot.load(path) reads a robot TOML file, DH or URDF).")
       .def_static(
-          "load", [](const std::string& path) { return PyRobot{std::make_shared<const RobotModel>(load_robot(path))}; },
+          "load",
+          [](const std::filesystem::path& path) { return PyRobot{std::make_shared<const RobotModel>(load_robot(path))}; },
           py::arg("path"), "Loads a robot TOML file; a bad file raises redres.ConfigError with file:line:col.")
       .def_property_readonly("name", [](const PyRobot& r) { return r.model->name(); })
       .def_property_readonly("kind", [](const PyRobot& r) { return std::string(to_string(r.model->kind())); },
@@ -362,7 +364,9 @@ PYBIND11_MODULE(_redres, m) {
       .def_property_readonly("wall_time_s", [](const PyResult& r) { return r.run->wall_time_s; })
       .def(
           "write",
-          [](const PyResult& r, const std::string& dir) { write_run(*r.scenario->robot, *r.run, *r.summary, dir); },
+          [](const PyResult& r, const std::filesystem::path& dir) {
+            write_run(*r.scenario->robot, *r.run, *r.summary, dir);
+          },
           py::arg("out_dir"), "Writes trajectory.csv, frames.csv and summary.json, as `redres run --out` does.")
       .def("__repr__", [](const PyResult& r) {
         return "<redres.Result '" + r.summary->name + "' " + std::to_string(r.run->trajectory.size()) + " rows, " +
@@ -372,7 +376,8 @@ PYBIND11_MODULE(_redres, m) {
   py::class_<PyScenario>(m, "Scenario")
       .def_static(
           "_load",
-          [](const std::string& path, const std::optional<std::vector<std::pair<std::string, std::string>>>& o) {
+          [](const std::filesystem::path& path,
+             const std::optional<std::vector<std::pair<std::string, std::string>>>& o) {
             return PyScenario{std::make_shared<Scenario>(load_scenario(path, override_strings(o)))};
           },
           py::arg("path"), py::arg("overrides") = py::none())

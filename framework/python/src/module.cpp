@@ -171,10 +171,7 @@ std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::li
   } else {
     std::string where;
     const toml::table t = spec_table(engine, where);
-    auto file = std::make_shared<TomlFile>();
-    file->path = where;
-    file->root = t;
-    c->engine = make_engine(TableReader::root(file));
+    c->engine = make_engine(reader_of(t, where));
   }
   if (!path.is_none()) {
     const Eigen::VectorXd start_theta = theta0 ? checked_theta(model, *theta0, "Controller") : model.home();
@@ -186,10 +183,7 @@ std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::li
     pc.duration = T;
     std::string where;
     const toml::table t = spec_table(path, where);
-    auto file = std::make_shared<TomlFile>();
-    file->path = where;
-    file->root = t;
-    c->path = make_path(TableReader::root(file), pc);
+    c->path = make_path(reader_of(t, where), pc);
   }
   c->controller = std::make_unique<Controller>(model, *c->scheme, *c->engine, c->path.get(), T, tau);
   c->out = c->controller->make_output();

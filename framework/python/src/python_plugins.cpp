@@ -170,13 +170,6 @@ py::object to_python(const toml::node& node) {
 
 namespace {
 
-std::shared_ptr<const TomlFile> file_of(const toml::table& config, const std::string& where) {
-  auto file = std::make_shared<TomlFile>();
-  file->path = where;
-  file->root = config;
-  return file;
-}
-
 // --- what a Python plugin sees during contribute() ---------------------------------------------------------------
 
 // The step's Context, valid only during the call (afterwards every accessor raises).
@@ -380,18 +373,25 @@ void register_in(Reg& registry, const std::string& type, const SharedObject& cls
 
 }  // namespace
 
+TableReader reader_of(const toml::table& config, const std::string& where) {
+  auto file = std::make_shared<TomlFile>();
+  file->path = where;
+  file->root = config;
+  return TableReader::root(std::move(file));
+}
+
 std::unique_ptr<Objective> make_objective_from(const toml::table& config, const std::string& where,
                                                const RobotModel& robot) {
-  return make_objective(TableReader::root(file_of(config, where)), robot);
+  return make_objective(reader_of(config, where), robot);
 }
 
 std::unique_ptr<Constraint> make_constraint_from(const toml::table& config, const std::string& where,
                                                  const RobotModel& robot) {
-  return make_constraint(TableReader::root(file_of(config, where)), robot);
+  return make_constraint(reader_of(config, where), robot);
 }
 
 void check_config(const std::string& kind, const toml::table& config, const std::string& where) {
-  const TableReader r = TableReader::root(file_of(config, where));
+  const TableReader r = reader_of(config, where);
   if (kind == "engine") {
     (void)make_engine(r);  // an engine needs no robot: build it
     return;

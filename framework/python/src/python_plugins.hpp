@@ -27,6 +27,9 @@ toml::table to_table(const py::dict& values, const std::string& where);
 /// A TOML node as a Python value (tables as dicts, arrays as lists).
 py::object to_python(const toml::node& node);
 
+/// A reader of `config` as the root table of a file named `where` (in messages: "where: key 'k': ...").
+TableReader reader_of(const toml::table& config, const std::string& where);
+
 /// An objective or constraint from its typed configuration: the TOML table `config` (with `type`) read by the
 /// registry of `kind` ("objective" or "constraint") as if it were a [[objectives]] / [[constraints]] entry of a file
 /// named `where`. Unknown keys and broken rules are ConfigErrors naming `where` and the key.

@@ -36,6 +36,7 @@ struct RunOptions {
   bool plots = false;
   bool animate = false;
   bool no_plots = false;
+  std::string record;  // --record; empty: the scenario's [output] record
 };
 
 // A progress bar on stderr, shown only on a terminal, and only once a run looks like it takes over a second.
@@ -191,14 +192,14 @@ struct Outcome {
   RunSummary summary;
 };
 
-Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet) {
+Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet, const RecordOptions& record = {}) {
   Outcome o{std::move(scenario), {}, {}};
   {
     ProgressBar bar(o.scenario.name, quiet);
     o.run = simulate(o.scenario, [&bar](double f, double t) { bar.update(f, t); });
   }
   o.summary = summarise(o.scenario, o.run);
-  write_run(*o.scenario.robot, o.run, o.summary, out);
+  write_run(*o.scenario.robot, o.run, o.summary, out, record);
   if (!quiet) {
     const RunSummary& s = o.summary;
     std::cout << std::setprecision(4) << s.name << ": " << s.steps << " steps of " << s.tau << " s, engine "
@@ -238,9 +239,22 @@ void add_run_commands(CLI::App& app, Action& action) {
   run->add_flag("--animate", opts->animate,
                 "render an animation of the arm and the obstacles into the output directory: animation.mp4 when "
                 "ffmpeg is on PATH, else animation.gif (plot_run.py, as --plots)");
+  run->add_option("--record", opts->record,
+                  "rows of trajectory.csv: all, every=N (every N-th step and the last), or none (summary.json only); "
+                  "the summary always uses every step (default: the scenario's [output] record, else all)");
   run->callback([opts, &action] {
     action = [opts] {
       Scenario scenario = load_scenario(opts->scenarios.front(), opts->overrides);
+      RecordOptions record;
+      try {
+        record = parse_record(opts->record.empty() ? scenario.record : opts->record);
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(std::string("--record: ") + e.what());
+      }
+      if (record.none && (opts->plots || opts->animate || scenario.plots || scenario.animate)) {
+        throw std::runtime_error("the figures and the animation are made from trajectory.csv and frames.csv, which "
+                                 "--record none does not write: use --record every=N");
+      }
       std::optional<Plotter> plotter, animator;
       if (opts->plots || scenario.plots) {
         plotter = find_plotter(opts->plots ? "--plots" : opts->scenarios.front() + ": [output] plots = true");
@@ -248,7 +262,7 @@ void add_run_commands(CLI::App& app, Action& action) {
       if (opts->animate || scenario.animate) {
         animator = find_plotter(opts->animate ? "--animate" : opts->scenarios.front() + ": [output] animate = true");
       }
-      const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet);
+      const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet, record);
       const std::string written = "trajectory.csv, frames.csv and summary.json in " + opts->out;
       if (plotter) render_plots(*plotter, {opts->out}, opts->quiet, written);
       if (animator) {

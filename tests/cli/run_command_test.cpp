@@ -56,6 +56,51 @@ TEST(CliScenario, RunWritesTheTrajectoryAndSummaryOfOutputFormats) {
   std::filesystem::remove_all(dir);
 }
 
+std::size_t line_count(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::size_t lines = 0;
+  for (std::string l; std::getline(in, l);) ++lines;
+  return lines;
+}
+
+// --record every=N keeps rows 0, N, 2N, ... and the last; --record none writes the summary only (and removes an
+// earlier run's trajectory); the summary is the same in every case, since it uses every step; bad values are exit 2.
+TEST(CliScenario, RecordKeepsEveryNthRowOrNoneWhileTheSummaryUsesEveryStep) {
+  const auto dir = scratch("record");
+  const auto summary_of = [&dir] {
+    std::ifstream js(dir / "summary.json");
+    nlohmann::json s = nlohmann::json::parse(js);
+    s.erase("wall_time_s");
+    return s;
+  };
+  ASSERT_EQ(redres("run configs/paper_r_mvn.toml --quiet --out '" + dir.string() + "'").code, 0);
+  const nlohmann::json all = summary_of();
+  ASSERT_EQ(redres("run configs/paper_r_mvn.toml --quiet --record every=7 --out '" + dir.string() + "'").code, 0);
+  EXPECT_EQ(line_count(dir / "trajectory.csv"), 1u + 4000 / 7 + 1 + 1) << "header, rows 0, 7, ..., 3997, and 4000";
+  EXPECT_EQ(summary_of(), all);
+  std::ifstream csv(dir / "trajectory.csv");
+  std::string line, last;
+  while (std::getline(csv, line)) last = line;
+  EXPECT_EQ(last.rfind("40,", 0), 0u) << "the last row is t = T: " << last.substr(0, 20);
+  ASSERT_EQ(redres("run configs/paper_r_mvn.toml --quiet --record none --out '" + dir.string() + "'").code, 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "trajectory.csv"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "frames.csv"));
+  EXPECT_EQ(summary_of(), all);
+  for (const char* bad : {"every=0", "every=x", "some", "every=3x"}) {
+    const Cli r = redres("run configs/paper_r_mvn.toml --quiet --record " + std::string(bad) + " --out '" +
+                         dir.string() + "'");
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.out.find("expected \"all\", \"none\" or \"every=N\""), std::string::npos) << r.out;
+  }
+  const Cli plots = redres("run configs/paper_r_mvn.toml --quiet --record none --plots --out '" + dir.string() + "'");
+  EXPECT_EQ(plots.code, 2);
+  EXPECT_NE(plots.out.find("--record none does not write"), std::string::npos) << plots.out;
+  const Cli file = redres("validate configs/paper_r_mvn.toml --set output.record=every=0");
+  EXPECT_EQ(file.code, 2);
+  EXPECT_NE(file.out.find("--set output.record:1:"), std::string::npos) << file.out;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CliScenario, SetOverridesValuesAndValidateChecksWithoutRunning) {
   const Cli ok = redres("validate configs/paper_r_tvcmm.toml --set solver.engine=newton --set objectives.1.p=1.5");
   ASSERT_EQ(ok.code, 0) << ok.out;

@@ -1,9 +1,20 @@
-// joint_frames (frames.csv): the rows it keeps and the frames it computes.
+// joint_frames (frames.csv): the rows it keeps and the frames it computes; trajectory.csv read back gives the
+// recorded doubles bit for bit.
+
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
 #include "redres/kinematics.hpp"
 #include "redres/run_output.hpp"
+#include "redres/run_summary.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -71,6 +82,65 @@ TEST(JointFrames, AreTheKinematicsOfTheRecordedTheta) {
     EXPECT_EQ(f.at(r, "ee_x"), k.ee_pose.translation().x());
     EXPECT_EQ(f.at(r, "ee_z"), k.ee_pose.translation().z());
   }
+}
+
+// trajectory.csv holds every recorded double in a form that reads back to the same bits: a real run, plus rows of
+// awkward values (signed zero, subnormals, the extremes, infinities, random bit patterns).
+TEST(TrajectoryCsv, ReadsBackBitForBit) {
+  Scenario s = load_scenario(source_path("configs/paper_r_fast.toml"));
+  RunResult run = simulate(s);
+  const RunSummary summary = summarise(s, run);
+  std::mt19937_64 rng(11);
+  const double lim = std::numeric_limits<double>::max();
+  const double specials[] = {0.0, -0.0, std::numeric_limits<double>::denorm_min(), -5e-324, 2.2250738585072014e-308,
+                             lim, -lim, std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                             0.1, 1.0 / 3.0, 1e22, 123456789012345678.0};
+  for (int extra = 0; extra < 50; ++extra) {
+    double* row = run.trajectory.append_row();
+    for (std::size_t c = 0; c < run.trajectory.width(); ++c) {
+      if (extra < 5) {
+        row[c] = specials[(c + static_cast<std::size_t>(extra)) % std::size(specials)];
+      } else {
+        std::uint64_t bits = rng();
+        std::memcpy(&row[c], &bits, sizeof(bits));
+        if (!std::isfinite(row[c])) row[c] = 1.0;
+      }
+      // frames.csv is computed from the theta columns: they stay finite.
+      const std::string& name = run.trajectory.columns()[c];
+      if (name.rfind("theta_", 0) == 0 && name.rfind("theta_dot", 0) != 0 && !std::isfinite(row[c])) row[c] = -0.0;
+    }
+  }
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "redres_csv_round_trip";
+  write_run(*s.robot, run, summary, dir);
+  std::ifstream in(dir / "trajectory.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  std::size_t r = 0, checked = 0;
+  while (std::getline(in, line)) {
+    ASSERT_LT(r, run.trajectory.size());
+    std::stringstream cells(line);
+    std::string cell;
+    std::size_t c = 0;
+    while (std::getline(cells, cell, ',')) {
+      double v = 0.0;
+      if (cell == "inf" || cell == "-inf") {
+        v = cell[0] == '-' ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+      } else {
+        const auto res = std::from_chars(cell.data(), cell.data() + cell.size(), v);
+        ASSERT_EQ(res.ec, std::errc()) << cell;
+        ASSERT_EQ(res.ptr, cell.data() + cell.size()) << cell;
+      }
+      const double want = run.trajectory(r, c);
+      ASSERT_EQ(std::memcmp(&v, &want, sizeof(v)), 0) << "row " << r << " column " << c << ": " << cell;
+      ++c;
+      ++checked;
+    }
+    ASSERT_EQ(c, run.trajectory.width());
+    ++r;
+  }
+  EXPECT_EQ(r, run.trajectory.size());
+  EXPECT_GT(checked, 1000u);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

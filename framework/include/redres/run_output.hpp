@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <string>
 
 #include "redres/run_summary.hpp"
 
@@ -22,9 +23,23 @@ inline constexpr std::size_t kFramesMaxRows = 500;
 [[nodiscard]] Trajectory joint_frames(const RobotModel& robot, const Trajectory& run,
                                       std::size_t max_rows = kFramesMaxRows);
 
-/// Writes DIR/trajectory.csv, DIR/frames.csv (joint_frames of `robot`, the run's robot) and
-/// DIR/summary.json, creating DIR; std::runtime_error naming the file on failure.
+/// Which rows of a run go into trajectory.csv: every row (every = 1), every N-th (and the last), or none. The
+/// summary always uses every step: it is computed from the run in memory.
+struct RecordOptions {
+  std::size_t every = 1;  //!< keep rows 0, N, 2N, ... and the last
+  bool none = false;      //!< write summary.json only (no trajectory.csv, no frames.csv)
+};
+
+/// Parses "all", "none" or "every=N" (N >= 1); std::invalid_argument saying what is expected otherwise.
+[[nodiscard]] RecordOptions parse_record(const std::string& text);
+/// "all", "none" or "every=N".
+[[nodiscard]] std::string to_string(const RecordOptions& record);
+
+/// Writes DIR/trajectory.csv (the rows `record` keeps), DIR/frames.csv (joint_frames of `robot`, the run's robot)
+/// and DIR/summary.json, creating DIR; std::runtime_error naming the file on failure. With record.none, only
+/// summary.json, and a trajectory.csv or frames.csv left in DIR by an earlier run is removed (it would not belong
+/// to this summary).
 void write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
-               const std::filesystem::path& dir);
+               const std::filesystem::path& dir, const RecordOptions& record = {});
 
 }  // namespace redres

@@ -15,7 +15,8 @@
 ///   [path]        type = "letter_r", ...       # see path.hpp
 ///   [[objectives]] ... [[constraints]] ...      # see plugin.hpp
 ///   [solver]      engine = "projection", ...    # see lvi.hpp
-///   [output]      plots = false                 # render the figures with tools/plot_run.py after a run
+///   [output]      record = "all"                # rows of trajectory.csv: "all", "none" or "every=N"
+///                 plots = false                 # render the figures with tools/plot_run.py after a run
 ///                 animate = false               # and/or the animation (animation.mp4 or animation.gif)
 
 #include <filesystem>
@@ -45,6 +46,7 @@ struct Scenario {
   /// [orientation] turn: the rotation (a world-frame rotation vector, rad; planar: its z) the end effector turns
   /// through over the run, from the orientation it has at t = 0 (Controller::set_orientation_turn); zero: hold it.
   Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();
+  std::string record = "all";  //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
   bool plots = false;    //!< [output] plots
   bool animate = false;  //!< [output] animate
 

@@ -358,10 +358,12 @@ PYBIND11_MODULE(_redres, m) {
       .def_property_readonly("wall_time_s", [](const PyResult& r) { return r.run->wall_time_s; })
       .def(
           "write",
-          [](const PyResult& r, const std::filesystem::path& dir) {
-            write_run(*r.scenario->robot, *r.run, *r.summary, dir);
+          [](const PyResult& r, const std::filesystem::path& dir, const std::string& record) {
+            write_run(*r.scenario->robot, *r.run, *r.summary, dir, parse_record(record));
           },
-          py::arg("out_dir"), "Writes trajectory.csv, frames.csv and summary.json, as `redres run --out` does.")
+          py::arg("out_dir"), py::arg("record") = "all",
+          "Writes trajectory.csv, frames.csv and summary.json, as `redres run --out` does; record is 'all', "
+          "'every=N' or 'none', as --record.")
       .def("__repr__", [](const PyResult& r) {
         return "<redres.Result '" + r.summary->name + "' " + std::to_string(r.run->trajectory.size()) + " rows, " +
                (r.run->failures == 0 ? std::string("ok") : std::to_string(r.run->failures) + " failed steps") + ">";

@@ -24,6 +24,9 @@ void add_robot_command(CLI::App& app, Action& action);
 /// `redres run`, `redres validate`, `redres compare`.
 void add_run_commands(CLI::App& app, Action& action);
 
+/// `redres sweep SWEEP.toml --out DIR [--jobs N] [--shard i/N] [--runs]`, `redres sweep --merge DIR... --out DIR`.
+void add_sweep_command(CLI::App& app, Action& action);
+
 /// `redres plugins [--json] [--check]`.
 void add_plugins_command(CLI::App& app, Action& action);
 

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   redres::cli::add_robot_command(app, action);
   redres::cli::add_plugins_command(app, action);
   redres::cli::add_run_commands(app, action);
+  redres::cli::add_sweep_command(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

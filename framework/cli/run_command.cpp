@@ -19,6 +19,7 @@
 #include <string_view>
 
 #include "commands.hpp"
+#include "progress.hpp"
 #include "redres/run_output.hpp"
 #include "redres/scenario.hpp"
 
@@ -37,39 +38,6 @@ struct RunOptions {
   bool animate = false;
   bool no_plots = false;
   std::string record;  // --record; empty: the scenario's [output] record
-};
-
-// A progress bar on stderr, shown only on a terminal, and only once a run looks like it takes over a second.
-class ProgressBar {
- public:
-  ProgressBar(std::string label, bool quiet)
-      : label_(std::move(label)),
-        enabled_(!quiet && isatty(STDERR_FILENO) != 0),
-        start_(std::chrono::steady_clock::now()) {}
-  ~ProgressBar() {
-    if (shown_) std::fprintf(stderr, "\r\033[K");
-  }
-  ProgressBar(const ProgressBar&) = delete;
-  ProgressBar& operator=(const ProgressBar&) = delete;
-
-  void update(double fraction, double t) {
-    if (!enabled_) return;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    if (!shown_ && (elapsed < 0.2 || fraction <= 0.0 || elapsed / fraction < 1.0)) return;
-    shown_ = true;
-    const int width = 30;
-    const int done = static_cast<int>(fraction * width);
-    const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
-    std::fprintf(stderr, "\r%s [%.*s%*s] %3.0f%%  t = %.2f s  eta %.1f s", label_.c_str(), done,
-                 "##############################", width - done, "", 100.0 * fraction, t, eta);
-    std::fflush(stderr);
-  }
-
- private:
-  std::string label_;
-  bool enabled_;
-  bool shown_ = false;
-  std::chrono::steady_clock::time_point start_;
 };
 
 // plot_run.py: $REDRES_TOOLS_DIR/plot_run.py when set, else <dir of this executable>/REDRES_TOOLS_RELDIR, which is
@@ -196,7 +164,11 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet,
   Outcome o{std::move(scenario), {}, {}};
   {
     ProgressBar bar(o.scenario.name, quiet);
-    o.run = simulate(o.scenario, [&bar](double f, double t) { bar.update(f, t); });
+    o.run = simulate(o.scenario, [&bar](double f, double t) {
+      char where[32];
+      std::snprintf(where, sizeof where, "t = %.2f s", t);
+      bar.update(f, where);
+    });
   }
   o.summary = summarise(o.scenario, o.run);
   write_run(*o.scenario.robot, o.run, o.summary, out, record);

@@ -84,7 +84,8 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   out.max_joint_velocity_violation = std::max(0.0, vel_viol);
   out.steps_with_active_bounds = active_steps;
   for (int j = 0; j < n; ++j) out.final_theta.push_back(tr(rows - 1, c_th[static_cast<std::size_t>(j)]));
-  out.solver = {run.engine(), it_sum / static_cast<double>(rows), it_max, max_res, run.failures, run.first_failure};
+  out.solver = {run.engine(),  it_sum / static_cast<double>(rows), it_max, max_res, run.failures, run.first_failure,
+                run.stopped};
   out.wall_time_s = run.wall_time_s;
   out.robot.name = robot.name();
   out.robot.kind = to_string(robot.kind());
@@ -189,7 +190,8 @@ std::string to_json(const RunSummary& s) {
         {"max_iterations", s.solver.max_iterations},
         {"max_residual", s.solver.max_residual},
         {"failures", s.solver.failures},
-        {"first_failure", s.solver.first_failure}}},
+        {"first_failure", s.solver.first_failure},
+        {"stopped", s.solver.stopped}}},
       {"wall_time_s", s.wall_time_s},
       {"robot",
        {{"name", s.robot.name},

@@ -96,7 +96,11 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot));
   if (r.has("solver")) {
     const TableReader t = r.table("solver");
-    s.engine = make_engine(TableReader(t.file_ptr(), t.raw(), "solver"));
+    const TableReader solver(t.file_ptr(), t.raw(), "solver");
+    s.on_infeasible = solver.choice("on_infeasible", {"continue", "stop"}, "continue") == "continue"
+                          ? OnInfeasible::kContinue
+                          : OnInfeasible::kStop;
+    s.engine = make_engine(solver);
   } else {
     s.engine = make_engine("projection");
   }

@@ -178,6 +178,10 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
     if (run.failures == failures_before) check_violations(t);  // one failure per step at most
     if (progress && (k % report_every == 0 || k == steps)) progress(static_cast<double>(k) / steps, t);
     if (k == steps) break;
+    if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before) {
+      run.stopped = true;  // the row of the failed step is the last
+      break;
+    }
     if (s.integrator == Integrator::kEuler) {
       theta += s.tau * out.theta_dot;
     } else {
@@ -185,7 +189,12 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
       theta_pred = theta + s.tau * out.theta_dot;
       const double t2 = std::min(s.duration, t + s.tau);
       ctrl.step(theta_pred, t2, out2);
+      const int failures_before_stage = run.failures;
       note(out2, t2);
+      if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before_stage) {
+        run.stopped = true;
+        break;
+      }
       theta += 0.5 * s.tau * (out.theta_dot + out2.theta_dot);
     }
   }

@@ -26,6 +26,7 @@ struct SolverStats {
   double max_residual = 0.0;  //!< largest ||e(u)||_2
   int failures = 0;           //!< solves that were not `solved`
   std::string first_failure;  //!< "t = ...: <status>: <diagnosis>", or empty
+  bool stopped = false;       //!< the run ended at its first failed step ([solver] on_infeasible = "stop")
 };
 
 /// A collision shape of a link, in that link's frame (the frames of frames.csv).

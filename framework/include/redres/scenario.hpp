@@ -30,6 +30,8 @@ namespace redres {
 
 /// Integration of theta_dot.
 enum class Integrator { kEuler, kHeun };
+/// What a run does after a failed step ([solver] on_infeasible): go on to T (counting failures), or stop there.
+enum class OnInfeasible { kContinue, kStop };
 
 /// A loaded scenario. Owns everything a run needs.
 struct Scenario {
@@ -46,6 +48,7 @@ struct Scenario {
   /// [orientation] turn: the rotation (a world-frame rotation vector, rad; planar: its z) the end effector turns
   /// through over the run, from the orientation it has at t = 0 (Controller::set_orientation_turn); zero: hold it.
   Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();
+  OnInfeasible on_infeasible = OnInfeasible::kContinue;  //!< [solver] on_infeasible: "continue" or "stop"
   std::string record = "all";  //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
   bool plots = false;    //!< [output] plots
   bool animate = false;  //!< [output] animate

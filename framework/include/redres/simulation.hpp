@@ -21,6 +21,7 @@ struct RunResult {
   std::string first_failure;              //!< "t = ...: <status>: <diagnosis>" of the first failed solve
   double wall_time_s = 0.0;               //!< time spent in the loop (s)
   std::vector<std::string_view> engines;  //!< engines that ran, in order of first use (a fallback adds one)
+  bool stopped = false;                   //!< ended at the first failed step ([solver] on_infeasible = "stop")
 
   /// "projection", or "newton+projection" when a fallback ran.
   [[nodiscard]] std::string engine() const;

@@ -1,0 +1,464 @@
+#include "redres/sweep.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "redres/error.hpp"
+#include "redres/formula.hpp"
+#include "redres/run_summary.hpp"
+#include "redres/scenario.hpp"
+#include "redres/toml_reader.hpp"
+
+namespace redres {
+
+namespace {
+
+std::string shortest(double v) {
+  char buf[64];
+  return std::string(buf, std::to_chars(buf, buf + sizeof(buf), v).ptr);
+}
+
+// A TOML value as the text `--set key=value` takes.
+std::string toml_text(const toml::node& node) {
+  if (const auto* f = node.as_floating_point()) return shortest(f->get());
+  toml::table t;
+  t.insert("v", node);
+  std::ostringstream s;
+  s << t;
+  const std::string text = s.str();
+  const auto eq = text.find("= ");
+  std::string out = eq == std::string::npos ? text : text.substr(eq + 2);
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return out;
+}
+
+// How a value is shown in sweep.csv: TOML text, strings without their quotes.
+std::string cell_text(const std::string& toml) {
+  if (toml.size() >= 2 && toml.front() == '"' && toml.back() == '"') return toml.substr(1, toml.size() - 2);
+  return toml;
+}
+
+SweepAxis read_axis(const TableReader& t) {
+  SweepAxis axis;
+  axis.key = t.string("key");
+  if (axis.key.empty()) t.fail("key", "expected a scenario key such as \"objectives.1.p\"");
+  const bool has_values = t.has("values"), has_range = t.has("range");
+  if (has_values == has_range) t.fail("give either 'values' (an array) or 'range' ({ start, stop, step })");
+  if (has_values) {
+    const toml::array* values = t.raw().get("values")->as_array();
+    if (values == nullptr || values->empty()) t.fail("values", "expected a non-empty array of values");
+    for (const auto& v : *values) axis.values.push_back(toml_text(v));
+  } else {
+    const TableReader range = t.table("range");
+    const double start = range.number("start"), stop = range.number("stop"), step = range.number("step");
+    range.finish();
+    if (!(std::isfinite(start) && std::isfinite(stop) && std::isfinite(step)) || step == 0.0 ||
+        (stop - start) / step < 0.0) {
+      t.fail("range", "expected finite start, stop and a step != 0 that goes from start towards stop");
+    }
+    const double n = std::floor((stop - start) / step * (1.0 + 1e-12) + 1e-9) + 1.0;
+    if (n > 1e6) t.fail("range", "expected at most 1e6 values, got " + shortest(n));
+    for (long k = 0; k < static_cast<long>(n); ++k) axis.values.push_back(shortest(start + static_cast<double>(k) * step));
+  }
+  t.finish();
+  return axis;
+}
+
+std::vector<Eigen::VectorXd> read_theta0(const TableReader& t, const RobotModel& robot) {
+  std::vector<Eigen::VectorXd> out;
+  const int n = robot.dof();
+  const auto inside = [&robot](const Eigen::VectorXd& q) {
+    return (q.array() >= robot.lower_limits().array()).all() && (q.array() <= robot.upper_limits().array()).all();
+  };
+  if (t.has("list")) {
+    if (t.has("samples")) t.fail("samples", "give either 'list' or 'samples', not both");
+    const toml::array* list = t.raw().get("list")->as_array();
+    if (list == nullptr || list->empty()) t.fail("list", "expected a non-empty array of configurations");
+    for (const auto& entry : *list) {
+      const toml::array* q = entry.as_array();
+      if (q == nullptr || static_cast<int>(q->size()) != n) {
+        throw ConfigError(location_of(t.file(), entry),
+                          "key 'list': expected configurations of " + std::to_string(n) + " joint positions");
+      }
+      Eigen::VectorXd theta(n);
+      for (int j = 0; j < n; ++j) {
+        const toml::node& el = (*q)[static_cast<std::size_t>(j)];
+        try {
+          if (const auto* s = el.as_string()) {
+            theta(j) = evaluate_constant(s->get());
+          } else if (const auto* i = el.as_integer()) {
+            theta(j) = static_cast<double>(i->get());
+          } else if (const auto* f = el.as_floating_point()) {
+            theta(j) = f->get();
+          } else {
+            throw std::invalid_argument("expected a number or a formula, got " + describe_type(el));
+          }
+        } catch (const std::invalid_argument& e) {
+          throw ConfigError(location_of(t.file(), el), "key 'list': " + std::string(e.what()));
+        }
+      }
+      if (!inside(theta)) throw ConfigError(location_of(t.file(), entry), "key 'list': outside the joint limits");
+      out.push_back(theta);
+    }
+  } else {
+    const std::int64_t samples = t.integer("samples");
+    const std::int64_t seed = t.integer("seed", 1);
+    const double margin = t.number("margin", 0.0);
+    if (samples < 1 || samples > 1000000) t.fail("samples", "expected 1 to 1000000 configurations");
+    if (!(margin >= 0.0 && margin < 0.5)) t.fail("margin", "expected a fraction 0 <= margin < 0.5 of each range");
+    // Uniform in [lo + margin (hi - lo), hi - margin (hi - lo)], from a 64-bit Mersenne twister: the same
+    // configurations on every machine.
+    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+    for (std::int64_t k = 0; k < samples; ++k) {
+      Eigen::VectorXd theta(n);
+      for (int j = 0; j < n; ++j) {
+        const double lo = robot.lower_limits()(j), hi = robot.upper_limits()(j);
+        const double u = static_cast<double>(rng() >> 11) / 9007199254740992.0;  // [0, 1)
+        theta(j) = lo + (margin + (1.0 - 2.0 * margin) * u) * (hi - lo);
+      }
+      out.push_back(theta);
+    }
+  }
+  t.finish();
+  return out;
+}
+
+// A variation's cells, named.
+using Cells = std::vector<std::pair<std::string, std::string>>;
+
+// The summary's figures as cells: objects flattened with dots, arrays as key_1, key_2, ... (1-based).
+void flatten(const nlohmann::json& j, const std::string& key, Cells& out) {
+  if (j.is_object()) {
+    for (const auto& [k, v] : j.items()) flatten(v, key.empty() ? k : key + "." + k, out);
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i) flatten(j[i], key + "_" + std::to_string(i + 1), out);
+  } else if (j.is_number_float()) {
+    out.emplace_back(key, shortest(j.get<double>()));
+  } else if (j.is_number()) {
+    out.emplace_back(key, j.dump());
+  } else if (j.is_boolean()) {
+    out.emplace_back(key, j.get<bool>() ? "true" : "false");
+  } else if (j.is_string()) {
+    out.emplace_back(key, j.get<std::string>());
+  } else {
+    out.emplace_back(key, "");
+  }
+}
+
+Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesystem::path& out_dir,
+                    std::mutex& load_lock) {
+  Cells cells;
+  cells.emplace_back("index", std::to_string(v.index));
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) cells.emplace_back(spec.axes[a].key, cell_text(v.values[a]));
+  if (v.theta0) {
+    for (Eigen::Index j = 0; j < v.theta0->size(); ++j) {
+      cells.emplace_back("theta0_" + std::to_string(j + 1), shortest((*v.theta0)(j)));
+    }
+  }
+  std::string status = "error", diagnosis;
+  Cells figures;
+  try {
+    std::optional<Scenario> s;
+    {
+      // Loading may load plugin libraries into the process-wide registries: one at a time.
+      const std::lock_guard<std::mutex> guard(load_lock);
+      s.emplace(load_scenario(spec.scenario, v.overrides));
+    }
+    const RunResult run = simulate(*s);
+    const RunSummary summary = summarise(*s, run);
+    if (spec.write_runs) write_run(*s->robot, run, summary, out_dir / "runs" / std::to_string(v.index), spec.record);
+    status = run.failures == 0 ? "ok" : "failed_steps";
+    diagnosis = run.first_failure;
+    nlohmann::json j = nlohmann::json::parse(to_json(summary));
+    for (const char* skip : {"wall_time_s", "source", "robot", "obstacles", "name"}) j.erase(skip);
+    flatten(j, "", figures);
+  } catch (const std::exception& e) {
+    diagnosis = e.what();
+  }
+  cells.emplace_back("status", status);
+  cells.emplace_back("diagnosis", diagnosis);
+  cells.insert(cells.end(), figures.begin(), figures.end());
+  return cells;
+}
+
+SweepTable to_table(const std::vector<Cells>& rows) {
+  SweepTable t;
+  std::map<std::string, std::size_t> index;
+  for (const Cells& row : rows) {
+    for (const auto& [k, v] : row) {
+      if (index.emplace(k, t.columns.size()).second) t.columns.push_back(k);
+    }
+  }
+  for (const Cells& row : rows) {
+    std::vector<std::string> cells(t.columns.size());
+    for (const auto& [k, v] : row) cells[index.at(k)] = v;
+    t.rows.push_back(std::move(cells));
+  }
+  return t;
+}
+
+std::string quoted(const std::string& cell) {
+  if (cell.find_first_of(",\"\n\r") == std::string::npos) return cell;
+  std::string out = "\"";
+  for (char c : cell) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+std::size_t SweepSpec::size() const {
+  std::size_t grid = 1;
+  if (zip) {
+    grid = axes.empty() ? 1 : axes.front().values.size();
+  } else {
+    for (const auto& a : axes) grid *= a.values.size();
+  }
+  return grid * std::max<std::size_t>(1, theta0.size());
+}
+
+SweepSpec load_sweep(const std::filesystem::path& file) {
+  const TableReader r = TableReader::root(parse_toml_file(file), "sweep");
+  SweepSpec spec;
+  spec.source = file.string();
+  spec.name = r.string("name", file.stem().string());
+  spec.scenario = r.path("scenario");
+  if (r.has("set")) spec.set = r.strings("set");
+  spec.zip = r.choice("combine", {"cross", "zip"}, "cross") == "zip";
+  for (const TableReader& t : r.tables("vary")) spec.axes.push_back(read_axis(t));
+  if (spec.zip) {
+    for (const auto& a : spec.axes) {
+      if (a.values.size() != spec.axes.front().values.size()) {
+        r.fail("combine", "\"zip\" needs axes of equal length: '" + spec.axes.front().key + "' has " +
+                              std::to_string(spec.axes.front().values.size()) + " values, '" + a.key + "' has " +
+                              std::to_string(a.values.size()));
+      }
+    }
+  }
+  // The base scenario must load; its robot bounds the sampled configurations.
+  const Scenario base = load_scenario(spec.scenario, spec.set);
+  if (auto t = r.optional_table("theta0")) {
+    spec.theta0 = read_theta0(TableReader(t->file_ptr(), t->raw(), "theta0"), *base.robot);
+  }
+  if (auto o = r.optional_table("output")) {
+    const TableReader out(o->file_ptr(), o->raw(), "output");
+    spec.write_runs = out.boolean("runs", false);
+    const std::string record = out.string("record", "none");
+    try {
+      spec.record = parse_record(record);
+    } catch (const std::invalid_argument& e) {
+      out.fail("record", e.what());
+    }
+    out.finish();
+  }
+  r.finish();
+  if (spec.size() > 10000000) r.fail("vary", "expected at most 1e7 variations, got " + std::to_string(spec.size()));
+  return spec;
+}
+
+Variation variation(const SweepSpec& spec, std::size_t index) {
+  REDRES_REQUIRE(index < spec.size(), "variation", "index < spec.size() = " + std::to_string(spec.size()));
+  Variation v;
+  v.index = index;
+  std::size_t grid = spec.size() / std::max<std::size_t>(1, spec.theta0.size());
+  std::size_t k = index % grid;
+  v.values.resize(spec.axes.size());
+  v.overrides = spec.set;
+  if (spec.zip) {
+    for (std::size_t a = 0; a < spec.axes.size(); ++a) v.values[a] = spec.axes[a].values[k];
+  } else {
+    for (std::size_t a = spec.axes.size(); a-- > 0;) {  // the last axis varies fastest
+      const std::size_t size = spec.axes[a].values.size();
+      v.values[a] = spec.axes[a].values[k % size];
+      k /= size;
+    }
+  }
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) v.overrides.push_back(spec.axes[a].key + "=" + v.values[a]);
+  if (!spec.theta0.empty()) {
+    const Eigen::VectorXd& q = spec.theta0[index / grid];
+    v.theta0 = q;
+    std::string text = "theta0=[";
+    for (Eigen::Index j = 0; j < q.size(); ++j) text += (j ? ", " : "") + shortest(q(j));
+    v.overrides.push_back(text + "]");
+  }
+  return v;
+}
+
+SweepShard parse_shard(const std::string& text) {
+  const auto slash = text.find('/');
+  SweepShard s;
+  const auto number = [](const std::string& digits, std::size_t& out) {
+    const auto res = std::from_chars(digits.data(), digits.data() + digits.size(), out);
+    return res.ec == std::errc() && res.ptr == digits.data() + digits.size() && !digits.empty();
+  };
+  if (slash == std::string::npos || !number(text.substr(0, slash), s.shard) || !number(text.substr(slash + 1), s.count) ||
+      s.count == 0 || s.shard >= s.count) {
+    throw std::invalid_argument("shard: expected i/N with 0 <= i < N, got \"" + text + "\"");
+  }
+  return s;
+}
+
+std::size_t SweepTable::failed() const {
+  const auto it = std::find(columns.begin(), columns.end(), "status");
+  if (it == columns.end()) return 0;
+  const auto c = static_cast<std::size_t>(it - columns.begin());
+  return static_cast<std::size_t>(
+      std::count_if(rows.begin(), rows.end(), [c](const auto& row) { return row[c] != "ok"; }));
+}
+
+SweepTable run_sweep(const SweepSpec& spec, const SweepShard& shard, unsigned jobs,
+                     const std::filesystem::path& out_dir, const SweepProgress& progress) {
+  REDRES_REQUIRE(shard.count >= 1 && shard.shard < shard.count, "run_sweep", "0 <= shard < count");
+  std::vector<std::size_t> mine;
+  for (std::size_t i = shard.shard; i < spec.size(); i += shard.count) mine.push_back(i);
+  std::vector<Cells> rows(mine.size());
+  std::atomic<std::size_t> next{0};
+  std::size_t done = 0;
+  std::mutex load_lock, progress_lock;
+  const auto work = [&] {
+    for (std::size_t k = next++; k < mine.size(); k = next++) {
+      rows[k] = run_variation(spec, variation(spec, mine[k]), out_dir, load_lock);
+      const std::lock_guard<std::mutex> guard(progress_lock);
+      ++done;
+      if (progress) progress(done, mine.size());
+    }
+  };
+  if (jobs == 0) jobs = std::max(1U, std::thread::hardware_concurrency());
+  const std::size_t threads = std::min<std::size_t>(jobs, std::max<std::size_t>(1, mine.size()));
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  return to_table(rows);
+}
+
+void write_sweep_csv(const SweepTable& table, const std::filesystem::path& file) {
+  std::ofstream out(file);
+  for (std::size_t c = 0; c < table.columns.size(); ++c) out << (c ? "," : "") << quoted(table.columns[c]);
+  out << "\n";
+  for (const auto& row : table.rows) {
+    for (std::size_t c = 0; c < row.size(); ++c) out << (c ? "," : "") << quoted(row[c]);
+    out << "\n";
+  }
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+}
+
+SweepTable read_sweep_csv(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw ConfigError({file.string(), 0, 0}, "cannot read the file");
+  std::ostringstream whole;
+  whole << in.rdbuf();
+  const std::string text = whole.str();
+  std::vector<std::vector<std::string>> records(1);
+  std::string cell;
+  bool quoted_cell = false, at_start = true;
+  std::uint32_t line = 1;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted_cell) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') {
+        cell += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted_cell = false;
+      } else {
+        if (c == '\n') ++line;
+        cell += c;
+      }
+    } else if (c == '"' && at_start) {
+      quoted_cell = true;
+      at_start = false;
+    } else if (c == ',') {
+      records.back().push_back(std::move(cell));
+      cell.clear();
+      at_start = true;
+    } else if (c == '\n') {
+      records.back().push_back(std::move(cell));
+      cell.clear();
+      records.emplace_back();
+      at_start = true;
+      ++line;
+    } else if (c != '\r') {
+      cell += c;
+      at_start = false;
+    }
+  }
+  if (quoted_cell) throw ConfigError({file.string(), line, 0}, "a quoted cell is not closed");
+  if (!cell.empty() || !records.back().empty()) records.back().push_back(std::move(cell));
+  if (records.back().empty()) records.pop_back();
+  if (records.empty()) throw ConfigError({file.string(), 1, 1}, "expected a header line");
+  SweepTable t;
+  t.columns = std::move(records.front());
+  if (std::find(t.columns.begin(), t.columns.end(), "index") == t.columns.end()) {
+    throw ConfigError({file.string(), 1, 1}, "expected a column 'index' (is this a sweep.csv?)");
+  }
+  for (std::size_t r = 1; r < records.size(); ++r) {
+    if (records[r].size() != t.columns.size()) {
+      throw ConfigError({file.string(), static_cast<std::uint32_t>(r + 1), 1},
+                        "expected " + std::to_string(t.columns.size()) + " cells, got " +
+                            std::to_string(records[r].size()));
+    }
+    t.rows.push_back(std::move(records[r]));
+  }
+  return t;
+}
+
+SweepTable merge_sweep_tables(const std::vector<SweepTable>& tables) {
+  std::vector<std::pair<std::size_t, Cells>> all;
+  std::map<std::size_t, bool> seen;
+  for (const SweepTable& t : tables) {
+    const auto c_index = static_cast<std::size_t>(std::find(t.columns.begin(), t.columns.end(), "index") -
+                                                  t.columns.begin());
+    REDRES_REQUIRE(c_index < t.columns.size(), "merge_sweep_tables", "every table has an 'index' column");
+    for (const auto& row : t.rows) {
+      std::size_t index = 0;
+      const std::string& text = row[c_index];
+      const auto res = std::from_chars(text.data(), text.data() + text.size(), index);
+      if (res.ec != std::errc() || res.ptr != text.data() + text.size()) {
+        throw std::invalid_argument("merge: a row has index '" + text + "', expected a number");
+      }
+      if (!seen.emplace(index, true).second) {
+        throw std::invalid_argument("merge: variation " + text + " appears in two tables (a shard merged twice?)");
+      }
+      Cells cells;
+      for (std::size_t c = 0; c < t.columns.size(); ++c) {
+        if (!row[c].empty() || c == c_index) cells.emplace_back(t.columns[c], row[c]);
+      }
+      all.emplace_back(index, std::move(cells));
+    }
+  }
+  // Columns in order of first appearance over the tables, rows by index.
+  std::vector<Cells> header_order;
+  for (const SweepTable& t : tables) {
+    Cells names;
+    for (const auto& c : t.columns) names.emplace_back(c, "");
+    header_order.push_back(std::move(names));
+  }
+  SweepTable columns = to_table(header_order);
+  std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  SweepTable out;
+  out.columns = columns.columns;
+  std::map<std::string, std::size_t> at;
+  for (std::size_t c = 0; c < out.columns.size(); ++c) at[out.columns[c]] = c;
+  for (const auto& [index, cells] : all) {
+    std::vector<std::string> row(out.columns.size());
+    for (const auto& [k, v] : cells) row[at.at(k)] = v;
+    out.rows.push_back(std::move(row));
+  }
+  return out;
+}
+
+}  // namespace redres

@@ -30,7 +30,12 @@ std::string shortest(double v) {
 
 // A TOML value as the text `--set key=value` takes.
 std::string toml_text(const toml::node& node) {
-  if (const auto* f = node.as_floating_point()) return shortest(f->get());
+  if (const auto* f = node.as_floating_point()) {
+    // Stays a TOML float: 2.0, not 2 (an integer).
+    std::string text = shortest(f->get());
+    if (text.find_first_of(".eni") == std::string::npos) text += ".0";
+    return text;
+  }
   toml::table t;
   t.insert("v", node);
   std::ostringstream s;
@@ -237,7 +242,9 @@ SweepSpec load_sweep(const std::filesystem::path& file) {
   spec.scenario = r.path("scenario");
   if (r.has("set")) spec.set = r.strings("set");
   spec.zip = r.choice("combine", {"cross", "zip"}, "cross") == "zip";
-  for (const TableReader& t : r.tables("vary")) spec.axes.push_back(read_axis(t));
+  if (r.has("vary")) {
+    for (const TableReader& t : r.tables("vary")) spec.axes.push_back(read_axis(t));
+  }
   if (spec.zip) {
     for (const auto& a : spec.axes) {
       if (a.values.size() != spec.axes.front().values.size()) {

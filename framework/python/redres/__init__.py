@@ -47,7 +47,7 @@ __version__ = "0.1.0"
 __all__ = [
     "ConfigError", "Constraint", "Controller", "Kinematics", "Objective", "Result", "Robot", "Scenario", "StepContext",
     "StepInfo", "StepQp", "Comparison", "check_plugins", "compare", "constraints", "engines", "objectives", "paths",
-    "plugins", "register",
+    "plugins", "register", "sweep",
 ]
 
 
@@ -373,6 +373,15 @@ def compare(scenarios, overrides=None, jobs=None):
     with _ThreadPoolExecutor(max_workers=jobs) as pool:
         results = list(pool.map(lambda s: s.run(), loaded))
     return Comparison(results)
+
+
+def sweep(path, jobs=None, shard=None, out_dir=None):
+    """Runs a sweep file (docs/sweeps.md) as `redres sweep` does, on `jobs` threads (default: one per core) with the
+    GIL released, and returns its table: a list of dicts, one per variation in variation order, with the axes'
+    values, status, diagnosis and every summary figure (strings, as in sweep.csv). shard="i/N" runs one slice;
+    out_dir receives runs/<index>/ when the sweep file asks for each run's directory."""
+    columns, rows = _redres._sweep(path, jobs or 0, shard or "", _os.fspath(out_dir) if out_dir else "")
+    return [dict(zip(columns, row)) for row in rows]
 
 
 def _result_summary(self):

@@ -21,6 +21,7 @@
 #include "redres/run_summary.hpp"
 #include "redres/scenario.hpp"
 #include "redres/simulation.hpp"
+#include "redres/sweep.hpp"
 #include "redres/velocity_limit.hpp"
 #include "types.hpp"
 
@@ -461,6 +462,19 @@ PYBIND11_MODULE(_redres, m) {
           },
           "the last step's QP (copies): W, zeta, J, d, A, b, lo, hi");
 
+  m.def(
+      "_sweep",
+      [](const std::filesystem::path& file, unsigned jobs, const std::string& shard, const std::string& out_dir) {
+        const SweepSpec spec = load_sweep(file);
+        SweepTable table;
+        {
+          py::gil_scoped_release release;
+          table = run_sweep(spec, shard.empty() ? SweepShard{} : parse_shard(shard), jobs,
+                            out_dir.empty() ? std::filesystem::temp_directory_path() : std::filesystem::path(out_dir));
+        }
+        return py::make_tuple(table.columns, table.rows);
+      },
+      py::arg("file"), py::arg("jobs") = 0, py::arg("shard") = "", py::arg("out_dir") = "");
   m.def("_registry", &registry_listing);
   bind_python_plugins(m);
 }

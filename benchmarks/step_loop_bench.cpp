@@ -1,0 +1,77 @@
+// The full paper run through the library against the hand-written baseline (paper_baseline.cpp), in the same
+// process: the TVCMM R of the paper's arm, T = 40 s at tau = 1 ms (40,001 steps).
+//   BM_PaperRun/baseline                 the hand-written loop (recording theta, x, w of every step)
+//   BM_PaperRun/redres_newton            simulate() with newton (recording every column in memory)
+//   BM_PaperRun/redres_projection        simulate() with the paper's eq. 15
+//   BM_PaperRun/redres_newton_no_record  Controller::step and Euler integration only (no recording)
+// per_step is the time per step (s). The ratio to the baseline is the framework's cost.
+
+#include <benchmark/benchmark.h>
+
+#include "paper_baseline_setup.hpp"
+#include "redres/simulation.hpp"
+
+namespace redres {
+namespace {
+
+Scenario paper_scenario(const char* engine) {
+  return load_scenario(std::string(REDRES_SOURCE_DIR) + "/configs/paper_r_tvcmm.toml",
+                       {"step=0.001", std::string("solver.engine=") + engine});
+}
+
+void per_step(benchmark::State& state, int steps) {
+  state.counters["per_step"] =
+      benchmark::Counter(steps + 1, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+void BM_PaperRun_Baseline(benchmark::State& state) {
+  const Scenario s = paper_scenario("newton");
+  const baseline::Case c = baseline::paper_case(s);
+  baseline::Record record;
+  record.rows.resize(static_cast<std::size_t>(c.steps + 1) * 13);
+  for (auto _ : state) {
+    record.iterations = 0;
+    benchmark::DoNotOptimize(baseline::run(c.arm, c.theta0, c.r_d.data(), c.r_d_dot.data(), c.steps, c.tau, record));
+  }
+  per_step(state, c.steps);
+}
+
+void BM_PaperRun_Redres(benchmark::State& state, const char* engine) {
+  Scenario s = paper_scenario(engine);
+  for (auto _ : state) {
+    const RunResult run = simulate(s);
+    if (run.failures != 0) state.SkipWithError(run.first_failure.c_str());
+    benchmark::DoNotOptimize(run.trajectory.values().data());
+  }
+  per_step(state, s.steps());
+}
+
+void BM_PaperRun_RedresNoRecord(benchmark::State& state) {
+  Scenario s = paper_scenario("newton");
+  Controller ctrl(*s.robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
+  StepOutput out = ctrl.make_output();
+  Eigen::VectorXd theta(s.robot->dof());
+  const int steps = s.steps();
+  for (auto _ : state) {
+    theta = s.theta0;
+    ctrl.reset();
+    for (int k = 0; k <= steps; ++k) {
+      ctrl.step(theta, k == steps ? s.duration : k * s.tau, out);
+      if (k < steps) theta += s.tau * out.theta_dot;
+    }
+    benchmark::DoNotOptimize(theta.data());
+  }
+  per_step(state, steps);
+}
+
+BENCHMARK(BM_PaperRun_Baseline)->Name("BM_PaperRun/baseline")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_PaperRun_Redres, redres_newton, "newton")
+    ->Name("BM_PaperRun/redres_newton")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_PaperRun_Redres, redres_projection, "projection")
+    ->Name("BM_PaperRun/redres_projection")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PaperRun_RedresNoRecord)->Name("BM_PaperRun/redres_newton_no_record")->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace redres

@@ -57,23 +57,42 @@ void check_finite(const M& m, const char* kind, const std::string& name, const c
 
 }  // namespace
 
+// The checks after a contribution look at what the plugin can have written, and only at that: zeta and the part of
+// W it added to (nothing, the diagonal, or all of it, then also its symmetry) for an objective, its own rows for a
+// constraint. The scan is the fast one (x - x is 0 exactly for finite x); check_finite names the entry on failure.
+template <class M>
+bool all_finite(const M& m) {
+  return (m.array() - m.array()).sum() == 0.0;
+}
+
 void Objective::contribute(const Context& ctx, QpBuilder& builder) const {
   if (!active()) return;
   add_to(ctx, builder);
   const QpProblem& qp = builder.problem();
-  check_finite(qp.W, "objective", name(), "W");
-  check_finite(qp.zeta, "objective", name(), "zeta");
-  if (!qp.W.isApprox(qp.W.transpose(), 1e-12)) bad_output("objective", name(), "W is not symmetric");
+  if (!all_finite(qp.zeta)) check_finite(qp.zeta, "objective", name(), "zeta");
+  switch (builder.written_w()) {
+    case QpBuilder::WrittenW::kNone: break;
+    case QpBuilder::WrittenW::kDiagonal:
+      if (!all_finite(qp.W.diagonal())) check_finite(qp.W, "objective", name(), "W");
+      break;
+    case QpBuilder::WrittenW::kFull:
+      if (!all_finite(qp.W)) check_finite(qp.W, "objective", name(), "W");
+      if (!qp.W.isApprox(qp.W.transpose(), 1e-12)) bad_output("objective", name(), "W is not symmetric");
+      break;
+  }
 }
 
 void Constraint::contribute(const Context& ctx, QpBuilder& builder) const {
   if (!active()) return;
   add_to(ctx, builder);
-  const QpProblem& qp = builder.problem();
-  check_finite(qp.J, "constraint", name(), "J");
-  check_finite(qp.d, "constraint", name(), "d");
-  check_finite(qp.A, "constraint", name(), "A");
-  check_finite(qp.b, "constraint", name(), "b");
+  // Entries are named by the constraint's own row (0-based), e.g. "its J(1, 4)".
+  const auto check = [this](const auto& m, const char* what) {
+    if (!all_finite(m)) check_finite(m, "constraint", name(), what);
+  };
+  check(builder.own_equality_rows(), "its J");
+  check(builder.own_equality_rhs(), "its d");
+  check(builder.own_inequality_rows(), "its A");
+  check(builder.own_inequality_rhs(), "its b");
 }
 
 ObjectiveRegistry& objective_registry() {

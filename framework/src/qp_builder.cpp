@@ -14,18 +14,24 @@ void QpBuilder::begin(int source, double weight, int eq_offset, int eq_rows, int
   eq_rows_ = eq_rows;
   in_offset_ = in_offset;
   in_rows_ = in_rows;
+  written_w_ = WrittenW::kNone;
 }
 
-void QpBuilder::add_identity(double scale) { qp_->W.diagonal().array() += weight_ * scale; }
+void QpBuilder::add_identity(double scale) {
+  qp_->W.diagonal().array() += weight_ * scale;
+  wrote_w(WrittenW::kDiagonal);
+}
 
 void QpBuilder::add_diagonal(const Eigen::Ref<const Eigen::VectorXd>& diagonal) {
   REDRES_REQUIRE(diagonal.size() == qp_->n(), "QpBuilder::add_diagonal", "diagonal.size() == n");
   qp_->W.diagonal() += weight_ * diagonal;
+  wrote_w(WrittenW::kDiagonal);
 }
 
 void QpBuilder::add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H) {
   REDRES_REQUIRE(H.rows() == qp_->n() && H.cols() == qp_->n(), "QpBuilder::add_hessian", "H is n x n");
   qp_->W += weight_ * H;
+  wrote_w(WrittenW::kFull);
   for (Eigen::Index c = 0; c < H.cols(); ++c) {
     for (Eigen::Index r = 0; r < H.rows(); ++r) {
       if (r != c && H(r, c) != 0.0) qp_->w_diagonal = false;

@@ -3,6 +3,8 @@
 /// QpBuilder: how a plugin writes its terms, rows and bounds into the step's QP. The framework positions it on the
 /// plugin's rows (and, for objectives, its weight) before each contribution.
 
+#include <algorithm>
+
 #include <Eigen/Core>
 
 #include "redres/qp.hpp"
@@ -42,12 +44,22 @@ class QpBuilder {
 
   /// Framework use: positions the builder on one plugin.
   void begin(int source, double weight, int eq_offset, int eq_rows, int in_offset, int in_rows);
+  /// Framework use: what the plugin positioned by begin() added to W: nothing, its diagonal only, or any entry.
+  enum class WrittenW { kNone, kDiagonal, kFull };
+  [[nodiscard]] WrittenW written_w() const noexcept { return written_w_; }
+  /// Framework use: the plugin's own rows, read-only (for the checks after its contribution).
+  [[nodiscard]] auto own_equality_rows() const { return qp_->J.middleRows(eq_offset_, eq_rows_); }
+  [[nodiscard]] auto own_equality_rhs() const { return qp_->d.segment(eq_offset_, eq_rows_); }
+  [[nodiscard]] auto own_inequality_rows() const { return qp_->A.middleRows(in_offset_, in_rows_); }
+  [[nodiscard]] auto own_inequality_rhs() const { return qp_->b.segment(in_offset_, in_rows_); }
 
  private:
   QpProblem* qp_;
   int source_ = -1;
   double weight_ = 1.0;
   int eq_offset_ = 0, eq_rows_ = 0, in_offset_ = 0, in_rows_ = 0;
+  WrittenW written_w_ = WrittenW::kNone;
+  void wrote_w(WrittenW w) noexcept { written_w_ = std::max(written_w_, w); }
 };
 
 }  // namespace redres

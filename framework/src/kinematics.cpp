@@ -42,7 +42,8 @@ KinematicsData::KinematicsData(const RobotModel& model)
       weighted_(Eigen::MatrixXd::Zero(model.task_dim(), model.dof())),
       products_(Eigen::VectorXd::Zero(model.task_dim())),
       eig_(model.task_dim()),
-      svd_(model.task_dim(), model.dof(), Eigen::ComputeThinU | Eigen::ComputeThinV) {}
+      svd_(model.task_dim(), model.dof(), Eigen::ComputeThinU | Eigen::ComputeThinV),
+      linear_(Eigen::Matrix3Xd::Zero(3, model.dof())) {}
 
 double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> adj,
                               TaskEigenSolver& eig) {
@@ -87,6 +88,53 @@ double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen:
   }
 }
 
+void kinematic_hessian_general(const RobotModel& model, KinematicsData& data) {
+  // A unit rate of joint i moves every axis z_j and point p_j with j > i, and p_e.
+  const int n = model.dof();
+  const Vector3d p_e = data.ee_pose.translation();
+  for (int i = 0; i < n; ++i) {
+    const bool rev_i = model.joint(i).type == JointType::kRevolute;
+    const Vector3d z_i = data.axes.col(i);
+    const Vector3d p_i = data.origins.col(i);
+    const Vector3d dp_e = joint_motion(rev_i, z_i, p_i, p_e);
+    auto block = data.dJ_block(i);
+    for (int j = 0; j < n; ++j) {
+      const Vector3d z_j = data.axes.col(j);
+      const Vector3d p_j = data.origins.col(j);
+      const bool downstream = i < j;
+      const Vector3d dz_j = (downstream && rev_i) ? Vector3d(z_i.cross(z_j)) : Vector3d::Zero();
+      const Vector3d dp_j = downstream ? joint_motion(rev_i, z_i, p_i, p_j) : Vector3d::Zero();
+      if (model.joint(j).type == JointType::kRevolute) {
+        put_rows(model, dz_j.cross(p_e - p_j) + z_j.cross(dp_e - dp_j), dz_j, block, j);
+      } else {
+        put_rows(model, dz_j, Vector3d::Zero(), block, j);
+      }
+    }
+  }
+}
+
+void kinematic_hessian_revolute(const RobotModel& model, KinematicsData& data) {
+  // With revolute joints only, the motion of joint i turns everything downstream about z_i, so (by the Jacobi
+  // identity) d(z_j x (p_e - p_j))/dtheta_i = z_i x Jv_j for i <= j and z_j x Jv_i for i > j, with
+  // Jv_j = z_j x (p_e - p_j); and dz_j/dtheta_i = z_i x z_j for i < j, else 0. One cross product per entry.
+  const int n = model.dof();
+  const Vector3d p_e = data.ee_pose.translation();
+  auto& lin = data.linear_;
+  for (int j = 0; j < n; ++j) lin.col(j) = data.axes.col(j).cross(p_e - data.origins.col(j));
+  for (int i = 0; i < n; ++i) {
+    const Vector3d z_i = data.axes.col(i);
+    auto block = data.dJ_block(i);
+    for (int j = 0; j < n; ++j) {
+      if (i <= j) {
+        const Vector3d z_j = data.axes.col(j);
+        put_rows(model, z_i.cross(lin.col(j)), i < j ? Vector3d(z_i.cross(z_j)) : Vector3d::Zero(), block, j);
+      } else {
+        put_rows(model, data.axes.col(j).cross(lin.col(i)), Vector3d::Zero(), block, j);
+      }
+    }
+  }
+}
+
 void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
                         KinematicsLevel level) {
   const int n = model.dof();
@@ -102,21 +150,36 @@ void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::V
   // Forward pass: joint frames and end-effector pose.
   Eigen::Isometry3d T = model.base();
   double phi = model.base_angle();  // planar end-effector angle, kept unwrapped
+  // The short cuts (frame_shape) skip products with the identity and with zeros: they give the very bits of the
+  // full products, which add only exact zeros to the same terms in the same order.
   for (int j = 0; j < n; ++j) {
     const JointSpec& joint = model.joint(j);
     const Vector3d& u = model.axis(j);
-    T = T * model.before(j);
+    const RobotModel::FrameShape& shape = model.frame_shape(j);
+    if (!shape.before_identity) T = T * model.before(j);
     // For the z axis, T.linear() * u is T's third column exactly (products with 0 and 1 round nothing).
-    data.axes.col(j) = T.linear() * u;
+    data.axes.col(j) = shape.z_axis ? Vector3d(T.linear().col(2)) : Vector3d(T.linear() * u);
     data.origins.col(j) = T.translation();
     if (joint.type == JointType::kRevolute) {
-      T.rotate(Eigen::AngleAxisd(theta(j), u));
+      if (shape.z_axis) {
+        // T.rotate(Rz(theta)): the first two columns turn by theta, the third stays.
+        const double c = std::cos(theta(j)), s = std::sin(theta(j));
+        const Vector3d c0 = T.linear().col(0), c1 = T.linear().col(1);
+        T.linear().col(0) = c0 * c + c1 * s;
+        T.linear().col(1) = c0 * -s + c1 * c;
+      } else {
+        T.rotate(Eigen::AngleAxisd(theta(j), u));
+      }
       phi += theta(j);
     } else {
       T.translate(theta(j) * u);
     }
     data.link_frames[static_cast<std::size_t>(j)] = T;
-    T = T * model.after(j);
+    if (shape.after_translation) {
+      T.translation() += T.linear() * model.after(j).translation();
+    } else {
+      T = T * model.after(j);
+    }
   }
   T = T * model.end_effector();
   data.ee_pose = T;
@@ -151,25 +214,10 @@ void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::V
   data.level = KinematicsLevel::kJacobian;
   if (level == KinematicsLevel::kJacobian) return;
 
-  // Kinematic Hessian. A unit rate of joint i moves every axis z_j and point p_j with j > i, and p_e.
-  for (int i = 0; i < n; ++i) {
-    const bool rev_i = model.joint(i).type == JointType::kRevolute;
-    const Vector3d z_i = data.axes.col(i);
-    const Vector3d p_i = data.origins.col(i);
-    const Vector3d dp_e = joint_motion(rev_i, z_i, p_i, p_e);
-    auto block = data.dJ_block(i);
-    for (int j = 0; j < n; ++j) {
-      const Vector3d z_j = data.axes.col(j);
-      const Vector3d p_j = data.origins.col(j);
-      const bool downstream = i < j;
-      const Vector3d dz_j = (downstream && rev_i) ? Vector3d(z_i.cross(z_j)) : Vector3d::Zero();
-      const Vector3d dp_j = downstream ? joint_motion(rev_i, z_i, p_i, p_j) : Vector3d::Zero();
-      if (model.joint(j).type == JointType::kRevolute) {
-        put_rows(model, dz_j.cross(p_e - p_j) + z_j.cross(dp_e - dp_j), dz_j, block, j);
-      } else {
-        put_rows(model, dz_j, Vector3d::Zero(), block, j);
-      }
-    }
+  if (model.all_revolute()) {
+    kinematic_hessian_revolute(model, data);
+  } else {
+    kinematic_hessian_general(model, data);
   }
 
   // w = det(J J') and q_i = 2 <adj(J J') J, dJ_i>_F.

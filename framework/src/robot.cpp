@@ -140,6 +140,12 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
     // z stays exactly (0, 0, 1) (normalising it changes nothing), so the DH chains compute as before.
     axes_.push_back(jt.axis.normalized());
   }
+  for (int j = 0; j < n; ++j) {
+    const auto J = static_cast<std::size_t>(j);
+    all_revolute_ = all_revolute_ && joint(j).type == JointType::kRevolute;
+    shapes_.push_back({before_[J].matrix() == Eigen::Matrix4d::Identity(),
+                       after_[J].linear() == Eigen::Matrix3d::Identity(), axes_[J] == Vector3d::UnitZ()});
+  }
   const Eigen::Matrix3d& R = spec_.base.linear();
   base_angle_ = spec_.kind == ChainKind::kPlanar ? std::atan2(R(1, 0), R(0, 0)) : 0.0;
   for (int j = 0; j < n; ++j) {

@@ -99,6 +99,23 @@ RC_GTEST_PROP(KinematicsProperty, HessianMatchesCentralDifferencesOfJ, ()) {
   }
 }
 
+// The two Hessian formulas (kinematics.hpp) agree wherever both apply: on chains of revolute joints only (random
+// chains with their prismatic joints made revolute), the general one and the one cross product per entry.
+RC_GTEST_PROP(KinematicsProperty, TheRevoluteHessianIsTheGeneralOne, ()) {
+  RobotSpec spec = *rc::gen::arbitrary<bool>() ? random_planar(*rc::gen::inRange(2, 10), TaskRows::kPose)
+                                               : random_spatial(*rc::gen::inRange(2, 10), TaskRows::kPose);
+  for (auto& j : spec.joints) j.type = JointType::kRevolute;
+  const RobotModel model(std::move(spec));
+  RC_ASSERT(model.all_revolute());
+  KinematicsData a(model), b(model);
+  const Eigen::VectorXd theta = random_theta(model);
+  compute_kinematics(model, theta, a, KinematicsLevel::kJacobian);
+  compute_kinematics(model, theta, b, KinematicsLevel::kJacobian);
+  kinematic_hessian_general(model, a);
+  kinematic_hessian_revolute(model, b);
+  expect_close(b.dJ, a.dJ, 1e-12, "dJ");
+}
+
 RC_GTEST_PROP(KinematicsProperty, ManipulabilityGradientsMatchCentralDifferences, ()) {
   const RobotModel model = random_model();
   const Eigen::VectorXd theta = random_theta(model);

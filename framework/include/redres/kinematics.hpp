@@ -63,13 +63,23 @@ class KinematicsData {
  private:
   friend void compute_kinematics(const RobotModel&, const Eigen::Ref<const Eigen::VectorXd>&, KinematicsData&,
                                  KinematicsLevel);
+  friend void kinematic_hessian_revolute(const RobotModel&, KinematicsData&);
   Eigen::MatrixXd jjt_;                    // A = J J' (m x m)
   Eigen::MatrixXd adj_;                    // adj(A) (m x m)
   Eigen::MatrixXd weighted_;               // adj(A) J or U diag(c) V' (m x n)
   Eigen::VectorXd products_;               // prod_{j != k} s_j (m)
   TaskEigenSolver eig_;                    // for adj(A) when m > 3
   Eigen::JacobiSVD<Eigen::MatrixXd> svd_;  // for mu
+  Eigen::Matrix3Xd linear_;                // the linear part of every joint's Jacobian column (3 x n)
 };
+
+/// The kinematic Hessian dJ/dtheta_i into data.dJ from the frames, axes, origins and end-effector pose already in
+/// `data` (compute_kinematics at kJacobian). Two formulas, which compute_kinematics chooses between: the general one
+/// (any joints: the motion of each joint applied to every downstream axis and point), and for chains of revolute
+/// joints only the same derivative written as one cross product per entry (z_i x Jv_j). The tests check both
+/// against central differences and against each other.
+void kinematic_hessian_general(const RobotModel& model, KinematicsData& data);
+void kinematic_hessian_revolute(const RobotModel& model, KinematicsData& data);
 
 /// Evaluates the kinematics of `model` at `theta` into `data`. Throws std::invalid_argument when theta has the
 /// wrong size or is not finite. Allocation-free.

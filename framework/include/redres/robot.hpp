@@ -146,6 +146,16 @@ class RobotModel {
   /// Fixed transforms before and after joint j's motion.
   [[nodiscard]] const Eigen::Isometry3d& before(int j) const { return before_[static_cast<std::size_t>(j)]; }
   [[nodiscard]] const Eigen::Isometry3d& after(int j) const { return after_[static_cast<std::size_t>(j)]; }
+  /// The shape of joint j's fixed transforms and axis, for the kinematics' short cuts (which compute the products
+  /// they stand for exactly): before(j) is the identity, after(j) a pure translation, the axis exactly z.
+  struct FrameShape {
+    bool before_identity = false;
+    bool after_translation = false;
+    bool z_axis = false;
+  };
+  [[nodiscard]] const FrameShape& frame_shape(int j) const { return shapes_[static_cast<std::size_t>(j)]; }
+  /// Whether every joint is revolute.
+  [[nodiscard]] bool all_revolute() const noexcept { return all_revolute_; }
   /// File the model was loaded from (empty when built in code).
   [[nodiscard]] const std::string& source() const noexcept { return spec_.source; }
   /// The spec the model was built from.
@@ -176,6 +186,8 @@ class RobotModel {
   Eigen::VectorXd lower_, upper_;
   std::vector<Eigen::Isometry3d> before_, after_;
   std::vector<Eigen::Vector3d> axes_;
+  std::vector<FrameShape> shapes_;
+  bool all_revolute_ = true;
   double base_angle_ = 0.0;
   std::vector<LinkShape> link_shapes_;
 };

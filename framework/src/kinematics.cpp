@@ -230,9 +230,16 @@ void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::V
 
   // mu = prod s_k and d mu = sum_k (prod_{j != k} s_j) u_k' dJ v_k. With fewer joints than task rows a
   // singular value is identically zero, so mu and its gradient vanish.
+  // Away from singularities, mu = sqrt(w) and grad mu = grad w / (2 mu) give the same without a singular value
+  // decomposition: used while w is at least 1e-4 of (trace(J J') / m)^m, the value w would have with all singular
+  // values equal, where the division loses at most about 1e-12 relatively (tested against the decomposition).
+  const double mean_square = data.jjt_.trace() / static_cast<double>(model.task_dim());
   if (n < model.task_dim()) {
     data.mu = 0.0;
     data.grad_mu.setZero();
+  } else if (data.w >= 1e-4 * std::pow(mean_square, model.task_dim()) && data.w > 0.0) {
+    data.mu = std::sqrt(data.w);
+    data.grad_mu = data.grad_w / (2.0 * data.mu);
   } else {
     data.svd_.compute(data.J, Eigen::ComputeThinU | Eigen::ComputeThinV);
     const auto& s = data.svd_.singularValues();

@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include <gtest/gtest.h>
+
+#include <Eigen/SVD>
 #include <rapidcheck/gtest.h>
 
 #include "alloc_counter.hpp"
@@ -114,6 +116,31 @@ RC_GTEST_PROP(KinematicsProperty, TheRevoluteHessianIsTheGeneralOne, ()) {
   kinematic_hessian_general(model, a);
   kinematic_hessian_revolute(model, b);
   expect_close(b.dJ, a.dJ, 1e-12, "dJ");
+}
+
+// mu and grad mu, whichever way compute_kinematics takes (sqrt(w) away from singularities, the singular value
+// decomposition near them), are those of the decomposition: mu = prod s_k, d mu = sum_k prod_{j != k} s_j u_k' dJ v_k.
+RC_GTEST_PROP(KinematicsProperty, YoshikawaIsThatOfTheSingularValues, ()) {
+  const RobotModel model = random_model();
+  RC_PRE(model.dof() >= model.task_dim());
+  KinematicsData k(model);
+  compute_kinematics(model, random_theta(model), k, KinematicsLevel::kAll);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(k.J, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  double mu = 1.0;
+  for (Eigen::Index i = 0; i < sv.size(); ++i) mu *= sv(i);
+  Eigen::VectorXd grad(model.dof());
+  for (int i = 0; i < model.dof(); ++i) {
+    double g = 0.0;
+    for (Eigen::Index a = 0; a < sv.size(); ++a) {
+      double others = 1.0;
+      for (Eigen::Index b = 0; b < sv.size(); ++b) others *= b == a ? 1.0 : sv(b);
+      g += others * svd.matrixU().col(a).dot(k.dJ_block(i) * svd.matrixV().col(a));
+    }
+    grad(i) = g;
+  }
+  RC_ASSERT(std::abs(k.mu - mu) <= 1e-10 * (1.0 + mu));
+  expect_close(k.grad_mu, grad, 1e-8, "grad mu");
 }
 
 RC_GTEST_PROP(KinematicsProperty, ManipulabilityGradientsMatchCentralDifferences, ()) {

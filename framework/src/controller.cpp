@@ -17,7 +17,9 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
       path_(path),
       kin_(robot),
       r_d_(Eigen::VectorXd::Zero(robot.reference_dim())),
-      r_d_dot_(Eigen::VectorXd::Zero(robot.reference_dim())) {
+      r_d_dot_(Eigen::VectorXd::Zero(robot.reference_dim())),
+      vlo_(Eigen::VectorXd::Zero(robot.dof())),
+      vhi_(Eigen::VectorXd::Zero(robot.dof())) {
   REDRES_REQUIRE(&scheme.robot() == &robot, "Controller", "the scheme was built for this robot");
   REDRES_REQUIRE(T > 0.0 && tau > 0.0, "Controller", "T > 0 and tau > 0");
   if (path != nullptr) {
@@ -34,6 +36,8 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
   ctx_.kinematics = &kin_;
   ctx_.r_d = &r_d_;
   ctx_.r_d_dot = &r_d_dot_;
+  ctx_.velocity_lower = &vlo_;
+  ctx_.velocity_upper = &vhi_;
 }
 
 StepOutput Controller::make_output() const {
@@ -105,6 +109,7 @@ void Controller::solve(double t, StepOutput& out) {
   REDRES_REQUIRE(out.theta_dot.size() == robot_->dof(), "Controller::step",
                  "out was made by make_output() (theta_dot has n entries)");
   ctx_.t = t;
+  robot_->velocity_limits(kin_.theta, vlo_, vhi_);
   scheme_->build(ctx_, qp_);
   engine_->solve(qp_, result_);
   out.theta_dot = result_.x;

@@ -1,5 +1,6 @@
 #include "redres/kinematics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -121,6 +122,18 @@ void kinematic_hessian_revolute(const RobotModel& model, KinematicsData& data) {
   const Vector3d p_e = data.ee_pose.translation();
   auto& lin = data.linear_;
   for (int j = 0; j < n; ++j) lin.col(j) = data.axes.col(j).cross(p_e - data.origins.col(j));
+  if (model.kind() == ChainKind::kPlanar) {
+    // Every axis is the world z: z x v = (-v_y, v_x, 0) exactly (the cross product's other terms are exact zeros),
+    // and z_i x z_j = 0.
+    for (int i = 0; i < n; ++i) {
+      auto block = data.dJ_block(i);
+      for (int j = 0; j < n; ++j) {
+        const int c = std::max(i, j);
+        put_rows(model, Vector3d(-lin(1, c), lin(0, c), 0.0), Vector3d::Zero(), block, j);
+      }
+    }
+    return;
+  }
   for (int i = 0; i < n; ++i) {
     const Vector3d z_i = data.axes.col(i);
     auto block = data.dJ_block(i);

@@ -88,7 +88,7 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   ctrl.set_orientation_turn(s.orientation_turn);
   ctrl.set_kinematics_level(KinematicsLevel::kManipulability);
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
-  Eigen::VectorXd theta = s.theta0, theta_pred(n), vlo(n), vhi(n);
+  Eigen::VectorXd theta = s.theta0, theta_pred(n);
   const bool orientation_rows = robot.has_orientation_rows();
   const bool spatial_orientation = orientation_rows && robot.kind() == ChainKind::kSpatial;
   bool all_position_rows = true, all_orientation_rows = true;
@@ -132,7 +132,8 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
     ctrl.step(theta, t, out);
     const KinematicsData& kin = ctrl.kinematics();
     const QpProblem& qp = ctrl.qp();
-    robot.velocity_limits(theta, vlo, vhi);
+    const Eigen::VectorXd& vlo = ctrl.velocity_lower();  // the laws at theta, as the step evaluated them
+    const Eigen::VectorXd& vhi = ctrl.velocity_upper();
     double* row = run.trajectory.append_row();
     std::size_t c = 0;
     row[c++] = t;

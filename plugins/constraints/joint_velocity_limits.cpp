@@ -18,6 +18,12 @@ void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder) const {
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
   const double scale = config_.scale;
+  if (ctx.velocity_lower != nullptr && ctx.velocity_upper != nullptr) {
+    for (int j = 0; j < robot.dof(); ++j) {
+      builder.intersect_bound(j, scale * (*ctx.velocity_lower)(j), scale * (*ctx.velocity_upper)(j));
+    }
+    return;
+  }
   for (int j = 0; j < robot.dof(); ++j) {
     const VelocityBounds b = robot.joint(j).velocity_limit->bounds(theta(j));
     builder.intersect_bound(j, scale * b.lower, scale * b.upper);

@@ -66,6 +66,9 @@ class Controller {
   [[nodiscard]] const QpProblem& qp() const noexcept { return qp_; }
   [[nodiscard]] const Eigen::VectorXd& r_d() const noexcept { return r_d_; }
   [[nodiscard]] const Eigen::VectorXd& r_d_dot() const noexcept { return r_d_dot_; }
+  /// The velocity-limit laws at the last step's theta (n each).
+  [[nodiscard]] const Eigen::VectorXd& velocity_lower() const noexcept { return vlo_; }
+  [[nodiscard]] const Eigen::VectorXd& velocity_upper() const noexcept { return vhi_; }
   [[nodiscard]] const SolverResult& result() const noexcept { return result_; }
   [[nodiscard]] const RobotModel& robot() const noexcept { return *robot_; }
 
@@ -80,6 +83,7 @@ class Controller {
   QpProblem qp_;
   SolverResult result_;
   Eigen::VectorXd r_d_, r_d_dot_;
+  Eigen::VectorXd vlo_, vhi_;  // the velocity-limit laws at theta, once per step
   Eigen::Vector3d orientation_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d turn_ = Eigen::Vector3d::Zero();  // set_orientation_turn(); zero: hold
   bool orientation_set_ = false;                    // by set_orientation_reference()

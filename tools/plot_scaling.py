@@ -1,0 +1,38 @@
+#!/usr/bin/env python3
+"""Plots BM_Scaling (redres-bench --benchmark_filter=Scaling --benchmark_out=FILE --benchmark_out_format=json):
+time per control step against the number of joints, per engine, planar and spatial chains, on log-log axes.
+
+    plot_scaling.py BENCH.json OUT.png
+"""
+import json
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+if len(sys.argv) != 3:
+    sys.exit(__doc__)
+with open(sys.argv[1]) as f:
+    runs = [b for b in json.load(f)["benchmarks"] if b["name"].startswith("BM_Scaling/")]
+series = {}
+for b in runs:
+    _, case, n = b["name"].split("/")[:3]
+    engine, kind = case.rsplit("_", 1)
+    series.setdefault((kind, engine), []).append((int(n), b["per_step"] * 1e6))
+fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
+for ax, kind in zip(axes, ("planar", "spatial")):
+    for (k, engine), points in sorted(series.items()):
+        if k != kind:
+            continue
+        points.sort()
+        ax.loglog([p[0] for p in points], [p[1] for p in points], "o-", label=engine)
+    ax.set_title(f"{kind} chains")
+    ax.set_xlabel("joints n")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend()
+axes[0].set_ylabel("time per step (us)")
+fig.tight_layout()
+fig.savefig(sys.argv[2], dpi=120)
+print(f"written: {sys.argv[2]}")

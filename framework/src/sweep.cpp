@@ -28,24 +28,6 @@ std::string shortest(double v) {
   return std::string(buf, std::to_chars(buf, buf + sizeof(buf), v).ptr);
 }
 
-// A TOML value as the text `--set key=value` takes.
-std::string toml_text(const toml::node& node) {
-  if (const auto* f = node.as_floating_point()) {
-    // Stays a TOML float: 2.0, not 2 (an integer).
-    std::string text = shortest(f->get());
-    if (text.find_first_of(".eni") == std::string::npos) text += ".0";
-    return text;
-  }
-  toml::table t;
-  t.insert("v", node);
-  std::ostringstream s;
-  s << t;
-  const std::string text = s.str();
-  const auto eq = text.find("= ");
-  std::string out = eq == std::string::npos ? text : text.substr(eq + 2);
-  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
-  return out;
-}
 
 // How a value is shown in sweep.csv: TOML text, strings without their quotes.
 std::string cell_text(const std::string& toml) {
@@ -62,7 +44,7 @@ SweepAxis read_axis(const TableReader& t) {
   if (has_values) {
     const toml::array* values = t.raw().get("values")->as_array();
     if (values == nullptr || values->empty()) t.fail("values", "expected a non-empty array of values");
-    for (const auto& v : *values) axis.values.push_back(toml_text(v));
+    for (const auto& v : *values) axis.values.push_back(toml_value_text(v));
   } else {
     const TableReader range = t.table("range");
     const double start = range.number("start"), stop = range.number("stop"), step = range.number("step");

@@ -1,5 +1,6 @@
 #include "redres/toml_reader.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -60,6 +61,24 @@ SourceLocation location_of(const TomlFile& file, const toml::node& node) {
   // A value spliced in from elsewhere (e.g. a --set override) keeps the name of where it came from.
   const std::string where = src.path && !src.path->empty() ? *src.path : file.path.string();
   return {where, src.begin.line, src.begin.column};
+}
+
+std::string toml_value_text(const toml::node& node) {
+  if (const auto* f = node.as_floating_point()) {
+    char buf[64];
+    std::string text(buf, std::to_chars(buf, buf + sizeof(buf), f->get()).ptr);
+    if (text.find_first_of(".eni") == std::string::npos) text += ".0";
+    return text;
+  }
+  toml::table t;
+  t.insert("v", node);
+  std::ostringstream s;
+  s << t;
+  const std::string text = s.str();
+  const auto eq = text.find("= ");
+  std::string out = eq == std::string::npos ? text : text.substr(eq + 2);
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return out;
 }
 
 std::string describe_type(const toml::node& node) {

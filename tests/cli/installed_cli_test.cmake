@@ -5,29 +5,8 @@
 # python3 on PATH, no matplotlib, a failing python3) are an error with exit code 2 and a message on stderr.
 # The scratch directory is removed when the test passes and kept, for a look, when it fails.
 
-# Scratch space outside both trees, so that a path that still pointed into them would be noticed.
-if(DEFINED ENV{TMPDIR} AND IS_DIRECTORY "$ENV{TMPDIR}")
-  set(tmp "$ENV{TMPDIR}")
-else()
-  set(tmp /tmp)
-endif()
-string(RANDOM LENGTH 8 tag)
-file(REAL_PATH ${tmp}/redres-installed-cli-${tag} work)
-foreach(tree ${SOURCE_DIR} ${BUILD_DIR})
-  file(REAL_PATH ${tree} tree)
-  string(FIND "${work}/" "${tree}/" at)
-  if(at EQUAL 0)
-    message(FATAL_ERROR "the scratch directory ${work} is inside ${tree}; set TMPDIR to a directory outside it")
-  endif()
-endforeach()
-file(REMOVE_RECURSE ${work})
-file(MAKE_DIRECTORY ${work})
-
-set(RUN_FAILURE_NOTE "(scratch directory kept: ${work})")
-include(${CMAKE_CURRENT_LIST_DIR}/run_checked.cmake)
-
-set(prefix ${work}/prefix)
-run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+set(SCRATCH_NAME installed-cli)
+include(${CMAKE_CURRENT_LIST_DIR}/scratch_install.cmake)
 set(redres ${prefix}/bin/redres)
 
 # The installed binary names neither tree (the build's RPATH is rewritten on install; the build tree's path starts

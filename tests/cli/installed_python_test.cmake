@@ -2,20 +2,8 @@
 # and build trees, then imports redres from <prefix>/PYTHON_DIR with PYTHON (the interpreter it was built for), from
 # a scratch working directory, and runs the installed paper scenario through it. Checks that the module came from
 # the prefix and that its run matches the installed CLI's. The scratch directory is removed when the test passes.
-if(DEFINED ENV{TMPDIR} AND IS_DIRECTORY "$ENV{TMPDIR}")
-  set(tmp "$ENV{TMPDIR}")
-else()
-  set(tmp /tmp)
-endif()
-string(RANDOM LENGTH 8 tag)
-file(REAL_PATH ${tmp}/redres-installed-python-${tag} work)
-file(REMOVE_RECURSE ${work})
-file(MAKE_DIRECTORY ${work})
-set(RUN_FAILURE_NOTE "(scratch directory kept: ${work})")
-include(${CMAKE_CURRENT_LIST_DIR}/run_checked.cmake)
-
-set(prefix ${work}/prefix)
-run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+set(SCRATCH_NAME installed-python)
+include(${CMAKE_CURRENT_LIST_DIR}/scratch_install.cmake)
 file(WRITE ${work}/check.py [=[
 import json, pathlib, subprocess, sys
 import redres

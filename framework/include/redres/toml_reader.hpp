@@ -39,6 +39,10 @@ struct TomlFile {
 /// Human-readable TOML type of a node ("a string", "an array", ...).
 [[nodiscard]] std::string describe_type(const toml::node& node);
 
+/// A TOML value as the text that reads back as it (what `--set key=value` takes): floats in their shortest
+/// round-trip form, still floats ("2.0", not "2"); strings quoted; arrays and tables inline.
+[[nodiscard]] std::string toml_value_text(const toml::node& node);
+
 /// Reads one table strictly. Cheap to copy; it refers to the TomlFile, which must outlive it.
 class TableReader {
  public:

@@ -64,16 +64,6 @@ void convert(py::handle v, const std::string& key, Sink&& sink) {
   }
 }
 
-// The default value of a key as TOML text, e.g. "2.0", "\"sine\"", "[0.0, 1.0]".
-std::string toml_text(const toml::node& node) {
-  toml::table t;
-  t.insert("v", node);
-  std::ostringstream s;
-  s << t;
-  const std::string text = s.str();
-  const auto eq = text.find("= ");
-  return eq == std::string::npos ? text : text.substr(eq + 2);
-}
 
 std::string type_text(const toml::node& node) {
   if (node.is_floating_point()) return "number";
@@ -455,7 +445,7 @@ std::string register_class(const std::string& kind, const std::string& type, py:
     if (v.is_table()) throw std::invalid_argument(type + ": key '" + std::string(k.str()) + "': tables are not supported");
     KeyInfo info;
     info.name = std::string(k.str());
-    info.default_text = toml_text(v);
+    info.default_text = toml_value_text(v);
     info.type = type_text(v);
     if (help.contains(info.name.c_str())) info.help = py::str(help[info.name.c_str()]).cast<std::string>();
     infos.push_back(std::move(info));

@@ -125,11 +125,16 @@ void kinematic_hessian_revolute(const RobotModel& model, KinematicsData& data) {
   if (model.kind() == ChainKind::kPlanar) {
     // Every axis is the world z: z x v = (-v_y, v_x, 0) exactly (the cross product's other terms are exact zeros),
     // and z_i x z_j = 0.
+    // Written straight into dJ's columns (contiguous, column-major): each task row takes x, y, or 0 for phi.
+    const int m = model.task_dim();
+    int rows[6];
+    for (int r = 0; r < m; ++r) rows[r] = model.twist_row(r);
     for (int i = 0; i < n; ++i) {
-      auto block = data.dJ_block(i);
       for (int j = 0; j < n; ++j) {
         const int c = std::max(i, j);
-        put_rows(model, Vector3d(-lin(1, c), lin(0, c), 0.0), Vector3d::Zero(), block, j);
+        const double vx = -lin(1, c), vy = lin(0, c);
+        double* col = data.dJ.col(static_cast<Eigen::Index>(i) * n + j).data();
+        for (int r = 0; r < m; ++r) col[r] = rows[r] == 0 ? vx : rows[r] == 1 ? vy : 0.0;
       }
     }
     return;

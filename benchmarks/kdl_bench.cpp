@@ -113,7 +113,8 @@ void BM_PandaHelix_KdlJacPinv(benchmark::State& state) {
       jac.JntToJac(q, J);
       Jp = J.data.topRows(3);
       const Eigen::Vector3d f(F.p.x(), F.p.y(), F.p.z());
-      const Eigen::Vector3d d = h.r_d_dot[static_cast<std::size_t>(k)] + gain * (h.r_d[static_cast<std::size_t>(k)] - f);
+      const Eigen::Vector3d d =
+          h.r_d_dot[static_cast<std::size_t>(k)] + gain * (h.r_d[static_cast<std::size_t>(k)] - f);
       ldlt.compute(Jp * Jp.transpose());
       const Eigen::VectorXd x = Jp.transpose() * ldlt.solve(d);
       if (k < steps) q.data += tau * x;
@@ -138,7 +139,8 @@ void BM_PandaHelix_KdlIkVelPinv(benchmark::State& state) {
     for (int k = 0; k <= steps; ++k) {
       fk.JntToCart(q, F);
       const Eigen::Vector3d f(F.p.x(), F.p.y(), F.p.z());
-      const Eigen::Vector3d d = h.r_d_dot[static_cast<std::size_t>(k)] + gain * (h.r_d[static_cast<std::size_t>(k)] - f);
+      const Eigen::Vector3d d =
+          h.r_d_dot[static_cast<std::size_t>(k)] + gain * (h.r_d[static_cast<std::size_t>(k)] - f);
       ik.CartToJnt(q, KDL::Twist(KDL::Vector(d.x(), d.y(), d.z()), KDL::Vector::Zero()), qdot);
       if (k < steps) q.data += tau * qdot.data;
     }

@@ -48,8 +48,8 @@ void kinematics(const PaperArm& arm, const Joints& theta, Kinematics& k) {
     double da = 0.0, db = 0.0, dc = 0.0;
     for (int j = 0; j < kJoints; ++j) {
       const int m = std::max(j, q);
-      da += 2.0 * Y[j] * X[m];   // 2 J0j dJ0j = 2 (-Y_j)(-X_m)
-      dc -= 2.0 * X[j] * Y[m];   // 2 J1j dJ1j = 2 X_j (-Y_m)
+      da += 2.0 * Y[j] * X[m];  // 2 J0j dJ0j = 2 (-Y_j)(-X_m)
+      dc -= 2.0 * X[j] * Y[m];  // 2 J1j dJ1j = 2 X_j (-Y_m)
       db += -X[m] * X[j] + Y[j] * Y[m];
     }
     k.grad_w[q] = da * cc + a * dc - 2.0 * b * db;
@@ -62,7 +62,8 @@ void bounds(const PaperArm& arm, const Joints& theta, Joints& lo, Joints& hi) {
     double vlo = -arm.joint1_speed, vhi = arm.joint1_speed;
     if (j > 0) {
       const double A = arm.a[j], B = arm.b[j];
-      const double rate = arm.s * std::sqrt(A * A + B * B + 2.0 * A * B * std::sin(theta[j])) / (A * B * std::cos(theta[j]));
+      const double rate =
+          arm.s * std::sqrt(A * A + B * B + 2.0 * A * B * std::sin(theta[j])) / (A * B * std::cos(theta[j]));
       vlo = std::min(rate * arm.sigma_min, rate * arm.sigma_max);
       vhi = std::max(rate * arm.sigma_min, rate * arm.sigma_max);
     }

@@ -18,15 +18,15 @@ using Joints = std::array<double, kJoints>;
 
 /// The paper's arm (Table I) and the scheme's constants.
 struct PaperArm {
-  Joints length{};                // l_i (m)
-  Joints lower{}, upper{};        // theta^-, theta^+ (rad)
-  Joints margin{};                // safety margin (rad)
-  double kappa = 4.0;             // eq. 9
-  double gain = 8.0;              // K (1/s)
-  double p = 2.0;                 // p(t) = p sin(pi t / T)
-  double joint1_speed = 0.0;      // joint 1: constant law +-joint1_speed (rad/s)
-  Joints a{}, b{};                // push-rod triangles of joints 2..6 (m); entry 0 unused
-  double s = 0.0;                 // push-rod elongation per motor turn (m/rot)
+  Joints length{};                          // l_i (m)
+  Joints lower{}, upper{};                  // theta^-, theta^+ (rad)
+  Joints margin{};                          // safety margin (rad)
+  double kappa = 4.0;                       // eq. 9
+  double gain = 8.0;                        // K (1/s)
+  double p = 2.0;                           // p(t) = p sin(pi t / T)
+  double joint1_speed = 0.0;                // joint 1: constant law +-joint1_speed (rad/s)
+  Joints a{}, b{};                          // push-rod triangles of joints 2..6 (m); entry 0 unused
+  double s = 0.0;                           // push-rod elongation per motor turn (m/rot)
   double sigma_min = 0.0, sigma_max = 0.0;  // motor rates (rot/s)
 };
 
@@ -34,7 +34,7 @@ struct PaperArm {
 struct Record {
   std::vector<double> rows;  // (steps + 1) x 13
   long iterations = 0;
-  int failures = 0;          // solves that did not converge
+  int failures = 0;  // solves that did not converge
 };
 
 /// Runs the scheme from theta0 over steps + 1 steps of tau (T = steps * tau), with r_d and r_d_dot given per step

@@ -70,9 +70,8 @@ void BM_PaperRun(benchmark::State& state, const char* objective, const char* eng
     benchmark::DoNotOptimize(result.ptr());
   }
   // Seconds per step (printed with an SI prefix, e.g. 1.25u = 1.25 us).
-  state.counters["per_step"] = benchmark::Counter(static_cast<double>(steps),
-                                                  benchmark::Counter::kIsIterationInvariantRate |
-                                                      benchmark::Counter::kInvert);
+  state.counters["per_step"] = benchmark::Counter(
+      static_cast<double>(steps), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 }  // namespace
@@ -81,7 +80,8 @@ BENCHMARK_CAPTURE(BM_PaperRun, cpp_mvn_projection, "cpp_mvn", "projection")->Uni
 BENCHMARK_CAPTURE(BM_PaperRun, py_mvn_projection, "py_mvn", "projection")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PaperRun, cpp_mvn_newton, "cpp_mvn", "newton")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PaperRun, py_mvn_newton, "py_mvn", "newton")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_PaperRun, cpp_manipulability_newton, "cpp_manipulability", "newton")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_PaperRun, cpp_manipulability_newton, "cpp_manipulability", "newton")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PaperRun, py_manipulability_newton, "py_manipulability", "newton")->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {

@@ -89,10 +89,14 @@ void spatial_sizes(benchmark::internal::Benchmark* b) {
   for (int n : {7, 14, 28}) b->Arg(n);
 }
 
-BENCHMARK_CAPTURE(BM_Scaling, projection_planar, "projection", true)->Apply(planar_sizes)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Scaling, projection_planar, "projection", true)
+    ->Apply(planar_sizes)
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Scaling, newton_planar, "newton", true)->Apply(planar_sizes)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Scaling, nlopt_planar, "nlopt", true)->Apply(planar_sizes)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Scaling, projection_spatial, "projection", false)->Apply(spatial_sizes)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Scaling, projection_spatial, "projection", false)
+    ->Apply(spatial_sizes)
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Scaling, newton_spatial, "newton", false)->Apply(spatial_sizes)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Scaling, nlopt_spatial, "nlopt", false)->Apply(spatial_sizes)->Unit(benchmark::kMicrosecond);
 

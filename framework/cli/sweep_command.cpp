@@ -40,8 +40,8 @@ SweepShard shard_of(const SweepOptions& o) {
     return parse_shard(std::to_string(i) + "/" + count);
   } catch (const std::exception& e) {
     throw std::invalid_argument(std::string("SLURM_ARRAY_TASK_ID=") + id + ", SLURM_ARRAY_TASK_COUNT=" + count +
-                                (min != nullptr ? std::string(", SLURM_ARRAY_TASK_MIN=") + min : std::string()) +
-                                ": " + e.what());
+                                (min != nullptr ? std::string(", SLURM_ARRAY_TASK_MIN=") + min : std::string()) + ": " +
+                                e.what());
   }
 }
 
@@ -76,9 +76,13 @@ int run(const SweepOptions& o) {
   const std::string name = table_name(shard);
   write_sweep_csv(table, std::filesystem::path(o.out) / (name + ".csv"));
   write_meta(std::filesystem::path(o.out) / (name + ".json"),
-             {{"name", spec.name}, {"sweep", spec.source}, {"scenario", spec.scenario.string()},
-              {"variations", spec.size()}, {"shard", std::to_string(shard.shard) + "/" + std::to_string(shard.count)},
-              {"rows", table.rows.size()}, {"failed", table.failed()}});
+             {{"name", spec.name},
+              {"sweep", spec.source},
+              {"scenario", spec.scenario.string()},
+              {"variations", spec.size()},
+              {"shard", std::to_string(shard.shard) + "/" + std::to_string(shard.count)},
+              {"rows", table.rows.size()},
+              {"failed", table.failed()}});
   if (!o.quiet) {
     std::cout << spec.name << ": " << table.rows.size() << " of " << spec.size() << " variations in " << seconds
               << " s, " << table.failed() << " not ok -> " << (std::filesystem::path(o.out) / (name + ".csv")).string()
@@ -110,9 +114,11 @@ int merge(const SweepOptions& o) {
   const SweepTable merged = merge_sweep_tables(tables);
   std::filesystem::create_directories(o.out);
   write_sweep_csv(merged, std::filesystem::path(o.out) / "sweep.csv");
-  write_meta(std::filesystem::path(o.out) / "sweep.json",
-             {{"merged_from", o.merge}, {"variations", expected}, {"shard", "0/1"}, {"rows", merged.rows.size()},
-              {"failed", merged.failed()}});
+  write_meta(std::filesystem::path(o.out) / "sweep.json", {{"merged_from", o.merge},
+                                                           {"variations", expected},
+                                                           {"shard", "0/1"},
+                                                           {"rows", merged.rows.size()},
+                                                           {"failed", merged.failed()}});
   if (!o.quiet) {
     std::cout << "merged " << tables.size() << " tables: " << merged.rows.size() << " of " << expected
               << " variations, " << merged.failed() << " not ok -> "

@@ -2,9 +2,9 @@
 
 #include <charconv>
 #include <cstdio>
-#include <string>
 #include <fstream>
 #include <stdexcept>
+#include <string>
 
 #include "redres/error.hpp"
 #include "redres/kinematics.hpp"

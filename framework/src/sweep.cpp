@@ -28,7 +28,6 @@ std::string shortest(double v) {
   return std::string(buf, std::to_chars(buf, buf + sizeof(buf), v).ptr);
 }
 
-
 // How a value is shown in sweep.csv: TOML text, strings without their quotes.
 std::string cell_text(const std::string& toml) {
   if (toml.size() >= 2 && toml.front() == '"' && toml.back() == '"') return toml.substr(1, toml.size() - 2);
@@ -55,7 +54,8 @@ SweepAxis read_axis(const TableReader& t) {
     }
     const double n = std::floor((stop - start) / step * (1.0 + 1e-12) + 1e-9) + 1.0;
     if (n > 1e6) t.fail("range", "expected at most 1e6 values, got " + shortest(n));
-    for (long k = 0; k < static_cast<long>(n); ++k) axis.values.push_back(shortest(start + static_cast<double>(k) * step));
+    for (long k = 0; k < static_cast<long>(n); ++k)
+      axis.values.push_back(shortest(start + static_cast<double>(k) * step));
   }
   t.finish();
   return axis;
@@ -292,8 +292,8 @@ SweepShard parse_shard(const std::string& text) {
     const auto res = std::from_chars(digits.data(), digits.data() + digits.size(), out);
     return res.ec == std::errc() && res.ptr == digits.data() + digits.size() && !digits.empty();
   };
-  if (slash == std::string::npos || !number(text.substr(0, slash), s.shard) || !number(text.substr(slash + 1), s.count) ||
-      s.count == 0 || s.shard >= s.count) {
+  if (slash == std::string::npos || !number(text.substr(0, slash), s.shard) ||
+      !number(text.substr(slash + 1), s.count) || s.count == 0 || s.shard >= s.count) {
     throw std::invalid_argument("shard: expected i/N with 0 <= i < N, got \"" + text + "\"");
   }
   return s;
@@ -396,9 +396,9 @@ SweepTable read_sweep_csv(const std::filesystem::path& file) {
   }
   for (std::size_t r = 1; r < records.size(); ++r) {
     if (records[r].size() != t.columns.size()) {
-      throw ConfigError({file.string(), static_cast<std::uint32_t>(r + 1), 1},
-                        "expected " + std::to_string(t.columns.size()) + " cells, got " +
-                            std::to_string(records[r].size()));
+      throw ConfigError(
+          {file.string(), static_cast<std::uint32_t>(r + 1), 1},
+          "expected " + std::to_string(t.columns.size()) + " cells, got " + std::to_string(records[r].size()));
     }
     t.rows.push_back(std::move(records[r]));
   }
@@ -409,8 +409,8 @@ SweepTable merge_sweep_tables(const std::vector<SweepTable>& tables) {
   std::vector<std::pair<std::size_t, Cells>> all;
   std::map<std::size_t, bool> seen;
   for (const SweepTable& t : tables) {
-    const auto c_index = static_cast<std::size_t>(std::find(t.columns.begin(), t.columns.end(), "index") -
-                                                  t.columns.begin());
+    const auto c_index =
+        static_cast<std::size_t>(std::find(t.columns.begin(), t.columns.end(), "index") - t.columns.begin());
     REDRES_REQUIRE(c_index < t.columns.size(), "merge_sweep_tables", "every table has an 'index' column");
     for (const auto& row : t.rows) {
       std::size_t index = 0;

@@ -30,9 +30,9 @@ TEST(CliSweep, SlurmSlicesMergeIntoTheWholeTable) {
   EXPECT_NE(whole.out.find("9 of 9 variations"), std::string::npos) << whole.out;
   // A job array of three tasks numbered from 1 (sbatch --array=1-3), all writing into one directory.
   for (int id = 1; id <= 3; ++id) {
-    const Cli task = redres_env("SLURM_ARRAY_TASK_ID=" + std::to_string(id) +
-                                    " SLURM_ARRAY_TASK_MIN=1 SLURM_ARRAY_TASK_COUNT=3 ",
-                                "sweep '" + sweep + "' --quiet --out '" + (dir / "array").string() + "'");
+    const Cli task =
+        redres_env("SLURM_ARRAY_TASK_ID=" + std::to_string(id) + " SLURM_ARRAY_TASK_MIN=1 SLURM_ARRAY_TASK_COUNT=3 ",
+                   "sweep '" + sweep + "' --quiet --out '" + (dir / "array").string() + "'");
     EXPECT_LE(task.code, 1) << task.out;
     const std::string name = "sweep-shard-" + std::to_string(id - 1) + "-of-3";
     ASSERT_TRUE(std::filesystem::exists(dir / "array" / (name + ".csv"))) << task.out;
@@ -41,7 +41,8 @@ TEST(CliSweep, SlurmSlicesMergeIntoTheWholeTable) {
     EXPECT_EQ(m["rows"], 3);
     EXPECT_EQ(m["variations"], 9);
   }
-  const Cli merged = redres("sweep --merge '" + (dir / "array").string() + "' --out '" + (dir / "merged").string() + "'");
+  const Cli merged =
+      redres("sweep --merge '" + (dir / "array").string() + "' --out '" + (dir / "merged").string() + "'");
   EXPECT_EQ(merged.code, 1) << merged.out;
   EXPECT_NE(merged.out.find("9 of 9 variations"), std::string::npos) << merged.out;
   EXPECT_EQ(read_all(dir / "merged" / "sweep.csv"), read_all(dir / "whole" / "sweep.csv"));

@@ -20,7 +20,8 @@ TEST(Baseline, ComputesTheFrameworksRunOfThePaperArm) {
     const baseline::Case c = baseline::paper_case(s);
     baseline::Record record;
     record.rows.resize(static_cast<std::size_t>(c.steps + 1) * 13);
-    const baseline::Joints theta = baseline::run(c.arm, c.theta0, c.r_d.data(), c.r_d_dot.data(), c.steps, c.tau, record);
+    const baseline::Joints theta =
+        baseline::run(c.arm, c.theta0, c.r_d.data(), c.r_d_dot.data(), c.steps, c.tau, record);
     EXPECT_EQ(record.failures, 0);
     const RunResult run = simulate(s);
     ASSERT_EQ(run.failures, 0) << run.first_failure;

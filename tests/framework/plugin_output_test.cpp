@@ -28,10 +28,23 @@ class Writer final : public Objective {
     Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
     Eigen::MatrixXd H = Eigen::MatrixXd::Identity(n, n);
     switch (where_) {
-      case Where::kZeta: v(2) = value_; b.add_linear(v); break;
-      case Where::kDiagonal: v.setOnes(); v(1) = value_; b.add_diagonal(v); break;
-      case Where::kHessian: H(0, 3) = H(3, 0) = value_; b.add_hessian(H); break;
-      case Where::kLopsided: H(0, 3) = value_; b.add_hessian(H); break;
+      case Where::kZeta:
+        v(2) = value_;
+        b.add_linear(v);
+        break;
+      case Where::kDiagonal:
+        v.setOnes();
+        v(1) = value_;
+        b.add_diagonal(v);
+        break;
+      case Where::kHessian:
+        H(0, 3) = H(3, 0) = value_;
+        b.add_hessian(H);
+        break;
+      case Where::kLopsided:
+        H(0, 3) = value_;
+        b.add_hessian(H);
+        break;
     }
   }
   void write_config(toml::table&) const override {}
@@ -89,8 +102,9 @@ std::string build_error(std::unique_ptr<Objective> objective, std::unique_ptr<Co
 TEST(PluginOutput, NonFiniteObjectiveTermsNameThePluginAndTheEntry) {
   using W = Writer::Where;
   for (double bad : {kNaN, kInf, -kInf}) {
-    EXPECT_NE(build_error(std::make_unique<Writer>(W::kZeta, bad), nullptr).find("objective 'writer' produced an "
-                                                                                  "invalid QP: zeta(2, 0)"),
+    EXPECT_NE(build_error(std::make_unique<Writer>(W::kZeta, bad), nullptr)
+                  .find("objective 'writer' produced an "
+                        "invalid QP: zeta(2, 0)"),
               std::string::npos);
     EXPECT_NE(build_error(std::make_unique<Writer>(W::kDiagonal, bad), nullptr).find("W(1, 1)"), std::string::npos);
     EXPECT_NE(build_error(std::make_unique<Writer>(W::kHessian, bad), nullptr).find("W(3, 0)"), std::string::npos);
@@ -104,8 +118,8 @@ TEST(PluginOutput, NonFiniteObjectiveTermsNameThePluginAndTheEntry) {
 
 TEST(PluginOutput, NonFiniteConstraintRowsNameThePluginAndItsRow) {
   using R = RowWriter::Where;
-  const std::pair<R, const char*> cases[] = {{R::kJ, "its J(0, 4)"}, {R::kD, "its d(0, 0)"}, {R::kA, "its A(0, 1)"},
-                                             {R::kB, "its b(0, 0)"}};
+  const std::pair<R, const char*> cases[] = {
+      {R::kJ, "its J(0, 4)"}, {R::kD, "its d(0, 0)"}, {R::kA, "its A(0, 1)"}, {R::kB, "its b(0, 0)"}};
   for (const auto& [where, entry] : cases) {
     for (double bad : {kNaN, kInf}) {
       const std::string e = build_error(nullptr, std::make_unique<RowWriter>(where, bad));

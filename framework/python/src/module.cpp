@@ -149,8 +149,8 @@ toml::table spec_table(py::handle item, std::string& where) {
 }
 
 std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::list& objectives,
-                                              const py::list& constraints, py::object engine, py::object path,
-                                              double T, double tau, std::optional<Eigen::VectorXd> theta0) {
+                                              const py::list& constraints, py::object engine, py::object path, double T,
+                                              double tau, std::optional<Eigen::VectorXd> theta0) {
   auto c = std::make_unique<PyController>();
   c->robot = robot.model;
   const RobotModel& model = *c->robot;
@@ -203,7 +203,9 @@ std::unique_ptr<PyController> controller_of(const PyScenario& s) {
   return c;
 }
 
-py::tuple step_result(const PyController& c) { return py::make_tuple(Eigen::VectorXd(c.out.theta_dot), info_of(c.out.info)); }
+py::tuple step_result(const PyController& c) {
+  return py::make_tuple(Eigen::VectorXd(c.out.theta_dot), info_of(c.out.info));
+}
 
 // --- the registries' listing ---------------------------------------------------------------------------------------
 
@@ -215,7 +217,9 @@ py::dict key_dict(const KeyInfo& k) {
   d["help"] = k.help;
   d["rule"] = k.rule;
   d["type"] = k.type;
-  d["presence"] = k.presence == Presence::kOptional ? "optional" : k.presence == Presence::kRequired ? "required" : "group";
+  d["presence"] = k.presence == Presence::kOptional   ? "optional"
+                  : k.presence == Presence::kRequired ? "required"
+                                                      : "group";
   d["group"] = k.group;
   return d;
 }
@@ -259,7 +263,8 @@ PYBIND11_MODULE(_redres, m) {
   m.doc() = "redres: redundancy resolution of redundant manipulators (the C++ core; use the `redres` package)";
 
   auto& config_error = py::register_exception<ConfigError>(m, "ConfigError", PyExc_ValueError);
-  config_error.doc() = "A bad robot or scenario file, or a bad plugin configuration: the message starts with file:line:col.";
+  config_error.doc() =
+      "A bad robot or scenario file, or a bad plugin configuration: the message starts with file:line:col.";
 
   py::class_<KinematicsResult>(m, "Kinematics", "Kinematics at one configuration (copies).")
       .def_readonly("theta", &KinematicsResult::theta, "the configuration (n,)")
@@ -276,13 +281,17 @@ PYBIND11_MODULE(_redres, m) {
   py::class_<PyRobot>(m, "Robot", "A robot model (redres.Robot.load(path) reads a robot TOML file, DH or URDF).")
       .def_static(
           "load",
-          [](const std::filesystem::path& path) { return PyRobot{std::make_shared<const RobotModel>(load_robot(path))}; },
+          [](const std::filesystem::path& path) {
+            return PyRobot{std::make_shared<const RobotModel>(load_robot(path))};
+          },
           py::arg("path"), "Loads a robot TOML file; a bad file raises redres.ConfigError with file:line:col.")
       .def_property_readonly("name", [](const PyRobot& r) { return r.model->name(); })
-      .def_property_readonly("kind", [](const PyRobot& r) { return std::string(to_string(r.model->kind())); },
-                             "'planar' or 'spatial'")
-      .def_property_readonly("dof", [](const PyRobot& r) { return r.model->dof(); }, "number of joints n")
-      .def_property_readonly("task_dim", [](const PyRobot& r) { return r.model->task_dim(); }, "task rows m")
+      .def_property_readonly(
+          "kind", [](const PyRobot& r) { return std::string(to_string(r.model->kind())); }, "'planar' or 'spatial'")
+      .def_property_readonly(
+          "dof", [](const PyRobot& r) { return r.model->dof(); }, "number of joints n")
+      .def_property_readonly(
+          "task_dim", [](const PyRobot& r) { return r.model->task_dim(); }, "task rows m")
       .def_property_readonly("task_names", [](const PyRobot& r) { return r.model->task_names(); })
       .def_property_readonly("reference_names", [](const PyRobot& r) { return r.model->reference_names(); })
       .def_property_readonly("joint_names",
@@ -291,15 +300,14 @@ PYBIND11_MODULE(_redres, m) {
                                for (const auto& j : r.model->joints()) names.push_back(j.name);
                                return names;
                              })
-      .def_property_readonly("lower_limits", [](const PyRobot& r) { return Eigen::VectorXd(r.model->lower_limits()); },
-                             "theta^- (n,)")
-      .def_property_readonly("upper_limits", [](const PyRobot& r) { return Eigen::VectorXd(r.model->upper_limits()); },
-                             "theta^+ (n,)")
+      .def_property_readonly(
+          "lower_limits", [](const PyRobot& r) { return Eigen::VectorXd(r.model->lower_limits()); }, "theta^- (n,)")
+      .def_property_readonly(
+          "upper_limits", [](const PyRobot& r) { return Eigen::VectorXd(r.model->upper_limits()); }, "theta^+ (n,)")
       .def_property_readonly("home", [](const PyRobot& r) { return Eigen::VectorXd(r.model->home()); })
       .def_property_readonly("source", [](const PyRobot& r) { return r.model->source(); })
       .def(
-          "kinematics",
-          [](const PyRobot& r, const Eigen::VectorXd& theta) { return kinematics_of(*r.model, theta); },
+          "kinematics", [](const PyRobot& r, const Eigen::VectorXd& theta) { return kinematics_of(*r.model, theta); },
           py::arg("theta"), "f, J, w, grad w, mu, grad mu and the end-effector pose at theta (numpy arrays).")
       .def(
           "velocity_limits",
@@ -337,10 +345,10 @@ PYBIND11_MODULE(_redres, m) {
           "values",
           [](py::object self) {
             const Trajectory& tr = self.cast<const PyResult&>().run->trajectory;
-            py::array a(py::dtype::of<double>(),
-                        {static_cast<py::ssize_t>(tr.size()), static_cast<py::ssize_t>(tr.width())},
-                        {static_cast<py::ssize_t>(sizeof(double) * tr.width()), static_cast<py::ssize_t>(sizeof(double))},
-                        tr.values().data(), self);
+            py::array a(
+                py::dtype::of<double>(), {static_cast<py::ssize_t>(tr.size()), static_cast<py::ssize_t>(tr.width())},
+                {static_cast<py::ssize_t>(sizeof(double) * tr.width()), static_cast<py::ssize_t>(sizeof(double))},
+                tr.values().data(), self);
             py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
             return a;
           },
@@ -351,11 +359,12 @@ PYBIND11_MODULE(_redres, m) {
       .def_property_readonly("status", [](const PyResult& r) { return r.run->failures == 0 ? "ok" : "failed_steps"; })
       .def_property_readonly("engine", [](const PyResult& r) { return r.run->engine(); })
       .def_property_readonly("name", [](const PyResult& r) { return r.summary->name; })
-      .def_property_readonly("final_theta",
-                             [](const PyResult& r) {
-                               return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
-                                   r.summary->final_theta.data(), static_cast<Eigen::Index>(r.summary->final_theta.size())));
-                             })
+      .def_property_readonly(
+          "final_theta",
+          [](const PyResult& r) {
+            return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
+                r.summary->final_theta.data(), static_cast<Eigen::Index>(r.summary->final_theta.size())));
+          })
       .def_property_readonly("wall_time_s", [](const PyResult& r) { return r.run->wall_time_s; })
       .def(
           "write",
@@ -380,13 +389,17 @@ PYBIND11_MODULE(_redres, m) {
           py::arg("path"), py::arg("overrides") = py::none())
       .def_property_readonly("name", [](const PyScenario& s) { return s.scenario->name; })
       .def_property_readonly("source", [](const PyScenario& s) { return s.scenario->source; })
-      .def_property_readonly("robot", [](const PyScenario& s) {
-        return PyRobot{std::shared_ptr<const RobotModel>(s.scenario, s.scenario->robot.get())};
-      })
+      .def_property_readonly("robot",
+                             [](const PyScenario& s) {
+                               return PyRobot{std::shared_ptr<const RobotModel>(s.scenario, s.scenario->robot.get())};
+                             })
       .def_property_readonly("theta0", [](const PyScenario& s) { return Eigen::VectorXd(s.scenario->theta0); })
-      .def_property_readonly("duration", [](const PyScenario& s) { return s.scenario->duration; }, "T (s)")
-      .def_property_readonly("step", [](const PyScenario& s) { return s.scenario->tau; }, "tau (s)")
-      .def_property_readonly("steps", [](const PyScenario& s) { return s.scenario->steps(); }, "N = T / tau")
+      .def_property_readonly(
+          "duration", [](const PyScenario& s) { return s.scenario->duration; }, "T (s)")
+      .def_property_readonly(
+          "step", [](const PyScenario& s) { return s.scenario->tau; }, "tau (s)")
+      .def_property_readonly(
+          "steps", [](const PyScenario& s) { return s.scenario->steps(); }, "N = T / tau")
       .def_property_readonly("engine", [](const PyScenario& s) { return std::string(s.scenario->engine->name()); })
       .def("run", &run_scenario, py::arg("progress") = py::none(),
            "Runs the scenario from theta0 over [0, T] and returns a redres.Result. The GIL is released while it "
@@ -437,13 +450,16 @@ PYBIND11_MODULE(_redres, m) {
           },
           py::arg("theta"), py::arg("t"), py::arg("r_d"), py::arg("r_d_dot"),
           "One control step with the caller's r_d and r_d_dot (reference_dim entries): returns (theta_dot, StepInfo).")
-      .def("reset", [](PyController& c) { c.controller->reset(); }, "Forgets the engine's warm start.")
+      .def(
+          "reset", [](PyController& c) { c.controller->reset(); }, "Forgets the engine's warm start.")
       .def_property_readonly("robot", [](const PyController& c) { return PyRobot{c.robot}; })
-      .def_property_readonly("r_d", [](const PyController& c) { return Eigen::VectorXd(c.controller->r_d()); },
-                             "the last step's desired task coordinates")
+      .def_property_readonly(
+          "r_d", [](const PyController& c) { return Eigen::VectorXd(c.controller->r_d()); },
+          "the last step's desired task coordinates")
       .def_property_readonly("r_d_dot", [](const PyController& c) { return Eigen::VectorXd(c.controller->r_d_dot()); })
-      .def_property_readonly("f", [](const PyController& c) { return Eigen::VectorXd(c.controller->kinematics().f); },
-                             "the last step's task coordinates f(theta)")
+      .def_property_readonly(
+          "f", [](const PyController& c) { return Eigen::VectorXd(c.controller->kinematics().f); },
+          "the last step's task coordinates f(theta)")
       .def_property_readonly("w", [](const PyController& c) { return c.controller->kinematics().w; })
       .def_property_readonly(
           "qp",

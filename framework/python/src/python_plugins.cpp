@@ -64,7 +64,6 @@ void convert(py::handle v, const std::string& key, Sink&& sink) {
   }
 }
 
-
 std::string type_text(const toml::node& node) {
   if (node.is_floating_point()) return "number";
   if (node.is_integer()) return "integer";
@@ -97,7 +96,8 @@ void read_like(const TableReader& r, const std::string& key, const toml::node& d
 }
 
 KinematicsLevel level_of(py::handle instance) {
-  const std::string level = py::hasattr(instance, "kinematics") ? instance.attr("kinematics").cast<std::string>() : "all";
+  const std::string level =
+      py::hasattr(instance, "kinematics") ? instance.attr("kinematics").cast<std::string>() : "all";
   if (level == "position") return KinematicsLevel::kPosition;
   if (level == "jacobian") return KinematicsLevel::kJacobian;
   if (level == "manipulability") return KinematicsLevel::kManipulability;
@@ -442,7 +442,8 @@ std::string register_class(const std::string& kind, const std::string& type, py:
   const toml::table defaults = to_table(keys, type);
   std::vector<KeyInfo> infos;
   for (const auto& [k, v] : defaults) {
-    if (v.is_table()) throw std::invalid_argument(type + ": key '" + std::string(k.str()) + "': tables are not supported");
+    if (v.is_table())
+      throw std::invalid_argument(type + ": key '" + std::string(k.str()) + "': tables are not supported");
     KeyInfo info;
     info.name = std::string(k.str());
     info.default_text = toml_value_text(v);
@@ -452,16 +453,17 @@ std::string register_class(const std::string& kind, const std::string& type, py:
   }
   const SharedObject shared = share(std::move(cls));
   if (kind == "objective") {
-    register_in<Objective>(objective_registry(), type, shared, defaults, std::move(infos), summary, origin,
-                           [](const std::string& t, py::object inst, const toml::table& own, const RobotModel&) {
-                             return std::unique_ptr<Objective>(std::make_unique<PythonObjective>(t, std::move(inst), own));
-                           });
+    register_in<Objective>(
+        objective_registry(), type, shared, defaults, std::move(infos), summary, origin,
+        [](const std::string& t, py::object inst, const toml::table& own, const RobotModel&) {
+          return std::unique_ptr<Objective>(std::make_unique<PythonObjective>(t, std::move(inst), own));
+        });
   } else if (kind == "constraint") {
-    register_in<Constraint>(constraint_registry(), type, shared, defaults, std::move(infos), summary, origin,
-                            [](const std::string& t, py::object inst, const toml::table& own, const RobotModel& r) {
-                              return std::unique_ptr<Constraint>(
-                                  std::make_unique<PythonConstraint>(t, std::move(inst), own, r));
-                            });
+    register_in<Constraint>(
+        constraint_registry(), type, shared, defaults, std::move(infos), summary, origin,
+        [](const std::string& t, py::object inst, const toml::table& own, const RobotModel& r) {
+          return std::unique_ptr<Constraint>(std::make_unique<PythonConstraint>(t, std::move(inst), own, r));
+        });
   } else {
     throw std::invalid_argument("register: kind '" + kind + "': expected 'objective' or 'constraint'");
   }
@@ -487,10 +489,14 @@ void bind_python_plugins(py::module_& m) {
   py::class_<StepContext>(m, "StepContext",
                           "What a Python plugin may read at one control step (valid during contribute() only).\n\n"
                           "Arrays are read-only views of the step's values, without a copy: copy() them to keep them.")
-      .def_property_readonly("t", [](const StepContext& c) { return c.get().t; }, "time since the start (s)")
-      .def_property_readonly("T", [](const StepContext& c) { return c.get().T; }, "task duration (s)")
-      .def_property_readonly("tau", [](const StepContext& c) { return c.get().tau; }, "control step (s)")
-      .def_property_readonly("robot", [](const StepContext& c) { return borrowed(*c.get().robot); }, "the robot")
+      .def_property_readonly(
+          "t", [](const StepContext& c) { return c.get().t; }, "time since the start (s)")
+      .def_property_readonly(
+          "T", [](const StepContext& c) { return c.get().T; }, "task duration (s)")
+      .def_property_readonly(
+          "tau", [](const StepContext& c) { return c.get().tau; }, "control step (s)")
+      .def_property_readonly(
+          "robot", [](const StepContext& c) { return borrowed(*c.get().robot); }, "the robot")
       .def_property_readonly(
           "theta", [](py::object self) { return view(self.cast<const StepContext&>().get().theta(), self); },
           "joint positions (n,)")
@@ -500,12 +506,14 @@ void bind_python_plugins(py::module_& m) {
       .def_property_readonly(
           "J", [](py::object self) { return view(self.cast<const StepContext&>().get().kinematics->J, self); },
           "task Jacobian (m, n)")
-      .def_property_readonly("w", [](const StepContext& c) { return c.get().kinematics->w; }, "w = det(J J')")
       .def_property_readonly(
-          "grad_w", [](py::object self) { return view(self.cast<const StepContext&>().get().kinematics->grad_w, self); },
+          "w", [](const StepContext& c) { return c.get().kinematics->w; }, "w = det(J J')")
+      .def_property_readonly(
+          "grad_w",
+          [](py::object self) { return view(self.cast<const StepContext&>().get().kinematics->grad_w, self); },
           "d w / d theta (n,)")
-      .def_property_readonly("mu", [](const StepContext& c) { return c.get().kinematics->mu; },
-                             "Yoshikawa's sqrt(det(J J'))")
+      .def_property_readonly(
+          "mu", [](const StepContext& c) { return c.get().kinematics->mu; }, "Yoshikawa's sqrt(det(J J'))")
       .def_property_readonly(
           "grad_mu",
           [](py::object self) { return view(self.cast<const StepContext&>().get().kinematics->grad_mu, self); },
@@ -517,15 +525,16 @@ void bind_python_plugins(py::module_& m) {
           "r_d_dot", [](py::object self) { return view(*self.cast<const StepContext&>().get().r_d_dot, self); },
           "desired task velocity")
       .def_property_readonly(
-          "ee_pose",
-          [](const StepContext& c) { return Eigen::Matrix4d(c.get().kinematics->ee_pose.matrix()); },
+          "ee_pose", [](const StepContext& c) { return Eigen::Matrix4d(c.get().kinematics->ee_pose.matrix()); },
           "end-effector pose in the world (4, 4), a copy");
 
   py::class_<StepQp>(m, "StepQp",
                      "A plugin's share of the step's QP  min x'Wx/2 + zeta'x  s.t.  J x = d,  A x <= b,  lo <= x <= hi "
                      "(valid during contribute() only). Objective terms are scaled by the plugin's weight.")
-      .def_property_readonly("n", [](const StepQp& q) { return q.n; }, "number of joints")
-      .def_property_readonly("weight", [](const StepQp& q) { return q.get().weight(); }, "the objective's weight")
+      .def_property_readonly(
+          "n", [](const StepQp& q) { return q.n; }, "number of joints")
+      .def_property_readonly(
+          "weight", [](const StepQp& q) { return q.get().weight(); }, "the objective's weight")
       .def_property_readonly("equality_rows", [](const StepQp& q) { return q.eq_rows; })
       .def_property_readonly("inequality_rows", [](const StepQp& q) { return q.in_rows; })
       .def(

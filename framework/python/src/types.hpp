@@ -20,13 +20,15 @@ struct PyRobot {
 };
 
 /// A robot that C++ owns and that lives at least as long as the call in which Python sees it (no ownership).
-inline PyRobot borrowed(const RobotModel& robot) { return PyRobot{std::shared_ptr<const RobotModel>(std::shared_ptr<void>(), &robot)}; }
+inline PyRobot borrowed(const RobotModel& robot) {
+  return PyRobot{std::shared_ptr<const RobotModel>(std::shared_ptr<void>(), &robot)};
+}
 
 /// A read-only numpy view of an Eigen matrix (column-major) or vector, kept alive by `base`; no copy.
 inline py::array view(const Eigen::MatrixXd& m, py::handle base) {
   py::array a(py::dtype::of<double>(), {m.rows(), m.cols()},
-              {static_cast<py::ssize_t>(sizeof(double)), static_cast<py::ssize_t>(sizeof(double) * m.rows())},
-              m.data(), base);
+              {static_cast<py::ssize_t>(sizeof(double)), static_cast<py::ssize_t>(sizeof(double) * m.rows())}, m.data(),
+              base);
   py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
   return a;
 }

@@ -15,13 +15,6 @@
 namespace redres {
 namespace {
 
-std::string read_all(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(CliSweep, SlurmSlicesMergeIntoTheWholeTable) {
   const auto dir = scratch("sweep");
   const std::string sweep = data_path("sweeps/small.toml").string();
@@ -45,7 +38,7 @@ TEST(CliSweep, SlurmSlicesMergeIntoTheWholeTable) {
       redres("sweep --merge '" + (dir / "array").string() + "' --out '" + (dir / "merged").string() + "'");
   EXPECT_EQ(merged.code, 1) << merged.out;
   EXPECT_NE(merged.out.find("9 of 9 variations"), std::string::npos) << merged.out;
-  EXPECT_EQ(read_all(dir / "merged" / "sweep.csv"), read_all(dir / "whole" / "sweep.csv"));
+  EXPECT_EQ(read_text(dir / "merged" / "sweep.csv"), read_text(dir / "whole" / "sweep.csv"));
   // A slice missing: exit 1 with the count.
   std::filesystem::remove(dir / "array" / "sweep-shard-1-of-3.csv");
   const Cli partial = redres("sweep --merge '" + (dir / "array").string() + "' --out '" + (dir / "p").string() + "'");

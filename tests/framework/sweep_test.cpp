@@ -16,13 +16,6 @@
 namespace redres {
 namespace {
 
-std::string text_of(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 std::size_t column(const SweepTable& t, const std::string& name) {
   const auto it = std::find(t.columns.begin(), t.columns.end(), name);
   EXPECT_NE(it, t.columns.end()) << name;
@@ -72,7 +65,7 @@ TEST(Sweep, TheTableDoesNotDependOnTheThreadsAndFailuresAreRows) {
   const SweepTable two = run_sweep(spec, {}, 2, dir);
   write_sweep_csv(one, dir / "one.csv");
   write_sweep_csv(two, dir / "two.csv");
-  EXPECT_EQ(text_of(dir / "one.csv"), text_of(dir / "two.csv"));
+  EXPECT_EQ(read_text(dir / "one.csv"), read_text(dir / "two.csv"));
   ASSERT_EQ(one.rows.size(), 9u);
   const std::size_t status = column(one, "status"), diagnosis = column(one, "diagnosis"), index = column(one, "index");
   for (std::size_t r = 0; r < 9; ++r) {
@@ -117,7 +110,7 @@ TEST(Sweep, ShardsMergeIntoTheWholeTable) {
   }
   write_sweep_csv(whole, dir / "whole.csv");
   write_sweep_csv(merge_sweep_tables(parts), dir / "merged.csv");
-  EXPECT_EQ(text_of(dir / "merged.csv"), text_of(dir / "whole.csv"));
+  EXPECT_EQ(read_text(dir / "merged.csv"), read_text(dir / "whole.csv"));
   parts.push_back(parts.front());
   EXPECT_THROW((void)merge_sweep_tables(parts), std::invalid_argument) << "a shard merged twice";
   std::filesystem::remove_all(dir);

@@ -3,7 +3,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include <Eigen/Core>
@@ -38,6 +40,14 @@ inline Eigen::VectorXd random_inside(const RobotModel& robot, std::mt19937& rng,
     theta(j) = robot.lower_limits()(j) + u(rng) * (robot.upper_limits()(j) - robot.lower_limits()(j));
   }
   return theta;
+}
+
+/// The whole text of a file ("" when it cannot be read).
+inline std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 /// theta at one row of a recorded run (its `theta_1` .. `theta_n` columns).

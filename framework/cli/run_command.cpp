@@ -217,11 +217,13 @@ void add_run_commands(CLI::App& app, Action& action) {
   run->callback([opts, &action] {
     action = [opts] {
       Scenario scenario = load_scenario(opts->scenarios.front(), opts->overrides);
-      RecordOptions record;
-      try {
-        record = parse_record(opts->record.empty() ? scenario.record : opts->record);
-      } catch (const std::invalid_argument& e) {
-        throw std::runtime_error(std::string("--record: ") + e.what());
+      RecordOptions record = scenario.record;
+      if (!opts->record.empty()) {
+        try {
+          record = parse_record(opts->record);
+        } catch (const std::invalid_argument& e) {
+          throw std::runtime_error(std::string("--record: ") + e.what());
+        }
       }
       if (record.none && (opts->plots || opts->animate || scenario.plots || scenario.animate)) {
         throw std::runtime_error("the figures and the animation are made from trajectory.csv and frames.csv, which "

@@ -99,32 +99,6 @@ Trajectory joint_frames(const RobotModel& robot, const Trajectory& run, std::siz
   return out;
 }
 
-RecordOptions parse_record(const std::string& text) {
-  RecordOptions r;
-  if (text == "all") return r;
-  if (text == "none") {
-    r.none = true;
-    return r;
-  }
-  const std::string prefix = "every=";
-  if (text.rfind(prefix, 0) == 0) {
-    const std::string digits = text.substr(prefix.size());
-    std::size_t n = 0;
-    const auto res = std::from_chars(digits.data(), digits.data() + digits.size(), n);
-    if (res.ec == std::errc() && res.ptr == digits.data() + digits.size() && n >= 1) {
-      r.every = n;
-      return r;
-    }
-  }
-  throw std::invalid_argument("record: expected \"all\", \"none\" or \"every=N\" with an integer N >= 1, got \"" +
-                              text + "\"");
-}
-
-std::string to_string(const RecordOptions& record) {
-  if (record.none) return "none";
-  return record.every == 1 ? "all" : "every=" + std::to_string(record.every);
-}
-
 void write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
                const std::filesystem::path& dir, const RecordOptions& record) {
   REDRES_REQUIRE(record.every >= 1, "write_run", "record.every >= 1");

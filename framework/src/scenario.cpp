@@ -6,7 +6,6 @@
 #include "redres/formula.hpp"
 #include "redres/overrides.hpp"
 #include "redres/plugin_loader.hpp"
-#include "redres/run_output.hpp"
 
 namespace redres {
 
@@ -123,12 +122,7 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   }
   if (auto out = r.optional_table("output")) {
     const TableReader o(out->file_ptr(), out->raw(), "output");
-    s.record = o.string("record", "all");
-    try {
-      (void)parse_record(s.record);
-    } catch (const std::invalid_argument& e) {
-      o.fail("record", e.what());
-    }
+    s.record = read_record(o, "record", "all");
     s.plots = o.boolean("plots", false);
     s.animate = o.boolean("animate", false);
     o.finish();

@@ -244,12 +244,7 @@ SweepSpec load_sweep(const std::filesystem::path& file) {
   if (auto o = r.optional_table("output")) {
     const TableReader out(o->file_ptr(), o->raw(), "output");
     spec.write_runs = out.boolean("runs", false);
-    const std::string record = out.string("record", "none");
-    try {
-      spec.record = parse_record(record);
-    } catch (const std::invalid_argument& e) {
-      out.fail("record", e.what());
-    }
+    spec.record = read_record(out, "record", "none");
     out.finish();
   }
   r.finish();

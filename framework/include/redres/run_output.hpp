@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "redres/record.hpp"
 #include "redres/run_summary.hpp"
 
 namespace redres {
@@ -22,18 +23,6 @@ inline constexpr std::size_t kFramesMaxRows = 500;
 /// always kept.
 [[nodiscard]] Trajectory joint_frames(const RobotModel& robot, const Trajectory& run,
                                       std::size_t max_rows = kFramesMaxRows);
-
-/// Which rows of a run go into trajectory.csv: every row (every = 1), every N-th (and the last), or none. The
-/// summary always uses every step: it is computed from the run in memory.
-struct RecordOptions {
-  std::size_t every = 1;  //!< keep rows 0, N, 2N, ... and the last
-  bool none = false;      //!< write summary.json only (no trajectory.csv, no frames.csv)
-};
-
-/// Parses "all", "none" or "every=N" (N >= 1); std::invalid_argument saying what is expected otherwise.
-[[nodiscard]] RecordOptions parse_record(const std::string& text);
-/// "all", "none" or "every=N".
-[[nodiscard]] std::string to_string(const RecordOptions& record);
 
 /// Writes DIR/trajectory.csv (the rows `record` keeps), DIR/frames.csv (joint_frames of `robot`, the run's robot)
 /// and DIR/summary.json, creating DIR; std::runtime_error naming the file on failure. With record.none, only

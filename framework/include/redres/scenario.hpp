@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "redres/controller.hpp"
+#include "redres/record.hpp"
 
 namespace redres {
 
@@ -49,7 +50,7 @@ struct Scenario {
   /// through over the run, from the orientation it has at t = 0 (Controller::set_orientation_turn); zero: hold it.
   Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();
   OnInfeasible on_infeasible = OnInfeasible::kContinue;  //!< [solver] on_infeasible: "continue" or "stop"
-  std::string record = "all";  //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
+  RecordOptions record;  //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
   bool plots = false;    //!< [output] plots
   bool animate = false;  //!< [output] animate
 

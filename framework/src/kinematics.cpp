@@ -44,7 +44,8 @@ KinematicsData::KinematicsData(const RobotModel& model)
       products_(Eigen::VectorXd::Zero(model.task_dim())),
       eig_(model.task_dim()),
       svd_(model.task_dim(), model.dof(), Eigen::ComputeThinU | Eigen::ComputeThinV),
-      linear_(Eigen::Matrix3Xd::Zero(3, model.dof())) {}
+      linear_(Eigen::Matrix3Xd::Zero(3, model.dof())),
+      terms_(Eigen::VectorXd::Zero(model.dof())) {}
 
 double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> adj,
                               TaskEigenSolver& eig) {
@@ -153,129 +154,265 @@ void kinematic_hessian_revolute(const RobotModel& model, KinematicsData& data) {
   }
 }
 
-void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
-                        KinematicsLevel level) {
-  const int n = model.dof();
-  REDRES_REQUIRE(
-      theta.size() == n, "compute_kinematics",
-      "theta.size() == dof() (got " + std::to_string(theta.size()) + ", expected " + std::to_string(n) + ")");
-  REDRES_REQUIRE(theta.allFinite(), "compute_kinematics", "theta is finite (it contains NaN or Inf)");
-  REDRES_REQUIRE(data.J.cols() == n && data.J.rows() == model.task_dim(), "compute_kinematics",
-                 "data was sized for this model (KinematicsData(model))");
+namespace detail {
 
-  data.theta = theta;
+// The stages of compute_kinematics(); a struct so that they may use KinematicsData's workspace.
+struct KinematicsKernels {
+  static void check(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
+                    const KinematicsData& data) {
+    const int n = model.dof();
+    REDRES_REQUIRE(
+        theta.size() == n, "compute_kinematics",
+        "theta.size() == dof() (got " + std::to_string(theta.size()) + ", expected " + std::to_string(n) + ")");
+    REDRES_REQUIRE(theta.allFinite(), "compute_kinematics", "theta is finite (it contains NaN or Inf)");
+    REDRES_REQUIRE(data.J.cols() == n && data.J.rows() == model.task_dim(), "compute_kinematics",
+                   "data was sized for this model (KinematicsData(model))");
+  }
 
-  // Forward pass: joint frames and end-effector pose.
-  Eigen::Isometry3d T = model.base();
-  double phi = model.base_angle();  // planar end-effector angle, kept unwrapped
-  // The short cuts (frame_shape) skip products with the identity and with zeros: they give the very bits of the
-  // full products, which add only exact zeros to the same terms in the same order.
-  for (int j = 0; j < n; ++j) {
-    const JointSpec& joint = model.joint(j);
-    const Vector3d& u = model.axis(j);
-    const RobotModel::FrameShape& shape = model.frame_shape(j);
-    if (!shape.before_identity) T = T * model.before(j);
-    // For the z axis, T.linear() * u is T's third column exactly (products with 0 and 1 round nothing).
-    data.axes.col(j) = shape.z_axis ? Vector3d(T.linear().col(2)) : Vector3d(T.linear() * u);
-    data.origins.col(j) = T.translation();
-    if (joint.type == JointType::kRevolute) {
-      if (shape.z_axis) {
-        // T.rotate(Rz(theta)): the first two columns turn by theta, the third stays.
-        const double c = std::cos(theta(j)), s = std::sin(theta(j));
-        const Vector3d c0 = T.linear().col(0), c1 = T.linear().col(1);
-        T.linear().col(0) = c0 * c + c1 * s;
-        T.linear().col(1) = c0 * -s + c1 * c;
+  // General path: joint frames, end-effector pose and f by 3-D frame products.
+  static void forward_general(const RobotModel& model, KinematicsData& data) {
+    const int n = model.dof();
+    const Eigen::VectorXd& theta = data.theta;
+    Eigen::Isometry3d T = model.base();
+    double phi = model.base_angle();  // planar end-effector angle, kept unwrapped
+    // The short cuts (frame_shape) skip products with the identity and with zeros: they give the very bits of the
+    // full products, which add only exact zeros to the same terms in the same order.
+    for (int j = 0; j < n; ++j) {
+      const JointSpec& joint = model.joint(j);
+      const Vector3d& u = model.axis(j);
+      const RobotModel::FrameShape& shape = model.frame_shape(j);
+      if (!shape.before_identity) T = T * model.before(j);
+      // For the z axis, T.linear() * u is T's third column exactly (products with 0 and 1 round nothing).
+      data.axes.col(j) = shape.z_axis ? Vector3d(T.linear().col(2)) : Vector3d(T.linear() * u);
+      data.origins.col(j) = T.translation();
+      if (joint.type == JointType::kRevolute) {
+        if (shape.z_axis) {
+          // T.rotate(Rz(theta)): the first two columns turn by theta, the third stays.
+          const double c = std::cos(theta(j)), s = std::sin(theta(j));
+          const Vector3d c0 = T.linear().col(0), c1 = T.linear().col(1);
+          T.linear().col(0) = c0 * c + c1 * s;
+          T.linear().col(1) = c0 * -s + c1 * c;
+        } else {
+          T.rotate(Eigen::AngleAxisd(theta(j), u));
+        }
+        phi += theta(j);
       } else {
-        T.rotate(Eigen::AngleAxisd(theta(j), u));
+        T.translate(theta(j) * u);
       }
-      phi += theta(j);
+      data.link_frames[static_cast<std::size_t>(j)] = T;
+      if (shape.after_translation) {
+        T.translation() += T.linear() * model.after(j).translation();
+      } else {
+        T = T * model.after(j);
+      }
+    }
+    T = T * model.end_effector();
+    data.ee_pose = T;
+    const Vector3d p_e = T.translation();
+    if (model.kind() == ChainKind::kPlanar) {
+      data.f(0) = p_e.x();
+      data.f(1) = p_e.y();
+      if (model.task() == TaskRows::kPose) data.f(2) = phi + model.end_effector_angle();
     } else {
-      T.translate(theta(j) * u);
+      data.f.head<3>() = p_e;
+      if (model.task() == TaskRows::kPose) {
+        const Eigen::AngleAxisd aa(T.linear());
+        data.f.tail<3>() = aa.angle() * aa.axis();
+      }
     }
-    data.link_frames[static_cast<std::size_t>(j)] = T;
-    if (shape.after_translation) {
-      T.translation() += T.linear() * model.after(j).translation();
+  }
+
+  // General path: the geometric Jacobian, task rows only.
+  static void jacobian_general(const RobotModel& model, KinematicsData& data) {
+    const Vector3d p_e = data.ee_pose.translation();
+    for (int j = 0; j < model.dof(); ++j) {
+      const Vector3d z = data.axes.col(j);
+      if (model.joint(j).type == JointType::kRevolute) {
+        put_rows(model, z.cross(p_e - data.origins.col(j)), z, data.J, j);
+      } else {
+        put_rows(model, z, Vector3d::Zero(), data.J, j);
+      }
+    }
+  }
+
+  static void hessian(const RobotModel& model, KinematicsData& data) {
+    if (model.all_revolute()) {
+      kinematic_hessian_revolute(model, data);
     } else {
-      T = T * model.after(j);
+      kinematic_hessian_general(model, data);
     }
   }
-  T = T * model.end_effector();
-  data.ee_pose = T;
-  const Vector3d p_e = T.translation();
 
-  if (model.kind() == ChainKind::kPlanar) {
-    data.f(0) = p_e.x();
-    data.f(1) = p_e.y();
-    if (model.task() == TaskRows::kPose) {
-      const Eigen::Matrix3d& E = model.end_effector().linear();
-      data.f(2) = phi + std::atan2(E(1, 0), E(0, 0));
-    }
-  } else {
-    data.f.head<3>() = p_e;
-    if (model.task() == TaskRows::kPose) {
-      const Eigen::AngleAxisd aa(T.linear());
-      data.f.tail<3>() = aa.angle() * aa.axis();
-    }
-  }
-  data.level = KinematicsLevel::kPosition;
-  if (level == KinematicsLevel::kPosition) return;
-
-  // Geometric Jacobian, task rows only.
-  for (int j = 0; j < n; ++j) {
-    const Vector3d z = data.axes.col(j);
-    if (model.joint(j).type == JointType::kRevolute) {
-      put_rows(model, z.cross(p_e - data.origins.col(j)), z, data.J, j);
-    } else {
-      put_rows(model, z, Vector3d::Zero(), data.J, j);
-    }
-  }
-  data.level = KinematicsLevel::kJacobian;
-  if (level == KinematicsLevel::kJacobian) return;
-
-  if (model.all_revolute()) {
-    kinematic_hessian_revolute(model, data);
-  } else {
-    kinematic_hessian_general(model, data);
+  // General path: w = det(J J') and q_i = 2 <adj(J J') J, dJ_i>_F, from dJ.
+  static void gradient_general(const RobotModel& model, KinematicsData& data) {
+    data.jjt_.noalias() = data.J * data.J.transpose();
+    data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
+    data.weighted_.noalias() = data.adj_ * data.J;
+    for (int i = 0; i < model.dof(); ++i) data.grad_w(i) = 2.0 * data.weighted_.cwiseProduct(data.dJ_block(i)).sum();
   }
 
-  // w = det(J J') and q_i = 2 <adj(J J') J, dJ_i>_F.
-  data.jjt_.noalias() = data.J * data.J.transpose();
-  data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
-  data.weighted_.noalias() = data.adj_ * data.J;
-  for (int i = 0; i < n; ++i) data.grad_w(i) = 2.0 * data.weighted_.cwiseProduct(data.dJ_block(i)).sum();
-  data.level = KinematicsLevel::kManipulability;
-  if (level == KinematicsLevel::kManipulability) return;
+  // Planar kernel: frames, f, and (when `jacobian`) J, in two passes over the joints.
+  static void forward_planar(const RobotModel& model, KinematicsData& data, bool jacobian) {
+    const int n = model.dof();
+    const double* theta = data.theta.data();
+    double phi = model.base_angle();
+    double px = model.base().translation().x(), py = model.base().translation().y();
+    for (int j = 0; j < n; ++j) {
+      data.origins(0, j) = px;
+      data.origins(1, j) = py;
+      data.origins(2, j) = 0.0;
+      data.axes.col(j) = Vector3d::UnitZ();
+      phi += theta[j];
+      const double c = std::cos(phi), s = std::sin(phi);
+      Eigen::Isometry3d& frame = data.link_frames[static_cast<std::size_t>(j)];
+      frame.linear() << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;
+      frame.translation() << px, py, 0.0;
+      const double l = model.joint(j).length;
+      px += l * c;
+      py += l * s;
+    }
+    // The last link's end point, turned by phi_n, then the end effector's fixed transform.
+    Eigen::Isometry3d tip = data.link_frames[static_cast<std::size_t>(n - 1)];
+    tip.translation() << px, py, 0.0;
+    data.ee_pose = tip * model.end_effector();
+    const double ex = data.ee_pose.translation().x(), ey = data.ee_pose.translation().y();
+    data.f(0) = ex;
+    data.f(1) = ey;
+    if (model.task() == TaskRows::kPose) data.f(2) = phi + model.end_effector_angle();
+    if (!jacobian) return;
+    // Column j: z x (p_e - p_j) = (-(e_y - p_jy), e_x - p_jx) in the x and y rows, 1 in the phi row.
+    const int m = model.task_dim();
+    double* J = data.J.data();
+    for (int j = 0; j < n; ++j) {
+      const double vx = -(ey - data.origins(1, j)), vy = ex - data.origins(0, j);
+      data.linear_(0, j) = vx;
+      data.linear_(1, j) = vy;
+      data.linear_(2, j) = 0.0;
+      for (int r = 0; r < m; ++r) {
+        const int t = model.twist_row(r);
+        J[j * m + r] = t == 0 ? vx : t == 1 ? vy : 1.0;
+      }
+    }
+  }
+
+  // Planar kernel: w and grad w in O(m n) from the prefix and suffix sums of the class comment.
+  static void gradient_planar(const RobotModel& model, KinematicsData& data) {
+    const int n = model.dof(), m = model.task_dim();
+    const double* J = data.J.data();
+    double A[9] = {};
+    for (int j = 0; j < n; ++j) {
+      for (int r = 0; r < m; ++r) {
+        for (int s = 0; s <= r; ++s) A[r * 3 + s] += J[j * m + r] * J[j * m + s];
+      }
+    }
+    for (int r = 0; r < m; ++r) {
+      for (int s = 0; s <= r; ++s) data.jjt_(r, s) = data.jjt_(s, r) = A[r * 3 + s];
+    }
+    data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
+    // Which task rows are x and y (h is zero in the phi row).
+    int rx = -1, ry = -1;
+    for (int r = 0; r < m; ++r) {
+      if (model.twist_row(r) == 0) rx = r;
+      if (model.twist_row(r) == 1) ry = r;
+    }
+    double adj_x[3] = {}, adj_y[3] = {};
+    for (int s = 0; s < m; ++s) {
+      adj_x[s] = rx >= 0 ? data.adj_(rx, s) : 0.0;
+      adj_y[s] = ry >= 0 ? data.adj_(ry, s) : 0.0;
+    }
+    // h_c = (-(e_x - p_cx), -(e_y - p_cy)) = (-Jv_y, Jv_x) for Jv_c = linear_.col(c).
+    double sum_x = 0.0, sum_y = 0.0;  // sum_{j <= i} of W's x and y rows
+    for (int i = 0; i < n; ++i) {
+      double wx = 0.0, wy = 0.0;
+      for (int s = 0; s < m; ++s) {
+        wx += adj_x[s] * J[i * m + s];
+        wy += adj_y[s] * J[i * m + s];
+      }
+      sum_x += wx;
+      sum_y += wy;
+      const double hx = -data.linear_(1, i), hy = data.linear_(0, i);
+      data.grad_w(i) = hx * sum_x + hy * sum_y;
+      data.terms_(i) = hx * wx + hy * wy;
+    }
+    double suffix = 0.0;  // sum_{j > i} h_j . W_j
+    for (int i = n - 1; i >= 0; --i) {
+      data.grad_w(i) = 2.0 * (data.grad_w(i) + suffix);
+      suffix += data.terms_(i);
+    }
+  }
 
   // mu = prod s_k and d mu = sum_k (prod_{j != k} s_j) u_k' dJ v_k. With fewer joints than task rows a
   // singular value is identically zero, so mu and its gradient vanish.
   // Away from singularities, mu = sqrt(w) and grad mu = grad w / (2 mu) give the same without a singular value
   // decomposition: used while w is at least 1e-4 of (trace(J J') / m)^m, the value w would have with all singular
   // values equal, where the division loses at most about 1e-12 relatively (tested against the decomposition).
-  const double mean_square = data.jjt_.trace() / static_cast<double>(model.task_dim());
-  if (n < model.task_dim()) {
-    data.mu = 0.0;
-    data.grad_mu.setZero();
-  } else if (data.w >= 1e-4 * std::pow(mean_square, model.task_dim()) && data.w > 0.0) {
-    data.mu = std::sqrt(data.w);
-    data.grad_mu = data.grad_w / (2.0 * data.mu);
-  } else {
-    data.svd_.compute(data.J, Eigen::ComputeThinU | Eigen::ComputeThinV);
-    const auto& s = data.svd_.singularValues();
-    const Eigen::Index m = s.size();
-    data.mu = 1.0;
-    for (Eigen::Index k = 0; k < m; ++k) {
-      data.mu *= s(k);
-      double others = 1.0;
-      for (Eigen::Index j = 0; j < m; ++j) {
-        if (j != k) others *= s(j);
+  static void yoshikawa(const RobotModel& model, KinematicsData& data) {
+    const int n = model.dof();
+    const double mean_square = data.jjt_.trace() / static_cast<double>(model.task_dim());
+    if (n < model.task_dim()) {
+      data.mu = 0.0;
+      data.grad_mu.setZero();
+    } else if (data.w >= 1e-4 * std::pow(mean_square, model.task_dim()) && data.w > 0.0) {
+      data.mu = std::sqrt(data.w);
+      data.grad_mu = data.grad_w / (2.0 * data.mu);
+    } else {
+      data.svd_.compute(data.J, Eigen::ComputeThinU | Eigen::ComputeThinV);
+      const auto& s = data.svd_.singularValues();
+      const Eigen::Index m = s.size();
+      data.mu = 1.0;
+      for (Eigen::Index k = 0; k < m; ++k) {
+        data.mu *= s(k);
+        double others = 1.0;
+        for (Eigen::Index j = 0; j < m; ++j) {
+          if (j != k) others *= s(j);
+        }
+        data.products_(k) = others;
       }
-      data.products_(k) = others;
+      data.adj_.noalias() = data.svd_.matrixU() * data.products_.asDiagonal();
+      data.weighted_.noalias() = data.adj_ * data.svd_.matrixV().transpose();
+      for (int i = 0; i < n; ++i) data.grad_mu(i) = data.weighted_.cwiseProduct(data.dJ_block(i)).sum();
     }
-    data.adj_.noalias() = data.svd_.matrixU() * data.products_.asDiagonal();
-    data.weighted_.noalias() = data.adj_ * data.svd_.matrixV().transpose();
-    for (int i = 0; i < n; ++i) data.grad_mu(i) = data.weighted_.cwiseProduct(data.dJ_block(i)).sum();
   }
-  data.level = KinematicsLevel::kAll;
+
+  static void compute(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
+                      KinematicsLevel level, bool planar_kernel) {
+    check(model, theta, data);
+    data.theta = theta;
+    const bool planar = planar_kernel && model.kind() == ChainKind::kPlanar;
+    if (planar) {
+      forward_planar(model, data, level >= KinematicsLevel::kJacobian);
+    } else {
+      forward_general(model, data);
+    }
+    data.level = KinematicsLevel::kPosition;
+    if (level == KinematicsLevel::kPosition) return;
+    if (!planar) jacobian_general(model, data);
+    data.level = KinematicsLevel::kJacobian;
+    if (level == KinematicsLevel::kJacobian) return;
+    if (planar) {
+      gradient_planar(model, data);
+      if (level >= KinematicsLevel::kManipulability) hessian(model, data);
+    } else {
+      hessian(model, data);
+      gradient_general(model, data);
+    }
+    data.level = std::min(level, KinematicsLevel::kManipulability);
+    if (level < KinematicsLevel::kAll) return;
+    yoshikawa(model, data);
+    data.level = KinematicsLevel::kAll;
+  }
+};
+
+}  // namespace detail
+
+void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
+                        KinematicsLevel level) {
+  detail::KinematicsKernels::compute(model, theta, data, level, true);
+}
+
+void compute_kinematics_general(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
+                                KinematicsData& data, KinematicsLevel level) {
+  detail::KinematicsKernels::compute(model, theta, data, level, false);
 }
 
 }  // namespace redres

@@ -148,6 +148,8 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
   }
   const Eigen::Matrix3d& R = spec_.base.linear();
   base_angle_ = spec_.kind == ChainKind::kPlanar ? std::atan2(R(1, 0), R(0, 0)) : 0.0;
+  const Eigen::Matrix3d& E = spec_.end_effector.linear();
+  end_effector_angle_ = spec_.kind == ChainKind::kPlanar ? std::atan2(E(1, 0), E(0, 0)) : 0.0;
   for (int j = 0; j < n; ++j) {
     // The link frame of joint j is the joint's frame after its motion; the next joint's origin (or the end
     // effector's) is after(j) * before(j + 1) in it.

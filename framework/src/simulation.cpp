@@ -86,7 +86,7 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
 
   Controller ctrl(robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
   ctrl.set_orientation_turn(s.orientation_turn);
-  ctrl.set_kinematics_level(KinematicsLevel::kManipulability);
+  ctrl.set_kinematics_level(KinematicsLevel::kGradient);
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
   Eigen::VectorXd theta = s.theta0, theta_pred(n);
   const bool orientation_rows = robot.has_orientation_rows();

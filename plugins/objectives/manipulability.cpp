@@ -60,7 +60,7 @@ double Manipulability::coefficient(double t, double T) const {
 }
 
 KinematicsLevel Manipulability::kinematics_level() const {
-  return config_.measure == Measure::kYoshikawa ? KinematicsLevel::kAll : KinematicsLevel::kManipulability;
+  return config_.measure == Measure::kYoshikawa ? KinematicsLevel::kAll : KinematicsLevel::kGradient;
 }
 
 namespace {

@@ -118,6 +118,54 @@ RC_GTEST_PROP(KinematicsProperty, TheRevoluteHessianIsTheGeneralOne, ()) {
   expect_close(b.dJ, a.dJ, 1e-12, "dJ");
 }
 
+// The planar kernel (compute_kinematics on a planar chain) and the general path (compute_kinematics_general) give
+// the same results to rounding at every level: frames, f, J, w and grad w (the kernel's prefix and suffix sums
+// against <adj(J J') J, dJ_i>), dJ, mu and grad mu; at kGradient the kernel leaves dJ alone.
+RC_GTEST_PROP(KinematicsProperty, ThePlanarKernelIsTheGeneralPath, ()) {
+  RobotSpec spec = random_planar(*rc::gen::inRange(1, 13), *rc::gen::element(TaskRows::kPosition, TaskRows::kPose));
+  if (*rc::gen::inRange(0, 3) == 0) {
+    const std::vector<std::string> all{"x", "y", "phi"};
+    const int mask = *rc::gen::inRange(1, 8);
+    for (std::size_t r = 0; r < all.size(); ++r) {
+      if ((mask >> r) & 1) spec.task_axes.push_back(all[r]);
+    }
+  }
+  const RobotModel model(std::move(spec));
+  const Eigen::VectorXd theta = random_theta(model);
+  const KinematicsLevel level =
+      *rc::gen::element(KinematicsLevel::kPosition, KinematicsLevel::kJacobian, KinematicsLevel::kGradient,
+                        KinematicsLevel::kManipulability, KinematicsLevel::kAll);
+  KinematicsData kernel(model), general(model);
+  kernel.dJ.setConstant(7.0);  // what the kernel must leave alone below kManipulability
+  compute_kinematics(model, theta, kernel, level);
+  compute_kinematics_general(model, theta, general, level);
+  RC_ASSERT(kernel.level == general.level);
+  const auto close = [](const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::Ref<const Eigen::MatrixXd>& b,
+                        const std::string& what) {
+    const double err = (a - b).cwiseAbs().maxCoeff();
+    if (!(err <= 1e-12 * (1.0 + b.cwiseAbs().maxCoeff()))) RC_FAIL(what + " differs by " + std::to_string(err));
+  };
+  close(kernel.f, general.f, "f");
+  close(kernel.ee_pose.matrix(), general.ee_pose.matrix(), "ee_pose");
+  close(kernel.axes, general.axes, "axes");
+  close(kernel.origins, general.origins, "origins");
+  for (int j = 0; j < model.dof(); ++j) {
+    close(kernel.link_frames[static_cast<std::size_t>(j)].matrix(),
+          general.link_frames[static_cast<std::size_t>(j)].matrix(), "link frame " + std::to_string(j + 1));
+  }
+  if (level >= KinematicsLevel::kJacobian) close(kernel.J, general.J, "J");
+  if (level >= KinematicsLevel::kGradient) {
+    RC_ASSERT(std::abs(kernel.w - general.w) <= 1e-12 * (1.0 + general.w));
+    close(kernel.grad_w, general.grad_w, "grad w");
+  }
+  if (level == KinematicsLevel::kGradient) RC_ASSERT((kernel.dJ.array() == 7.0).all());
+  if (level >= KinematicsLevel::kManipulability) close(kernel.dJ, general.dJ, "dJ");
+  if (level == KinematicsLevel::kAll) {
+    RC_ASSERT(std::abs(kernel.mu - general.mu) <= 1e-12 * (1.0 + general.mu));
+    close(kernel.grad_mu, general.grad_mu, "grad mu");
+  }
+}
+
 // mu and grad mu, whichever way compute_kinematics takes (sqrt(w) away from singularities, the singular value
 // decomposition near them), are those of the decomposition: mu = prod s_k, d mu = sum_k prod_{j != k} s_j u_k' dJ v_k.
 RC_GTEST_PROP(KinematicsProperty, YoshikawaIsThatOfTheSingularValues, ()) {

@@ -28,9 +28,15 @@ namespace redres {
 enum class KinematicsLevel {
   kPosition,        //!< f, end-effector pose, joint frames
   kJacobian,        //!< + J
-  kManipulability,  //!< + dJ/dtheta_i, w, q = grad w
+  kGradient,        //!< + w and q = grad w (dJ is not filled in)
+  kManipulability,  //!< + dJ/dtheta_i
   kAll,             //!< + Yoshikawa's mu and grad mu
 };
+
+class KinematicsData;
+namespace detail {
+struct KinematicsKernels;
+}  // namespace detail
 
 /// Eigen-decomposition of an m x m task-space matrix, m <= 6 task rows. Its storage is fixed at 6 x 6, so that
 /// compute() allocates nothing: with dynamic storage, Eigen's tridiagonalisation allocates a work vector per call.
@@ -61,8 +67,7 @@ class KinematicsData {
   [[nodiscard]] auto dJ_block(int i) const { return dJ.middleCols(static_cast<Eigen::Index>(i) * J.cols(), J.cols()); }
 
  private:
-  friend void compute_kinematics(const RobotModel&, const Eigen::Ref<const Eigen::VectorXd>&, KinematicsData&,
-                                 KinematicsLevel);
+  friend struct detail::KinematicsKernels;
   friend void kinematic_hessian_revolute(const RobotModel&, KinematicsData&);
   Eigen::MatrixXd jjt_;                    // A = J J' (m x m)
   Eigen::MatrixXd adj_;                    // adj(A) (m x m)
@@ -71,6 +76,7 @@ class KinematicsData {
   TaskEigenSolver eig_;                    // for adj(A) when m > 3
   Eigen::JacobiSVD<Eigen::MatrixXd> svd_;  // for mu
   Eigen::Matrix3Xd linear_;                // the linear part of every joint's Jacobian column (3 x n)
+  Eigen::VectorXd terms_;                  // planar kernel: h_j . W_j (n)
 };
 
 /// The kinematic Hessian dJ/dtheta_i into data.dJ from the frames, axes, origins and end-effector pose already in
@@ -81,10 +87,23 @@ class KinematicsData {
 void kinematic_hessian_general(const RobotModel& model, KinematicsData& data);
 void kinematic_hessian_revolute(const RobotModel& model, KinematicsData& data);
 
-/// Evaluates the kinematics of `model` at `theta` into `data`. Throws std::invalid_argument when theta has the
-/// wrong size or is not finite. Allocation-free.
+/// Evaluates the kinematics of `model` at `theta` into `data`, up to `level`. Throws std::invalid_argument when
+/// theta has the wrong size or is not finite. Allocation-free.
+///
+/// Planar chains take a kernel of their own: the angles phi_j = base angle + theta_1 + ... + theta_j, the joint
+/// points in one pass, J's columns from p_e - p_j, and grad w in O(m n) without the kinematic Hessian. (For a
+/// planar chain dJ/dtheta_i has column j equal to h_max(i,j), h_c = -(p_e - p_c) in the x and y rows and 0 in the
+/// phi row, so q_i = 2 (h_i . sum_{j <= i} W_j + sum_{j > i} h_j . W_j) with W = adj(J J') J: one prefix and one
+/// suffix sum.) Every other chain, and planar ones through compute_kinematics_general(), take the general
+/// path: 3-D frame products, J from the axes, dJ/dtheta_i, and q_i = 2 <adj(J J') J, dJ/dtheta_i>_F. The tests
+/// check that both give the same results to rounding.
 void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
                         KinematicsLevel level = KinematicsLevel::kManipulability);
+
+/// The general path for any chain (the reference the planar kernel is tested against). Same contract as
+/// compute_kinematics().
+void compute_kinematics_general(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
+                                KinematicsData& data, KinematicsLevel level = KinematicsLevel::kManipulability);
 
 /// det(A) and adj(A) of a symmetric m x m matrix (m <= 6) without inverting it (cofactors for m <= 3,
 /// eigen-decomposition otherwise, using `eig` as scratch). Allocation-free when `adj` is sized.

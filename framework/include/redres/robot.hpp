@@ -139,6 +139,8 @@ class RobotModel {
   [[nodiscard]] const Eigen::Isometry3d& base() const noexcept { return spec_.base; }
   /// Planar chains: the base's rotation about z (rad), which starts the end-effector angle phi.
   [[nodiscard]] double base_angle() const noexcept { return base_angle_; }
+  /// Planar chains: the end effector's fixed rotation about z (rad), which ends the end-effector angle phi.
+  [[nodiscard]] double end_effector_angle() const noexcept { return end_effector_angle_; }
   /// Unit axis u_j of joint j, in the frame after A_j.
   [[nodiscard]] const Eigen::Vector3d& axis(int j) const { return axes_[static_cast<std::size_t>(j)]; }
   /// End-effector transform E in the last joint's frame.
@@ -189,6 +191,7 @@ class RobotModel {
   std::vector<FrameShape> shapes_;
   bool all_revolute_ = true;
   double base_angle_ = 0.0;
+  double end_effector_angle_ = 0.0;
   std::vector<LinkShape> link_shapes_;
 };
 

@@ -213,7 +213,7 @@ class _PythonPlugin:
     keys = {}            # key -> default value; its type fixes how a scenario file's value is read
     help = {}            # key -> one line of help
     summary = ""         # one line, for redres.plugins() and `redres plugins`
-    kinematics = "all"   # what contribute() reads: 'position', 'jacobian', 'manipulability' or 'all'
+    kinematics = "all"   # what contribute() reads: 'position', 'jacobian', 'gradient' (w, grad w), 'manipulability' (+ dJ) or 'all'
     name = None          # instance name in diagnoses (default: the type)
     active = True
 

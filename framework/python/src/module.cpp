@@ -198,7 +198,7 @@ std::unique_ptr<PyController> controller_of(const PyScenario& s) {
   c->robot = std::shared_ptr<const RobotModel>(s.scenario, sc.robot.get());
   c->controller = std::make_unique<Controller>(*sc.robot, *sc.scheme, *sc.engine, sc.path.get(), sc.duration, sc.tau);
   c->controller->set_orientation_turn(sc.orientation_turn);
-  c->controller->set_kinematics_level(KinematicsLevel::kManipulability);
+  c->controller->set_kinematics_level(KinematicsLevel::kGradient);
   c->out = c->controller->make_output();
   return c;
 }

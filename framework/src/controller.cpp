@@ -111,7 +111,7 @@ void Controller::solve(double t, StepOutput& out) {
   ctx_.t = t;
   robot_->velocity_limits(kin_.theta, vlo_, vhi_);
   scheme_->build(ctx_, qp_);
-  engine_->solve(qp_, result_);
+  engine_->solve_valid(qp_, result_);  // build() checked every entry it wrote
   out.theta_dot = result_.x;
   out.info = result_.info;
 }

@@ -339,6 +339,9 @@ struct KinematicsKernels {
       data.grad_w(i) = 2.0 * (data.grad_w(i) + suffix);
       suffix += data.terms_(i);
     }
+    // Joint 1 turns the whole arm rigidly, which leaves J J' unchanged when the task has both position rows or
+    // neither: q_1 = 0 exactly, where the sums above leave rounding of either sign.
+    if ((rx >= 0) == (ry >= 0)) data.grad_w(0) = 0.0;
   }
 
   // mu = prod s_k and d mu = sum_k (prod_{j != k} s_j) u_k' dJ v_k. With fewer joints than task rows a

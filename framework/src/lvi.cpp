@@ -117,14 +117,27 @@ void LviEngine::setup(int n, int m_e, int m_i, SolverResult& result) {
   do_setup(n, m_e, m_i);
 }
 
-void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
+void LviEngine::check_sizes(const QpProblem& qp, const SolverResult& result) const {
   REDRES_REQUIRE(n_ > 0, "LviEngine::solve", "setup() was called");
   REDRES_REQUIRE(qp.n() == n_ && qp.m_eq() == m_e_ && qp.m_in() == m_i_, "LviEngine::solve",
                  "the QP has the sizes given to setup() (n " + std::to_string(n_) + ", m_e " + std::to_string(m_e_) +
                      ", m_i " + std::to_string(m_i_) + ")");
   REDRES_REQUIRE(result.x.size() == n_ && result.y.size() == m_e_ && result.z.size() == m_i_, "LviEngine::solve",
                  "result was sized by setup()");
+}
+
+void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
+  check_sizes(qp, result);
   qp.validate();
+  run(qp, result);
+}
+
+void LviEngine::solve_valid(const QpProblem& qp, SolverResult& result) {
+  check_sizes(qp, result);
+  run(qp, result);
+}
+
+void LviEngine::run(const QpProblem& qp, SolverResult& result) {
   SolverInfo& info = result.info;
   info.diagnosis.clear();
   info.iterations = 0;

@@ -55,36 +55,51 @@ void check_finite(const M& m, const char* kind, const std::string& name, const c
   }
 }
 
-}  // namespace
-
-// The checks after a contribution look at what the plugin can have written, and only at that: zeta and the part of
-// W it added to (nothing, the diagonal, or all of it, then also its symmetry) for an objective, its own rows for a
-// constraint. The scan is the fast one (x - x is 0 exactly for finite x); check_finite names the entry on failure.
+// The checks after a contribution look at what the plugin can have written, and only at that: zeta if it added to it,
+// the part of W it added to (nothing, the diagonal, or all of it, then also its symmetry), and a constraint's own
+// rows. The scan is a plain loop over the entries (x * 0 is 0 exactly for finite x, NaN otherwise);
+// check_finite names the entry on failure.
 template <class M>
 bool all_finite(const M& m) {
-  return (m.array() - m.array()).sum() == 0.0;
+  const double* p = m.data();
+  const Eigen::Index rows = m.rows(), cols = m.cols(), stride = m.outerStride();
+  double acc = 0.0;
+  for (Eigen::Index c = 0; c < cols; ++c, p += stride) {
+    for (Eigen::Index r = 0; r < rows; ++r) acc += p[r] * 0.0;
+  }
+  return acc == 0.0;
 }
+
+void check_contribution(const QpBuilder& builder, const char* kind, const std::string& name) {
+  const QpProblem& qp = builder.problem();
+  if (builder.wrote_zeta() && !all_finite(qp.zeta)) check_finite(qp.zeta, kind, name, "zeta");
+  switch (builder.written_w()) {
+    case QpBuilder::WrittenW::kNone: break;
+    case QpBuilder::WrittenW::kDiagonal: {
+      double acc = 0.0;
+      for (Eigen::Index i = 0; i < qp.W.rows(); ++i) acc += qp.W(i, i) * 0.0;
+      if (acc != 0.0) check_finite(qp.W, kind, name, "W");
+      break;
+    }
+    case QpBuilder::WrittenW::kFull:
+      if (!all_finite(qp.W)) check_finite(qp.W, kind, name, "W");
+      if (!qp.W.isApprox(qp.W.transpose(), 1e-12)) bad_output(kind, name, "W is not symmetric");
+      break;
+  }
+}
+
+}  // namespace
 
 void Objective::contribute(const Context& ctx, QpBuilder& builder) const {
   if (!active()) return;
   add_to(ctx, builder);
-  const QpProblem& qp = builder.problem();
-  if (!all_finite(qp.zeta)) check_finite(qp.zeta, "objective", name(), "zeta");
-  switch (builder.written_w()) {
-    case QpBuilder::WrittenW::kNone: break;
-    case QpBuilder::WrittenW::kDiagonal:
-      if (!all_finite(qp.W.diagonal())) check_finite(qp.W, "objective", name(), "W");
-      break;
-    case QpBuilder::WrittenW::kFull:
-      if (!all_finite(qp.W)) check_finite(qp.W, "objective", name(), "W");
-      if (!qp.W.isApprox(qp.W.transpose(), 1e-12)) bad_output("objective", name(), "W is not symmetric");
-      break;
-  }
+  check_contribution(builder, "objective", name());
 }
 
 void Constraint::contribute(const Context& ctx, QpBuilder& builder) const {
   if (!active()) return;
   add_to(ctx, builder);
+  check_contribution(builder, "constraint", name());
   // Entries are named by the constraint's own row (0-based), e.g. "its J(1, 4)".
   const auto check = [this](const auto& m, const char* what) {
     if (!all_finite(m)) check_finite(m, "constraint", name(), what);

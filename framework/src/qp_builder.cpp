@@ -15,6 +15,7 @@ void QpBuilder::begin(int source, double weight, int eq_offset, int eq_rows, int
   in_offset_ = in_offset;
   in_rows_ = in_rows;
   written_w_ = WrittenW::kNone;
+  wrote_zeta_ = false;
 }
 
 void QpBuilder::add_identity(double scale) {
@@ -42,21 +43,15 @@ void QpBuilder::add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H) {
 void QpBuilder::add_linear(const Eigen::Ref<const Eigen::VectorXd>& z) {
   REDRES_REQUIRE(z.size() == qp_->n(), "QpBuilder::add_linear", "z.size() == n");
   qp_->zeta += weight_ * z;
+  wrote_zeta_ = true;
 }
 
-void QpBuilder::intersect_bound(int joint, double lower, double upper) {
-  REDRES_REQUIRE(joint >= 0 && joint < qp_->n(), "QpBuilder::intersect_bound", "0 <= joint < n");
-  REDRES_REQUIRE(!std::isnan(lower) && !std::isnan(upper), "QpBuilder::intersect_bound",
-                 "bounds of joint " + std::to_string(joint + 1) + " are not NaN");
-  const auto j = static_cast<std::size_t>(joint);
-  if (lower > qp_->lo(joint)) {
-    qp_->lo(joint) = lower;
-    qp_->lo_source[j] = source_;
-  }
-  if (upper < qp_->hi(joint)) {
-    qp_->hi(joint) = upper;
-    qp_->hi_source[j] = source_;
-  }
+void QpBuilder::bad_bound(int joint, double lower, double upper) const {
+  REDRES_REQUIRE(joint >= 0 && joint < qp_->n(), "QpBuilder::intersect_bound",
+                 "0 <= joint < n (got joint " + std::to_string(joint) + ", n " + std::to_string(qp_->n()) + ")");
+  throw_invalid_argument("QpBuilder::intersect_bound", "a bound of joint " + std::to_string(joint + 1) +
+                                                           " is NaN (lower " + std::to_string(lower) + ", upper " +
+                                                           std::to_string(upper) + ")");
 }
 
 void QpBuilder::intersect_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower,

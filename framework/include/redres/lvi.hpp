@@ -83,6 +83,11 @@ class LviEngine {
   /// bound conflict as infeasible, runs the engine, and diagnoses a failure. After an infeasible or failed solve
   /// the warm start is reset, so that runaway duals do not slow the next steps down.
   void solve(const QpProblem& qp, SolverResult& result);
+  /// solve() for a QP whose values are known to be valid: every entry of W, zeta, J, d, A and b finite, and no
+  /// bound NaN (what QpProblem::validate() checks). Scheme::build() gives such a QP: it checks each plugin's
+  /// contribution as it is written, and the entries no plugin writes keep clear()'s zeros. The Controller solves
+  /// with it, so that no entry is scanned twice per step. Sizes are still checked.
+  void solve_valid(const QpProblem& qp, SolverResult& result);
   /// Forgets the warm start.
   void reset() { warm_ = false; }
   /// Engine name ("projection", ...): the registry type, a static string.
@@ -101,6 +106,8 @@ class LviEngine {
   /// Runs the engine. `result` holds the previous u when warm(). Must set status, iterations and residual (solve()
   /// names the engine before; a fallback that runs another engine names that one).
   virtual void do_solve(const QpProblem& qp, SolverResult& result) = 0;
+  void check_sizes(const QpProblem& qp, const SolverResult& result) const;
+  void run(const QpProblem& qp, SolverResult& result);  // solve() after its checks
 
   SolverSettings settings_;
   bool warm_ = false;

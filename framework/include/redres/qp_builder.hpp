@@ -4,6 +4,7 @@
 /// plugin's rows (and, for objectives, its weight) before each contribution.
 
 #include <algorithm>
+#include <cmath>
 
 #include <Eigen/Core>
 
@@ -34,7 +35,18 @@ class QpBuilder {
   /// lo = max(lo, lower), hi = min(hi, upper), entry-wise, remembering this plugin as the source of each change.
   void intersect_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower, const Eigen::Ref<const Eigen::VectorXd>& upper);
   /// The same for one joint.
-  void intersect_bound(int joint, double lower, double upper);
+  void intersect_bound(int joint, double lower, double upper) {
+    if (joint < 0 || joint >= qp_->n() || std::isnan(lower) || std::isnan(upper)) bad_bound(joint, lower, upper);
+    const auto j = static_cast<std::size_t>(joint);
+    if (lower > qp_->lo(joint)) {
+      qp_->lo(joint) = lower;
+      qp_->lo_source[j] = source_;
+    }
+    if (upper < qp_->hi(joint)) {
+      qp_->hi(joint) = upper;
+      qp_->hi_source[j] = source_;
+    }
+  }
   /// An n-vector of workspace (contents undefined on entry), so that contributions need no allocation.
   [[nodiscard]] Eigen::VectorXd& scratch() noexcept { return qp_->scratch; }
   /// The plugin's weight.
@@ -47,6 +59,8 @@ class QpBuilder {
   /// Framework use: what the plugin positioned by begin() added to W: nothing, its diagonal only, or any entry.
   enum class WrittenW { kNone, kDiagonal, kFull };
   [[nodiscard]] WrittenW written_w() const noexcept { return written_w_; }
+  /// Framework use: whether the plugin positioned by begin() added to zeta.
+  [[nodiscard]] bool wrote_zeta() const noexcept { return wrote_zeta_; }
   /// Framework use: the plugin's own rows, read-only (for the checks after its contribution).
   [[nodiscard]] auto own_equality_rows() const { return qp_->J.middleRows(eq_offset_, eq_rows_); }
   [[nodiscard]] auto own_equality_rhs() const { return qp_->d.segment(eq_offset_, eq_rows_); }
@@ -59,7 +73,9 @@ class QpBuilder {
   double weight_ = 1.0;
   int eq_offset_ = 0, eq_rows_ = 0, in_offset_ = 0, in_rows_ = 0;
   WrittenW written_w_ = WrittenW::kNone;
+  bool wrote_zeta_ = false;
   void wrote_w(WrittenW w) noexcept { written_w_ = std::max(written_w_, w); }
+  [[noreturn]] void bad_bound(int joint, double lower, double upper) const;
 };
 
 }  // namespace redres

@@ -255,18 +255,27 @@ struct KinematicsKernels {
   static void forward_planar(const RobotModel& model, KinematicsData& data, bool jacobian) {
     const int n = model.dof();
     const double* theta = data.theta.data();
+    double* origins = data.origins.data();
+    double* axes = data.axes.data();
     double phi = model.base_angle();
     double px = model.base().translation().x(), py = model.base().translation().y();
+    double c = 1.0, s = 0.0;
     for (int j = 0; j < n; ++j) {
-      data.origins(0, j) = px;
-      data.origins(1, j) = py;
-      data.origins(2, j) = 0.0;
-      data.axes.col(j) = Vector3d::UnitZ();
+      origins[3 * j] = px;
+      origins[3 * j + 1] = py;
+      origins[3 * j + 2] = 0.0;
+      axes[3 * j] = 0.0;
+      axes[3 * j + 1] = 0.0;
+      axes[3 * j + 2] = 1.0;
       phi += theta[j];
-      const double c = std::cos(phi), s = std::sin(phi);
-      Eigen::Isometry3d& frame = data.link_frames[static_cast<std::size_t>(j)];
-      frame.linear() << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;
-      frame.translation() << px, py, 0.0;
+      c = std::cos(phi);
+      s = std::sin(phi);
+      // The link frame: Rz(phi_j) at p_j (column-major 4 x 4).
+      double* F = data.link_frames[static_cast<std::size_t>(j)].matrix().data();
+      F[0] = c, F[1] = s, F[2] = 0.0, F[3] = 0.0;
+      F[4] = -s, F[5] = c, F[6] = 0.0, F[7] = 0.0;
+      F[8] = 0.0, F[9] = 0.0, F[10] = 1.0, F[11] = 0.0;
+      F[12] = px, F[13] = py, F[14] = 0.0, F[15] = 1.0;
       const double l = model.joint(j).length;
       px += l * c;
       py += l * s;
@@ -282,16 +291,16 @@ struct KinematicsKernels {
     if (!jacobian) return;
     // Column j: z x (p_e - p_j) = (-(e_y - p_jy), e_x - p_jx) in the x and y rows, 1 in the phi row.
     const int m = model.task_dim();
+    int rows[3] = {5, 5, 5};
+    for (int r = 0; r < m; ++r) rows[r] = model.twist_row(r);
     double* J = data.J.data();
+    double* lin = data.linear_.data();
     for (int j = 0; j < n; ++j) {
-      const double vx = -(ey - data.origins(1, j)), vy = ex - data.origins(0, j);
-      data.linear_(0, j) = vx;
-      data.linear_(1, j) = vy;
-      data.linear_(2, j) = 0.0;
-      for (int r = 0; r < m; ++r) {
-        const int t = model.twist_row(r);
-        J[j * m + r] = t == 0 ? vx : t == 1 ? vy : 1.0;
-      }
+      const double vx = -(ey - origins[3 * j + 1]), vy = ex - origins[3 * j];
+      lin[3 * j] = vx;
+      lin[3 * j + 1] = vy;
+      lin[3 * j + 2] = 0.0;
+      for (int r = 0; r < m; ++r) J[j * m + r] = rows[r] == 0 ? vx : rows[r] == 1 ? vy : 1.0;
     }
   }
 
@@ -299,49 +308,53 @@ struct KinematicsKernels {
   static void gradient_planar(const RobotModel& model, KinematicsData& data) {
     const int n = model.dof(), m = model.task_dim();
     const double* J = data.J.data();
-    double A[9] = {};
+    const double* lin = data.linear_.data();
+    // A = J J' (lower triangle summed, then mirrored).
+    double A[3][3] = {};
     for (int j = 0; j < n; ++j) {
+      const double* col = J + j * m;
       for (int r = 0; r < m; ++r) {
-        for (int s = 0; s <= r; ++s) A[r * 3 + s] += J[j * m + r] * J[j * m + s];
+        for (int q = 0; q <= r; ++q) A[r][q] += col[r] * col[q];
       }
     }
     for (int r = 0; r < m; ++r) {
-      for (int s = 0; s <= r; ++s) data.jjt_(r, s) = data.jjt_(s, r) = A[r * 3 + s];
+      for (int q = 0; q <= r; ++q) data.jjt_(r, q) = data.jjt_(q, r) = A[r][q];
     }
     data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
-    // Which task rows are x and y (h is zero in the phi row).
-    int rx = -1, ry = -1;
-    for (int r = 0; r < m; ++r) {
-      if (model.twist_row(r) == 0) rx = r;
-      if (model.twist_row(r) == 1) ry = r;
-    }
+    // W = adj(A) J in the x and y rows only (h is zero in the phi row).
     double adj_x[3] = {}, adj_y[3] = {};
-    for (int s = 0; s < m; ++s) {
-      adj_x[s] = rx >= 0 ? data.adj_(rx, s) : 0.0;
-      adj_y[s] = ry >= 0 ? data.adj_(ry, s) : 0.0;
+    bool has_x = false, has_y = false;
+    for (int r = 0; r < m; ++r) {
+      const int t = model.twist_row(r);
+      if (t > 1) continue;
+      for (int q = 0; q < m; ++q) (t == 0 ? adj_x : adj_y)[q] = data.adj_(r, q);
+      (t == 0 ? has_x : has_y) = true;
     }
     // h_c = (-(e_x - p_cx), -(e_y - p_cy)) = (-Jv_y, Jv_x) for Jv_c = linear_.col(c).
+    double* g = data.grad_w.data();
+    double* terms = data.terms_.data();
     double sum_x = 0.0, sum_y = 0.0;  // sum_{j <= i} of W's x and y rows
     for (int i = 0; i < n; ++i) {
+      const double* col = J + i * m;
       double wx = 0.0, wy = 0.0;
-      for (int s = 0; s < m; ++s) {
-        wx += adj_x[s] * J[i * m + s];
-        wy += adj_y[s] * J[i * m + s];
+      for (int q = 0; q < m; ++q) {
+        wx += adj_x[q] * col[q];
+        wy += adj_y[q] * col[q];
       }
       sum_x += wx;
       sum_y += wy;
-      const double hx = -data.linear_(1, i), hy = data.linear_(0, i);
-      data.grad_w(i) = hx * sum_x + hy * sum_y;
-      data.terms_(i) = hx * wx + hy * wy;
+      const double hx = -lin[3 * i + 1], hy = lin[3 * i];
+      g[i] = hx * sum_x + hy * sum_y;
+      terms[i] = hx * wx + hy * wy;
     }
     double suffix = 0.0;  // sum_{j > i} h_j . W_j
     for (int i = n - 1; i >= 0; --i) {
-      data.grad_w(i) = 2.0 * (data.grad_w(i) + suffix);
-      suffix += data.terms_(i);
+      g[i] = 2.0 * (g[i] + suffix);
+      suffix += terms[i];
     }
     // Joint 1 turns the whole arm rigidly, which leaves J J' unchanged when the task has both position rows or
     // neither: q_1 = 0 exactly, where the sums above leave rounding of either sign.
-    if ((rx >= 0) == (ry >= 0)) data.grad_w(0) = 0.0;
+    if (has_x == has_y) g[0] = 0.0;
   }
 
   // mu = prod s_k and d mu = sum_k (prod_{j != k} s_j) u_k' dJ v_k. With fewer joints than task rows a

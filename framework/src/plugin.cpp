@@ -70,6 +70,18 @@ bool all_finite(const M& m) {
   return acc == 0.0;
 }
 
+// Rows [offset, offset + rows) of M (column-major) and of v: finite?
+bool rows_finite(const Eigen::MatrixXd& M, const Eigen::VectorXd& v, int offset, int rows) {
+  if (rows == 0) return true;
+  double acc = 0.0;
+  const double* p = M.data() + offset;
+  for (Eigen::Index c = 0; c < M.cols(); ++c, p += M.rows()) {
+    for (int r = 0; r < rows; ++r) acc += p[r] * 0.0;
+  }
+  for (int r = 0; r < rows; ++r) acc += v(offset + r) * 0.0;
+  return acc == 0.0;
+}
+
 void check_contribution(const QpBuilder& builder, const char* kind, const std::string& name) {
   const QpProblem& qp = builder.problem();
   if (builder.wrote_zeta() && !all_finite(qp.zeta)) check_finite(qp.zeta, kind, name, "zeta");
@@ -86,6 +98,15 @@ void check_contribution(const QpBuilder& builder, const char* kind, const std::s
       if (!qp.W.isApprox(qp.W.transpose(), 1e-12)) bad_output(kind, name, "W is not symmetric");
       break;
   }
+  // A constraint's own rows; entries are named by its own row (0-based), e.g. "its J(1, 4)".
+  if (!rows_finite(qp.J, qp.d, builder.eq_offset(), builder.eq_rows())) {
+    check_finite(qp.J.middleRows(builder.eq_offset(), builder.eq_rows()), kind, name, "its J");
+    check_finite(qp.d.segment(builder.eq_offset(), builder.eq_rows()), kind, name, "its d");
+  }
+  if (!rows_finite(qp.A, qp.b, builder.in_offset(), builder.in_rows())) {
+    check_finite(qp.A.middleRows(builder.in_offset(), builder.in_rows()), kind, name, "its A");
+    check_finite(qp.b.segment(builder.in_offset(), builder.in_rows()), kind, name, "its b");
+  }
 }
 
 }  // namespace
@@ -100,14 +121,6 @@ void Constraint::contribute(const Context& ctx, QpBuilder& builder) const {
   if (!active()) return;
   add_to(ctx, builder);
   check_contribution(builder, "constraint", name());
-  // Entries are named by the constraint's own row (0-based), e.g. "its J(1, 4)".
-  const auto check = [this](const auto& m, const char* what) {
-    if (!all_finite(m)) check_finite(m, "constraint", name(), what);
-  };
-  check(builder.own_equality_rows(), "its J");
-  check(builder.own_equality_rhs(), "its d");
-  check(builder.own_inequality_rows(), "its A");
-  check(builder.own_inequality_rhs(), "its b");
 }
 
 ObjectiveRegistry& objective_registry() {

@@ -27,20 +27,27 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
   REDRES_REQUIRE(ctx.r_d->size() == rows && ctx.r_d_dot->size() == rows, "task_tracking",
                  "r_d and r_d_dot have one entry per reference row (" + std::to_string(rows) + ")");
   const KinematicsData& k = *ctx.kinematics;
-  builder.equality_matrix() = k.J;
+  auto J = builder.equality_matrix();
+  const Eigen::Index m = k.J.rows(), n = k.J.cols();
+  for (Eigen::Index c = 0; c < n; ++c) {
+    for (Eigen::Index r = 0; r < m; ++r) J(r, c) = k.J(r, c);
+  }
   // The error e = r_d - f in every reference row; a spatial orientation's is the rotation vector of R_d R'.
-  Eigen::Matrix<double, 6, 1> e;
-  e.head(rows) = *ctx.r_d - k.f;
+  double e[6];
+  for (Eigen::Index r = 0; r < rows; ++r) e[r] = (*ctx.r_d)(r) - k.f(r);
   if (robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows()) {
     const Eigen::AngleAxisd err(rotation_from_vector(ctx.r_d->tail<3>()) * k.ee_pose.linear().transpose());
-    e.segment<3>(3) = err.angle() * err.axis();
+    const Eigen::Vector3d v = err.angle() * err.axis();
+    e[3] = v.x();
+    e[4] = v.y();
+    e[5] = v.z();
   }
   // d = S (r_d_dot + K e): the task rows only (all of them unless the task names a subset).
   auto d = builder.equality_rhs();
   const std::vector<int>& task_rows = robot.task_rows();
   for (Eigen::Index i = 0; i < gain_.size(); ++i) {
     const int r = task_rows[static_cast<std::size_t>(i)];
-    d(i) = (*ctx.r_d_dot)(r) + gain_(i) * e(r);
+    d(i) = (*ctx.r_d_dot)(r) + gain_(i) * e[r];
   }
 }
 

@@ -61,11 +61,11 @@ class QpBuilder {
   [[nodiscard]] WrittenW written_w() const noexcept { return written_w_; }
   /// Framework use: whether the plugin positioned by begin() added to zeta.
   [[nodiscard]] bool wrote_zeta() const noexcept { return wrote_zeta_; }
-  /// Framework use: the plugin's own rows, read-only (for the checks after its contribution).
-  [[nodiscard]] auto own_equality_rows() const { return qp_->J.middleRows(eq_offset_, eq_rows_); }
-  [[nodiscard]] auto own_equality_rhs() const { return qp_->d.segment(eq_offset_, eq_rows_); }
-  [[nodiscard]] auto own_inequality_rows() const { return qp_->A.middleRows(in_offset_, in_rows_); }
-  [[nodiscard]] auto own_inequality_rhs() const { return qp_->b.segment(in_offset_, in_rows_); }
+  /// Framework use: where the plugin's own rows are (for the checks after its contribution).
+  [[nodiscard]] int eq_offset() const noexcept { return eq_offset_; }
+  [[nodiscard]] int eq_rows() const noexcept { return eq_rows_; }
+  [[nodiscard]] int in_offset() const noexcept { return in_offset_; }
+  [[nodiscard]] int in_rows() const noexcept { return in_rows_; }
 
  private:
   QpProblem* qp_;

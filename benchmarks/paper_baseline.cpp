@@ -126,10 +126,91 @@ int solve(const Kinematics& k, const Joints& zeta, double d0, double d1, const J
   return -60;
 }
 
-}  // namespace
+// The letter's segments in letter coordinates: a line from a to b, or an arc about a of radius r from angle a0
+// through the sweep.
+struct Segment {
+  bool arc = false;
+  double ax = 0.0, ay = 0.0, bx = 0.0, by = 0.0;
+  double r = 0.0, a0 = 0.0, sweep = 0.0;
+  double length = 0.0;
+};
 
-Joints run(const PaperArm& arm, const Joints& theta0, const double* r_d, const double* r_d_dot, int steps, double tau,
-           Record& record) {
+class LetterPath {
+ public:
+  LetterPath(const LetterR& letter, double ox, double oy, double T) : ox_(ox), oy_(oy), c_(std::cos(letter.psi)),
+                                                                        s_(std::sin(letter.psi)) {
+    const double h = letter.height, c = h / 6.0, rho = h / 4.0, pi = std::numbers::pi;
+    const auto line = [](double ax, double ay, double bx, double by) {
+      return Segment{false, ax, ay, bx, by, 0.0, 0.0, 0.0, std::hypot(bx - ax, by - ay)};
+    };
+    seg_[0] = line(0, 0, 0, h);
+    seg_[1] = line(0, h, c, h);
+    seg_[2] = Segment{true, c, 0.75 * h, 0.0, 0.0, rho, pi / 2.0, -pi, rho * pi};
+    seg_[3] = line(c, h / 2.0, 0, h / 2.0);
+    seg_[4] = line(0, h / 2.0, c + rho, 0);
+    const int first[4] = {0, 1, 4, 5};  // strokes: stem, bowl, leg
+    double total = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      stroke_start_[k] = total;
+      double len = 0.0;
+      for (int i = first[k]; i < first[k + 1]; ++i) {
+        seg_start_[i] = total + len;
+        len += seg_[i].length;
+      }
+      stroke_length_[k] = len;
+      total += len;
+    }
+    total_ = total;
+    double t0 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      stroke_t0_[k] = t0;
+      stroke_T_[k] = T * stroke_length_[k] / total;
+      t0 += stroke_T_[k];
+    }
+  }
+
+  void at(double t, double& x, double& y, double& vx, double& vy) const {
+    int k = 0;
+    while (k < 2 && stroke_t0_[k + 1] <= t) ++k;
+    const double two_pi = 2.0 * std::numbers::pi;
+    const double u = std::clamp((t - stroke_t0_[k]) / stroke_T_[k], 0.0, 1.0);
+    const double sigma = u - std::sin(two_pi * u) / two_pi, dsigma = 1.0 - std::cos(two_pi * u);
+    const double s = std::clamp(stroke_start_[k] + stroke_length_[k] * sigma, 0.0, total_);
+    const double speed = stroke_length_[k] * dsigma / stroke_T_[k];
+    int i = 0;
+    while (i < 4 && seg_start_[i + 1] <= s) ++i;
+    const Segment& g = seg_[i];
+    const double local = std::min(s - seg_start_[i], g.length);
+    double px = 0.0, py = 0.0, tx = 0.0, ty = 0.0;
+    if (g.arc) {
+      const double frac = local / g.length, angle = g.a0 + frac * g.sweep;
+      const double c = std::cos(angle), sn = std::sin(angle), rate = g.sweep / g.length * g.r;
+      px = g.ax + g.r * c;
+      py = g.ay + g.r * sn;
+      tx = -rate * sn;
+      ty = rate * c;
+    } else {
+      tx = (g.bx - g.ax) / g.length;
+      ty = (g.by - g.ay) / g.length;
+      px = g.ax + local * tx;
+      py = g.ay + local * ty;
+    }
+    x = ox_ + c_ * px - s_ * py;
+    y = oy_ + s_ * px + c_ * py;
+    vx = (c_ * tx - s_ * ty) * speed;
+    vy = (s_ * tx + c_ * ty) * speed;
+  }
+
+ private:
+  Segment seg_[5];
+  double seg_start_[5] = {}, stroke_start_[3] = {}, stroke_length_[3] = {}, stroke_t0_[3] = {}, stroke_T_[3] = {};
+  double total_ = 0.0, ox_, oy_, c_, s_;
+};
+
+// The loop shared by both runs; desired(step, t, r_d[2], r_d_dot[2]) gives the path.
+template <class Desired>
+Joints run_loop(const PaperArm& arm, const Joints& theta0, const Desired& desired, int steps, double tau,
+                Record& record) {
   const double T = steps * tau;
   Joints theta = theta0, x{}, zeta{}, lo{}, hi{};
   Kinematics k;
@@ -141,8 +222,10 @@ Joints run(const PaperArm& arm, const Joints& theta0, const double* r_d, const d
     bounds(arm, theta, lo, hi);
     const double p = arm.p * std::sin(std::numbers::pi * t / T);
     for (int j = 0; j < kJoints; ++j) zeta[j] = -p * k.grad_w[j];
-    const double d0 = r_d_dot[2 * step] + arm.gain * (r_d[2 * step] - k.x);
-    const double d1 = r_d_dot[2 * step + 1] + arm.gain * (r_d[2 * step + 1] - k.y);
+    double r_d[2], r_d_dot[2];
+    desired(step, t, r_d, r_d_dot);
+    const double d0 = r_d_dot[0] + arm.gain * (r_d[0] - k.x);
+    const double d1 = r_d_dot[1] + arm.gain * (r_d[1] - k.y);
     const int it = solve(k, zeta, d0, d1, lo, hi, y, x);
     record.iterations += it < 0 ? -it : it;
     record.failures += it < 0 ? 1 : 0;
@@ -157,6 +240,42 @@ Joints run(const PaperArm& arm, const Joints& theta0, const double* r_d, const d
     }
   }
   return theta;
+}
+
+}  // namespace
+
+Joints run(const PaperArm& arm, const Joints& theta0, const double* r_d, const double* r_d_dot, int steps, double tau,
+           Record& record) {
+  return run_loop(
+      arm, theta0,
+      [&](int step, double /*t*/, double* r, double* v) {
+        r[0] = r_d[2 * step];
+        r[1] = r_d[2 * step + 1];
+        v[0] = r_d_dot[2 * step];
+        v[1] = r_d_dot[2 * step + 1];
+      },
+      steps, tau, record);
+}
+
+void letter_r_at(const LetterR& letter, double ox, double oy, double T, double t, double r[2], double v[2]) {
+  LetterPath(letter, ox, oy, T).at(t, r[0], r[1], v[0], v[1]);
+}
+
+void end_effector(const PaperArm& arm, const Joints& theta, double f[2]) {
+  Kinematics k;
+  kinematics(arm, theta, k);
+  f[0] = k.x;
+  f[1] = k.y;
+}
+
+Joints run_letter_r(const PaperArm& arm, const LetterR& letter, const Joints& theta0, int steps, double tau,
+                    Record& record) {
+  Kinematics k0;
+  kinematics(arm, theta0, k0);
+  const LetterPath path(letter, k0.x + letter.offset[0], k0.y + letter.offset[1], steps * tau);
+  return run_loop(
+      arm, theta0, [&](int /*step*/, double t, double* r, double* v) { path.at(t, r[0], r[1], v[0], v[1]); }, steps,
+      tau, record);
 }
 
 }  // namespace redres::baseline

@@ -4,8 +4,9 @@
 // its gradient from suffix sums), the merged bounds (eq. 9 with the safety margin, and the push-rod law of eq. 2),
 // and the QP  min x'x/2 - p(t) grad w' x  s.t.  J x = r_d_dot + K (r_d - f),  lo <= x <= hi  solved by semismooth
 // Newton on the two multipliers of J x = d (x = clip(-zeta - J'y, lo, hi)), warm-started, then Euler integration.
-// It records theta, x and w of every step into preallocated memory, as the framework's run does. The desired path
-// comes as a table (r_d, r_d_dot per step) computed before the loop.
+// It records theta, x and w of every step into preallocated memory, as the framework's run does. The desired path is
+// the paper's letter R, evaluated inside the loop as the framework does (run_letter_r), or, for comparison, a table
+// of r_d and r_d_dot per step computed before the loop (run).
 
 #include <array>
 #include <cstddef>
@@ -37,9 +38,27 @@ struct Record {
   int failures = 0;  // solves that did not converge
 };
 
+/// The letter R of height h (the project's definition: stem, bowl, leg, each stroke timed by the cycloidal law over
+/// its share of T by length), rotated by psi about its origin, which sits at f(theta0) + offset.
+struct LetterR {
+  double height = 0.15;     // h (m)
+  double psi = 0.0;         // rotation (rad)
+  double offset[2] = {};    // origin shift from f(theta0) (m)
+};
+
 /// Runs the scheme from theta0 over steps + 1 steps of tau (T = steps * tau), with r_d and r_d_dot given per step
 /// as 2 (steps + 1) values each. `record` must hold (steps + 1) * 13 values. Returns theta(T).
 Joints run(const PaperArm& arm, const Joints& theta0, const double* r_d, const double* r_d_dot, int steps, double tau,
            Record& record);
+
+/// The letter's r_d and r_d_dot at time t of T, with its origin at (ox, oy) (for the set-up's check).
+void letter_r_at(const LetterR& letter, double ox, double oy, double T, double t, double r[2], double v[2]);
+
+/// f(theta) of the arm (for the set-up).
+void end_effector(const PaperArm& arm, const Joints& theta, double f[2]);
+
+/// The same run with the letter R evaluated at each step.
+Joints run_letter_r(const PaperArm& arm, const LetterR& letter, const Joints& theta0, int steps, double tau,
+                    Record& record);
 
 }  // namespace redres::baseline

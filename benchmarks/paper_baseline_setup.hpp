@@ -3,7 +3,11 @@
 // velocity laws, the scheme's constants, theta(0), and the desired path as a table of r_d and r_d_dot per step.
 // Shared by the step-loop benchmark and the test that the baseline and the framework compute the same run.
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "paper_baseline.hpp"
@@ -20,6 +24,7 @@ struct Case {
   PaperArm arm;
   Joints theta0{};
   std::vector<double> r_d, r_d_dot;  // 2 (steps + 1)
+  LetterR letter;                    // the same path, for run_letter_r
   int steps = 0;
   double tau = 0.0;
 };
@@ -68,6 +73,27 @@ inline Case paper_case(const Scenario& s) {
     s.path->evaluate(k == c.steps ? s.duration : k * s.tau, r, v);
     c.r_d.insert(c.r_d.end(), {r(0), r(1)});
     c.r_d_dot.insert(c.r_d_dot.end(), {v(0), v(1)});
+  }
+  // The letter: the path's length is h (1 + 1/3 + pi/4 + sqrt((5/12)^2 + 1/4)), r_d(0) is its origin, and the
+  // paper's scenarios keep the default rotation of 180 degrees. Checked against the scenario's path below.
+  const double per_height = 1.0 + 1.0 / 3.0 + std::numbers::pi / 4.0 + std::sqrt(25.0 / 144.0 + 0.25);
+  c.letter.height = s.path->length() / per_height;
+  c.letter.psi = std::numbers::pi;
+  double f0[2];
+  end_effector(c.arm, c.theta0, f0);
+  c.letter.offset[0] = c.r_d[0] - f0[0];
+  c.letter.offset[1] = c.r_d[1] - f0[1];
+  for (int k = 0; k <= c.steps; k += 97) {
+    double at[2], rate[2];
+    letter_r_at(c.letter, f0[0] + c.letter.offset[0], f0[1] + c.letter.offset[1], c.steps * c.tau, k * c.tau, at,
+                rate);
+    const auto K = static_cast<std::size_t>(k);
+    const double err = std::max({std::abs(at[0] - c.r_d[2 * K]), std::abs(at[1] - c.r_d[2 * K + 1]),
+                                 std::abs(rate[0] - c.r_d_dot[2 * K]), std::abs(rate[1] - c.r_d_dot[2 * K + 1])});
+    if (!(err <= 1e-12)) {
+      throw std::invalid_argument("the scenario's path is not the baseline's letter R (it differs by " +
+                                  std::to_string(err) + " at step " + std::to_string(k) + ")");
+    }
   }
   return c;
 }

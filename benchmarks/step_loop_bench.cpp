@@ -1,6 +1,8 @@
 // The full paper run through the library against the hand-written baseline (paper_baseline.cpp), in the same
 // process: the TVCMM R of the paper's arm, T = 40 s at tau = 1 ms (40,001 steps).
-//   BM_PaperRun/baseline                 the hand-written loop (recording theta, x, w of every step)
+//   BM_PaperRun/baseline                 the hand-written loop (the letter R evaluated in the loop, as redres does;
+//                                        recording theta, x, w of every step)
+//   BM_PaperRun/baseline_path_table      the same loop reading r_d and r_d_dot from a table made before it
 //   BM_PaperRun/redres_newton            simulate() with newton (recording every column in memory)
 //   BM_PaperRun/redres_projection        simulate() with the paper's eq. 15
 //   BM_PaperRun/redres_newton_no_record  Controller::step and Euler integration only (no recording)
@@ -36,6 +38,18 @@ void BM_PaperRun_Baseline(benchmark::State& state) {
   per_step(state, c.steps);
 }
 
+void BM_PaperRun_BaselineLetterInLoop(benchmark::State& state) {
+  const Scenario s = paper_scenario("newton");
+  const baseline::Case c = baseline::paper_case(s);
+  baseline::Record record;
+  record.rows.resize(static_cast<std::size_t>(c.steps + 1) * 13);
+  for (auto _ : state) {
+    record.iterations = 0;
+    benchmark::DoNotOptimize(baseline::run_letter_r(c.arm, c.letter, c.theta0, c.steps, c.tau, record));
+  }
+  per_step(state, c.steps);
+}
+
 void BM_PaperRun_Redres(benchmark::State& state, const char* engine) {
   Scenario s = paper_scenario(engine);
   for (auto _ : state) {
@@ -64,7 +78,8 @@ void BM_PaperRun_RedresNoRecord(benchmark::State& state) {
   per_step(state, steps);
 }
 
-BENCHMARK(BM_PaperRun_Baseline)->Name("BM_PaperRun/baseline")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PaperRun_BaselineLetterInLoop)->Name("BM_PaperRun/baseline")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PaperRun_Baseline)->Name("BM_PaperRun/baseline_path_table")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PaperRun_Redres, redres_newton, "newton")
     ->Name("BM_PaperRun/redres_newton")
     ->Unit(benchmark::kMillisecond);

@@ -289,10 +289,22 @@ struct KinematicsKernels {
     data.f(1) = ey;
     if (model.task() == TaskRows::kPose) data.f(2) = phi + model.end_effector_angle();
     if (!jacobian) return;
-    // Column j: z x (p_e - p_j) = (-(e_y - p_jy), e_x - p_jx) in the x and y rows, 1 in the phi row.
-    const int m = model.task_dim();
-    int rows[3] = {5, 5, 5};
-    for (int r = 0; r < m; ++r) rows[r] = model.twist_row(r);
+    switch (model.task_dim()) {
+      case 1: jacobian_planar<1>(model, data); break;
+      case 2: jacobian_planar<2>(model, data); break;
+      default: jacobian_planar<3>(model, data); break;
+    }
+  }
+
+  // Planar kernel: column j of J is z x (p_e - p_j) = (-(e_y - p_jy), e_x - p_jx) in the x and y rows, 1 in the phi
+  // row. M = m, as in gradient_planar.
+  template <int M>
+  static void jacobian_planar(const RobotModel& model, KinematicsData& data) {
+    const int n = model.dof();
+    const double ex = data.ee_pose.translation().x(), ey = data.ee_pose.translation().y();
+    int rows[M];
+    for (int r = 0; r < M; ++r) rows[r] = model.twist_row(r);
+    const double* origins = data.origins.data();
     double* J = data.J.data();
     double* lin = data.linear_.data();
     for (int j = 0; j < n; ++j) {
@@ -300,13 +312,16 @@ struct KinematicsKernels {
       lin[3 * j] = vx;
       lin[3 * j + 1] = vy;
       lin[3 * j + 2] = 0.0;
-      for (int r = 0; r < m; ++r) J[j * m + r] = rows[r] == 0 ? vx : rows[r] == 1 ? vy : 1.0;
+      for (int r = 0; r < M; ++r) J[j * M + r] = rows[r] == 0 ? vx : rows[r] == 1 ? vy : 1.0;
     }
   }
 
-  // Planar kernel: w and grad w in O(m n) from the prefix and suffix sums of the class comment.
+  // Planar kernel: w and grad w in O(m n) from the prefix and suffix sums of the class comment. M is the number of
+  // task rows m (1 to 3), fixed at compile time so that the loops over the rows unroll.
+  template <int M>
   static void gradient_planar(const RobotModel& model, KinematicsData& data) {
-    const int n = model.dof(), m = model.task_dim();
+    const int n = model.dof();
+    constexpr int m = M;
     const double* J = data.J.data();
     const double* lin = data.linear_.data();
     // A = J J' (lower triangle summed, then mirrored).
@@ -406,7 +421,11 @@ struct KinematicsKernels {
     data.level = KinematicsLevel::kJacobian;
     if (level == KinematicsLevel::kJacobian) return;
     if (planar) {
-      gradient_planar(model, data);
+      switch (model.task_dim()) {
+        case 1: gradient_planar<1>(model, data); break;
+        case 2: gradient_planar<2>(model, data); break;
+        default: gradient_planar<3>(model, data); break;
+      }
       if (level >= KinematicsLevel::kManipulability) hessian(model, data);
     } else {
       hessian(model, data);

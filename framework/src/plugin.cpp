@@ -82,31 +82,38 @@ bool rows_finite(const Eigen::MatrixXd& M, const Eigen::VectorXd& v, int offset,
   return acc == 0.0;
 }
 
+// The full check with the names of the culprits; runs only when the fast scan below finds a non-finite entry.
+[[gnu::cold]] [[gnu::noinline]] void name_culprit(const QpBuilder& builder, const char* kind, const std::string& name) {
+  const QpProblem& qp = builder.problem();
+  if (builder.wrote_zeta()) check_finite(qp.zeta, kind, name, "zeta");
+  if (builder.written_w() != QpBuilder::WrittenW::kNone) check_finite(qp.W, kind, name, "W");
+  // A constraint's own rows; entries are named by its own row (0-based), e.g. "its J(1, 4)".
+  check_finite(qp.J.middleRows(builder.eq_offset(), builder.eq_rows()), kind, name, "its J");
+  check_finite(qp.d.segment(builder.eq_offset(), builder.eq_rows()), kind, name, "its d");
+  check_finite(qp.A.middleRows(builder.in_offset(), builder.in_rows()), kind, name, "its A");
+  check_finite(qp.b.segment(builder.in_offset(), builder.in_rows()), kind, name, "its b");
+}
+
 void check_contribution(const QpBuilder& builder, const char* kind, const std::string& name) {
   const QpProblem& qp = builder.problem();
-  if (builder.wrote_zeta() && !all_finite(qp.zeta)) check_finite(qp.zeta, kind, name, "zeta");
+  const Eigen::Index n = qp.zeta.size();
+  double acc = 0.0;  // x * 0 summed: 0 while every entry scanned is finite
+  if (builder.wrote_zeta()) {
+    for (Eigen::Index i = 0; i < n; ++i) acc += qp.zeta(i) * 0.0;
+  }
   switch (builder.written_w()) {
     case QpBuilder::WrittenW::kNone: break;
-    case QpBuilder::WrittenW::kDiagonal: {
-      double acc = 0.0;
-      for (Eigen::Index i = 0; i < qp.W.rows(); ++i) acc += qp.W(i, i) * 0.0;
-      if (acc != 0.0) check_finite(qp.W, kind, name, "W");
+    case QpBuilder::WrittenW::kDiagonal:
+      for (Eigen::Index i = 0; i < n; ++i) acc += qp.W(i, i) * 0.0;
       break;
-    }
     case QpBuilder::WrittenW::kFull:
-      if (!all_finite(qp.W)) check_finite(qp.W, kind, name, "W");
+      if (!all_finite(qp.W)) name_culprit(builder, kind, name);
       if (!qp.W.isApprox(qp.W.transpose(), 1e-12)) bad_output(kind, name, "W is not symmetric");
       break;
   }
-  // A constraint's own rows; entries are named by its own row (0-based), e.g. "its J(1, 4)".
-  if (!rows_finite(qp.J, qp.d, builder.eq_offset(), builder.eq_rows())) {
-    check_finite(qp.J.middleRows(builder.eq_offset(), builder.eq_rows()), kind, name, "its J");
-    check_finite(qp.d.segment(builder.eq_offset(), builder.eq_rows()), kind, name, "its d");
-  }
-  if (!rows_finite(qp.A, qp.b, builder.in_offset(), builder.in_rows())) {
-    check_finite(qp.A.middleRows(builder.in_offset(), builder.in_rows()), kind, name, "its A");
-    check_finite(qp.b.segment(builder.in_offset(), builder.in_rows()), kind, name, "its b");
-  }
+  if (builder.eq_rows() > 0 && !rows_finite(qp.J, qp.d, builder.eq_offset(), builder.eq_rows())) acc += NAN;
+  if (builder.in_rows() > 0 && !rows_finite(qp.A, qp.b, builder.in_offset(), builder.in_rows())) acc += NAN;
+  if (acc != 0.0) name_culprit(builder, kind, name);
 }
 
 }  // namespace

@@ -32,10 +32,13 @@ void QpProblem::clear() {
   d.setZero();
   A.setZero();
   b.setZero();
-  lo.setConstant(-kNoBound);
-  hi.setConstant(kNoBound);
-  std::fill(lo_source.begin(), lo_source.end(), -1);
-  std::fill(hi_source.begin(), hi_source.end(), -1);
+  const Eigen::Index nn = lo.size();
+  for (Eigen::Index i = 0; i < nn; ++i) {
+    lo(i) = -kNoBound;
+    hi(i) = kNoBound;
+    lo_source[static_cast<std::size_t>(i)] = -1;
+    hi_source[static_cast<std::size_t>(i)] = -1;
+  }
   w_diagonal = true;
 }
 

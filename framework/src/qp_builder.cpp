@@ -7,22 +7,6 @@
 
 namespace redres {
 
-void QpBuilder::begin(int source, double weight, int eq_offset, int eq_rows, int in_offset, int in_rows) {
-  source_ = source;
-  weight_ = weight;
-  eq_offset_ = eq_offset;
-  eq_rows_ = eq_rows;
-  in_offset_ = in_offset;
-  in_rows_ = in_rows;
-  written_w_ = WrittenW::kNone;
-  wrote_zeta_ = false;
-}
-
-void QpBuilder::add_identity(double scale) {
-  qp_->W.diagonal().array() += weight_ * scale;
-  wrote_w(WrittenW::kDiagonal);
-}
-
 void QpBuilder::add_diagonal(const Eigen::Ref<const Eigen::VectorXd>& diagonal) {
   REDRES_REQUIRE(diagonal.size() == qp_->n(), "QpBuilder::add_diagonal", "diagonal.size() == n");
   qp_->W.diagonal() += weight_ * diagonal;
@@ -40,11 +24,7 @@ void QpBuilder::add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H) {
   }
 }
 
-void QpBuilder::add_linear(const Eigen::Ref<const Eigen::VectorXd>& z) {
-  REDRES_REQUIRE(z.size() == qp_->n(), "QpBuilder::add_linear", "z.size() == n");
-  qp_->zeta += weight_ * z;
-  wrote_zeta_ = true;
-}
+void QpBuilder::bad_size(const char* function, const char* condition) { throw_invalid_argument(function, condition); }
 
 void QpBuilder::bad_bound(int joint, double lower, double upper) const {
   REDRES_REQUIRE(joint >= 0 && joint < qp_->n(), "QpBuilder::intersect_bound",

@@ -23,6 +23,12 @@ TEST(Baseline, ComputesTheFrameworksRunOfThePaperArm) {
     const baseline::Joints theta =
         baseline::run(c.arm, c.theta0, c.r_d.data(), c.r_d_dot.data(), c.steps, c.tau, record);
     EXPECT_EQ(record.failures, 0);
+    // The run that evaluates the letter in its loop is the same run.
+    baseline::Record in_loop;
+    in_loop.rows.resize(record.rows.size());
+    const baseline::Joints theta_in_loop = baseline::run_letter_r(c.arm, c.letter, c.theta0, c.steps, c.tau, in_loop);
+    EXPECT_EQ(in_loop.failures, 0);
+    for (std::size_t j = 0; j < 6; ++j) EXPECT_NEAR(theta_in_loop[j], theta[j], 1e-9) << "joint " << j + 1;
     const RunResult run = simulate(s);
     ASSERT_EQ(run.failures, 0) << run.first_failure;
     const std::size_t last = run.trajectory.size() - 1;

@@ -19,13 +19,26 @@ class QpBuilder {
   explicit QpBuilder(QpProblem& qp) : qp_(&qp) {}
 
   /// W += weight * scale * I.
-  void add_identity(double scale = 1.0);
+  void add_identity(double scale = 1.0) {
+    const double add = weight_ * scale;
+    const Eigen::Index n = qp_->W.rows();
+    double* W = qp_->W.data();
+    for (Eigen::Index i = 0; i < n; ++i) W[i * (n + 1)] += add;
+    wrote_w(WrittenW::kDiagonal);
+  }
   /// W += weight * diag(diagonal).
   void add_diagonal(const Eigen::Ref<const Eigen::VectorXd>& diagonal);
   /// W += weight * H (H symmetric); marks W as non-diagonal when H has off-diagonal entries.
   void add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H);
   /// zeta += weight * z.
-  void add_linear(const Eigen::Ref<const Eigen::VectorXd>& z);
+  void add_linear(const Eigen::Ref<const Eigen::VectorXd>& z) {
+    const Eigen::Index n = qp_->zeta.size();
+    if (z.size() != n) bad_size("QpBuilder::add_linear", "z.size() == n");
+    double* zeta = qp_->zeta.data();
+    const double* v = z.data();
+    for (Eigen::Index i = 0; i < n; ++i) zeta[i] += weight_ * v[i];
+    wrote_zeta_ = true;
+  }
   /// This plugin's equality rows of J (rows x n) and d; the plugin overwrites them.
   [[nodiscard]] Eigen::Block<Eigen::MatrixXd> equality_matrix() { return qp_->J.middleRows(eq_offset_, eq_rows_); }
   [[nodiscard]] Eigen::VectorBlock<Eigen::VectorXd> equality_rhs() { return qp_->d.segment(eq_offset_, eq_rows_); }
@@ -55,7 +68,16 @@ class QpBuilder {
   [[nodiscard]] const QpProblem& problem() const noexcept { return *qp_; }
 
   /// Framework use: positions the builder on one plugin.
-  void begin(int source, double weight, int eq_offset, int eq_rows, int in_offset, int in_rows);
+  void begin(int source, double weight, int eq_offset, int eq_rows, int in_offset, int in_rows) {
+    source_ = source;
+    weight_ = weight;
+    eq_offset_ = eq_offset;
+    eq_rows_ = eq_rows;
+    in_offset_ = in_offset;
+    in_rows_ = in_rows;
+    written_w_ = WrittenW::kNone;
+    wrote_zeta_ = false;
+  }
   /// Framework use: what the plugin positioned by begin() added to W: nothing, its diagonal only, or any entry.
   enum class WrittenW { kNone, kDiagonal, kFull };
   [[nodiscard]] WrittenW written_w() const noexcept { return written_w_; }
@@ -76,6 +98,7 @@ class QpBuilder {
   bool wrote_zeta_ = false;
   void wrote_w(WrittenW w) noexcept { written_w_ = std::max(written_w_, w); }
   [[noreturn]] void bad_bound(int joint, double lower, double upper) const;
+  [[noreturn]] static void bad_size(const char* function, const char* condition);
 };
 
 }  // namespace redres

@@ -8,6 +8,13 @@
 //   BM_PaperRun/redres_newton_no_record  Controller::step and Euler integration only (no recording)
 // per_step is the time per step (s). The ratio to the baseline is the framework's cost.
 
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <unistd.h>
+
 #include <benchmark/benchmark.h>
 
 #include "paper_baseline_setup.hpp"
@@ -79,6 +86,29 @@ void BM_PaperRun_RedresNoRecord(benchmark::State& state) {
 }
 
 BENCHMARK(BM_PaperRun_BaselineLetterInLoop)->Name("BM_PaperRun/baseline")->Unit(benchmark::kMillisecond);
+// Whole processes, timed by the wall clock around std::system: the baseline program writing its CSV (t, theta,
+// theta_dot, w) against `redres run` of the same run writing its outputs (trajectory.csv with every column,
+// summary.json, scenario.toml).
+void BM_Process(benchmark::State& state, const char* which) {
+  const std::string dir = "/tmp/redres_bench_process_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  const std::string cmd =
+      std::string(which) == "baseline"
+          ? std::string("'") + REDRES_BASELINE_PROCESS + "' '" + dir + "/baseline.csv' 0.001 > /dev/null"
+          : std::string("cd '") + REDRES_SOURCE_DIR + "' && '" + REDRES_CLI +
+                "' run configs/paper_r_tvcmm.toml --set step=0.001 --set solver.engine=newton --out '" + dir +
+                "/run' --quiet";
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    const int status = std::system(cmd.c_str());
+    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (status != 0) state.SkipWithError(("exit status " + std::to_string(status) + " of " + cmd).c_str());
+  }
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK_CAPTURE(BM_Process, baseline, "baseline")->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(BM_Process, redres_run, "redres_run")->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
 BENCHMARK(BM_PaperRun_Baseline)->Name("BM_PaperRun/baseline_path_table")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PaperRun_Redres, redres_newton, "newton")
     ->Name("BM_PaperRun/redres_newton")

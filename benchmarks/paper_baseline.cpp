@@ -137,8 +137,8 @@ struct Segment {
 
 class LetterPath {
  public:
-  LetterPath(const LetterR& letter, double ox, double oy, double T) : ox_(ox), oy_(oy), c_(std::cos(letter.psi)),
-                                                                        s_(std::sin(letter.psi)) {
+  LetterPath(const LetterR& letter, double ox, double oy, double T)
+      : ox_(ox), oy_(oy), c_(std::cos(letter.psi)), s_(std::sin(letter.psi)) {
     const double h = letter.height, c = h / 6.0, rho = h / 4.0, pi = std::numbers::pi;
     const auto line = [](double ax, double ay, double bx, double by) {
       return Segment{false, ax, ay, bx, by, 0.0, 0.0, 0.0, std::hypot(bx - ax, by - ay)};

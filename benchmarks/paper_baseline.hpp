@@ -41,9 +41,9 @@ struct Record {
 /// The letter R of height h (the project's definition: stem, bowl, leg, each stroke timed by the cycloidal law over
 /// its share of T by length), rotated by psi about its origin, which sits at f(theta0) + offset.
 struct LetterR {
-  double height = 0.15;     // h (m)
-  double psi = 0.0;         // rotation (rad)
-  double offset[2] = {};    // origin shift from f(theta0) (m)
+  double height = 0.15;   // h (m)
+  double psi = 0.0;       // rotation (rad)
+  double offset[2] = {};  // origin shift from f(theta0) (m)
 };
 
 /// Runs the scheme from theta0 over steps + 1 steps of tau (T = steps * tau), with r_d and r_d_dot given per step

@@ -85,8 +85,7 @@ inline Case paper_case(const Scenario& s) {
   c.letter.offset[1] = c.r_d[1] - f0[1];
   for (int k = 0; k <= c.steps; k += 97) {
     double at[2], rate[2];
-    letter_r_at(c.letter, f0[0] + c.letter.offset[0], f0[1] + c.letter.offset[1], c.steps * c.tau, k * c.tau, at,
-                rate);
+    letter_r_at(c.letter, f0[0] + c.letter.offset[0], f0[1] + c.letter.offset[1], c.steps * c.tau, k * c.tau, at, rate);
     const auto K = static_cast<std::size_t>(k);
     const double err = std::max({std::abs(at[0] - c.r_d[2 * K]), std::abs(at[1] - c.r_d[2 * K + 1]),
                                  std::abs(rate[0] - c.r_d_dot[2 * K]), std::abs(rate[1] - c.r_d_dot[2 * K + 1])});

@@ -33,26 +33,17 @@ void per_step(benchmark::State& state, int steps) {
       benchmark::Counter(steps + 1, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
-void BM_PaperRun_Baseline(benchmark::State& state) {
+// in_loop: the letter evaluated in the loop (run_letter_r); otherwise the path from the table (run).
+void BM_PaperRun_Baseline(benchmark::State& state, bool in_loop) {
   const Scenario s = paper_scenario("newton");
   const baseline::Case c = baseline::paper_case(s);
   baseline::Record record;
   record.rows.resize(static_cast<std::size_t>(c.steps + 1) * 13);
   for (auto _ : state) {
     record.iterations = 0;
-    benchmark::DoNotOptimize(baseline::run(c.arm, c.theta0, c.r_d.data(), c.r_d_dot.data(), c.steps, c.tau, record));
-  }
-  per_step(state, c.steps);
-}
-
-void BM_PaperRun_BaselineLetterInLoop(benchmark::State& state) {
-  const Scenario s = paper_scenario("newton");
-  const baseline::Case c = baseline::paper_case(s);
-  baseline::Record record;
-  record.rows.resize(static_cast<std::size_t>(c.steps + 1) * 13);
-  for (auto _ : state) {
-    record.iterations = 0;
-    benchmark::DoNotOptimize(baseline::run_letter_r(c.arm, c.letter, c.theta0, c.steps, c.tau, record));
+    benchmark::DoNotOptimize(
+        in_loop ? baseline::run_letter_r(c.arm, c.letter, c.theta0, c.steps, c.tau, record)
+                : baseline::run(c.arm, c.theta0, c.r_d.data(), c.r_d_dot.data(), c.steps, c.tau, record));
   }
   per_step(state, c.steps);
 }
@@ -85,7 +76,7 @@ void BM_PaperRun_RedresNoRecord(benchmark::State& state) {
   per_step(state, steps);
 }
 
-BENCHMARK(BM_PaperRun_BaselineLetterInLoop)->Name("BM_PaperRun/baseline")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_PaperRun_Baseline, in_loop, true)->Name("BM_PaperRun/baseline")->Unit(benchmark::kMillisecond);
 // Whole processes, timed by the wall clock around std::system: the baseline program writing its CSV (t, theta,
 // theta_dot, w) against `redres run` of the same run writing its outputs (trajectory.csv with every column,
 // summary.json, scenario.toml).
@@ -109,7 +100,9 @@ void BM_Process(benchmark::State& state, const char* which) {
 BENCHMARK_CAPTURE(BM_Process, baseline, "baseline")->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(BM_Process, redres_run, "redres_run")->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
-BENCHMARK(BM_PaperRun_Baseline)->Name("BM_PaperRun/baseline_path_table")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_PaperRun_Baseline, table, false)
+    ->Name("BM_PaperRun/baseline_path_table")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PaperRun_Redres, redres_newton, "newton")
     ->Name("BM_PaperRun/redres_newton")
     ->Unit(benchmark::kMillisecond);

@@ -34,7 +34,7 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
   }
   // The error e = r_d - f in every reference row; a spatial orientation's is the rotation vector of R_d R'.
   double e[6];
-  for (Eigen::Index r = 0; r < rows; ++r) e[r] = (*ctx.r_d)(r) - k.f(r);
+  for (Eigen::Index r = 0; r < rows; ++r) e[r] = (*ctx.r_d)(r)-k.f(r);
   if (robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows()) {
     const Eigen::AngleAxisd err(rotation_from_vector(ctx.r_d->tail<3>()) * k.ee_pose.linear().transpose());
     const Eigen::Vector3d v = err.angle() * err.axis();

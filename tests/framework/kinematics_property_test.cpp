@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/SVD>
 #include <rapidcheck/gtest.h>
+#include <Eigen/SVD>
 
 #include "alloc_counter.hpp"
 #include "random_chain.hpp"
@@ -31,8 +31,8 @@ RobotModel random_model() {
   RobotSpec spec = planar ? random_planar(n, task) : random_spatial(n, task);
   if (*rc::gen::inRange(0, 3) == 0) {
     // A random non-empty subset of the pose's rows (a selection matrix S on J).
-    const std::vector<std::string> all = planar ? std::vector<std::string>{"x", "y", "phi"}
-                                                : std::vector<std::string>{"x", "y", "z", "wx", "wy", "wz"};
+    const std::vector<std::string> all =
+        planar ? std::vector<std::string>{"x", "y", "phi"} : std::vector<std::string>{"x", "y", "z", "wx", "wy", "wz"};
     const int mask = *rc::gen::inRange(1, 1 << all.size());
     for (std::size_t r = 0; r < all.size(); ++r) {
       if ((mask >> r) & 1) spec.task_axes.push_back(all[r]);

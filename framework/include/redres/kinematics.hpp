@@ -48,18 +48,18 @@ class KinematicsData {
   /// Sizes every buffer for `model`.
   explicit KinematicsData(const RobotModel& model);
 
-  Eigen::VectorXd theta;                       //!< configuration the results belong to (n)
-  Eigen::VectorXd f;                           //!< reference coordinates f(theta) (reference_dim()): m, rad, rot. vector
-  Eigen::Isometry3d ee_pose;                   //!< end-effector pose in the world frame (the base pose applied)
-  Eigen::Matrix3Xd axes;                       //!< z_j, joint axes in the world frame (3 x n)
-  Eigen::Matrix3Xd origins;                    //!< p_j, points on the joint axes (3 x n), m
-  std::vector<Eigen::Isometry3d> link_frames;  //!< frame of each link: joint j's frame after its motion (n)
-  Eigen::MatrixXd J;                           //!< task Jacobian (m x n)
-  Eigen::MatrixXd dJ;                          //!< [dJ/dtheta_1, ..., dJ/dtheta_n] (m x n*n); see dJ_block()
-  double w = 0.0;                              //!< det(J J')
-  Eigen::VectorXd grad_w;                      //!< q = d w / d theta (n)
-  double mu = 0.0;                             //!< Yoshikawa's sqrt(det(J J'))
-  Eigen::VectorXd grad_mu;                     //!< d mu / d theta (n)
+  Eigen::VectorXd theta;      //!< configuration the results belong to (n)
+  Eigen::VectorXd f;          //!< reference coordinates f(theta) (reference_dim()): m, rad, rot. vector
+  Eigen::Isometry3d ee_pose;  //!< end-effector pose in the world frame (the base pose applied)
+  Eigen::Matrix3Xd axes;      //!< z_j, joint axes in the world frame (3 x n)
+  Eigen::Matrix3Xd origins;   //!< p_j, points on the joint axes (3 x n), m
+  std::vector<Eigen::Isometry3d> link_frames;          //!< frame of each link: joint j's frame after its motion (n)
+  Eigen::MatrixXd J;                                   //!< task Jacobian (m x n)
+  Eigen::MatrixXd dJ;                                  //!< [dJ/dtheta_1, ..., dJ/dtheta_n] (m x n*n); see dJ_block()
+  double w = 0.0;                                      //!< det(J J')
+  Eigen::VectorXd grad_w;                              //!< q = d w / d theta (n)
+  double mu = 0.0;                                     //!< Yoshikawa's sqrt(det(J J'))
+  Eigen::VectorXd grad_mu;                             //!< d mu / d theta (n)
   KinematicsLevel level = KinematicsLevel::kPosition;  //!< what the last compute() filled in
 
   /// dJ/dtheta_i (m x n).

@@ -34,11 +34,4 @@ void QpBuilder::bad_bound(int joint, double lower, double upper) const {
                                                            std::to_string(upper) + ")");
 }
 
-void QpBuilder::intersect_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower,
-                                 const Eigen::Ref<const Eigen::VectorXd>& upper) {
-  REDRES_REQUIRE(lower.size() == qp_->n() && upper.size() == qp_->n(), "QpBuilder::intersect_bounds",
-                 "lower and upper have n entries");
-  for (int i = 0; i < qp_->n(); ++i) intersect_bound(i, lower(i), upper(i));
-}
-
 }  // namespace redres

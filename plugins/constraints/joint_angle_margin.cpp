@@ -29,10 +29,17 @@ void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder) const {
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
   const double kappa = config_.kappa;
+  const double* lower = robot.lower_limits().data();
+  const double* upper = robot.upper_limits().data();
+  const double* margin = margin_.data();
+  const double* q = theta.data();
+  double* lo = builder.scratch().data();
+  double* hi = builder.scratch2().data();
   for (int j = 0; j < robot.dof(); ++j) {
-    builder.intersect_bound(j, kappa * ((robot.lower_limits()(j) + margin_(j)) - theta(j)),
-                            kappa * ((robot.upper_limits()(j) - margin_(j)) - theta(j)));
+    lo[j] = kappa * ((lower[j] + margin[j]) - q[j]);
+    hi[j] = kappa * ((upper[j] - margin[j]) - q[j]);
   }
+  builder.intersect_bounds(builder.scratch(), builder.scratch2());
 }
 
 void JointAngleMargin::summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const {

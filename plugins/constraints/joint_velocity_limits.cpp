@@ -19,9 +19,17 @@ void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder) const {
   const Eigen::VectorXd& theta = ctx.theta();
   const double scale = config_.scale;
   if (ctx.velocity_lower != nullptr && ctx.velocity_upper != nullptr) {
-    for (int j = 0; j < robot.dof(); ++j) {
-      builder.intersect_bound(j, scale * (*ctx.velocity_lower)(j), scale * (*ctx.velocity_upper)(j));
+    if (scale == 1.0) {
+      builder.intersect_bounds(*ctx.velocity_lower, *ctx.velocity_upper);
+      return;
     }
+    Eigen::VectorXd& lo = builder.scratch();
+    Eigen::VectorXd& hi = builder.scratch2();
+    for (int j = 0; j < robot.dof(); ++j) {
+      lo(j) = scale * (*ctx.velocity_lower)(j);
+      hi(j) = scale * (*ctx.velocity_upper)(j);
+    }
+    builder.intersect_bounds(lo, hi);
     return;
   }
   for (int j = 0; j < robot.dof(); ++j) {

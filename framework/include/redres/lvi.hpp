@@ -84,8 +84,8 @@ class LviEngine {
   /// the warm start is reset, so that runaway duals do not slow the next steps down.
   void solve(const QpProblem& qp, SolverResult& result);
   /// solve() for a QP whose values are known to be valid: every entry of W, zeta, J, d, A and b finite, and no
-  /// bound NaN (what QpProblem::validate() checks). Scheme::build() gives such a QP: it checks each plugin's
-  /// contribution as it is written, and the entries no plugin writes keep clear()'s zeros. The Controller solves
+  /// bound NaN (what QpProblem::validate() checks). Scheme::build() gives such a QP: it checks every entry the
+  /// plugins wrote, and the entries no plugin writes keep clear()'s zeros. The Controller solves
   /// with it, so that no entry is scanned twice per step. Sizes are still checked.
   void solve_valid(const QpProblem& qp, SolverResult& result);
   /// Forgets the warm start.

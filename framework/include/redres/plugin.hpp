@@ -104,6 +104,11 @@ class Objective : public Plugin {
   void set_weight(double weight);
   /// Adds this objective's terms and validates them.
   void contribute(const Context& ctx, QpBuilder& builder) const;
+  /// Framework use (Scheme::build): adds the terms without validating them; the caller checks the whole QP after
+  /// every plugin has written, and builds it again through contribute() to name a culprit.
+  void contribute_unchecked(const Context& ctx, QpBuilder& builder) const {
+    if (active()) add_to(ctx, builder);
+  }
   /// A scalar P(theta) whose gradient is the zeta this objective adds per unit weight, where one exists; the
   /// conformance checks compare zeta with central differences of it.
   [[nodiscard]] virtual std::optional<double> potential(const Context& ctx) const {
@@ -126,6 +131,10 @@ class Constraint : public Plugin {
  public:
   /// Adds this constraint's rows and bounds and validates them.
   void contribute(const Context& ctx, QpBuilder& builder) const;
+  /// Framework use (Scheme::build): as Objective::contribute_unchecked.
+  void contribute_unchecked(const Context& ctx, QpBuilder& builder) const {
+    if (active()) add_to(ctx, builder);
+  }
   /// Number of equality rows it writes (fixed at setup).
   [[nodiscard]] virtual int equality_rows(const RobotModel& robot) const {
     (void)robot;

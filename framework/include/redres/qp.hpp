@@ -40,6 +40,7 @@ struct QpProblem {
   std::vector<int> eq_source;               //!< source of each equality row
   std::vector<int> in_source;               //!< source of each inequality row
   Eigen::VectorXd scratch;                  //!< n-vector a plugin may use as workspace while it contributes
+  Eigen::VectorXd scratch2;                 //!< a second one (e.g. upper bounds beside lower ones in scratch)
   /// What inequality row r stands for at the last build (e.g. "link 'j3' shape 1 vs obstacle 2 at 0.012 m"), for
   /// diagnoses; may be empty. Called only when a solve fails.
   std::function<std::string(int)> in_row_description;

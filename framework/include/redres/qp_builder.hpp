@@ -46,7 +46,35 @@ class QpBuilder {
   [[nodiscard]] Eigen::Block<Eigen::MatrixXd> inequality_matrix() { return qp_->A.middleRows(in_offset_, in_rows_); }
   [[nodiscard]] Eigen::VectorBlock<Eigen::VectorXd> inequality_rhs() { return qp_->b.segment(in_offset_, in_rows_); }
   /// lo = max(lo, lower), hi = min(hi, upper), entry-wise, remembering this plugin as the source of each change.
-  void intersect_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower, const Eigen::Ref<const Eigen::VectorXd>& upper);
+  /// Bounds may be infinite; a NaN throws std::invalid_argument naming the joint.
+  void intersect_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower,
+                        const Eigen::Ref<const Eigen::VectorXd>& upper) {
+    const Eigen::Index n = qp_->lo.size();
+    if (lower.size() != n || upper.size() != n) {
+      bad_size("QpBuilder::intersect_bounds", "lower and upper have n entries");
+    }
+    const double* a = lower.data();
+    const double* b = upper.data();
+    double* lo = qp_->lo.data();
+    double* hi = qp_->hi.data();
+    int* lo_source = qp_->lo_source.data();
+    int* hi_source = qp_->hi_source.data();
+    bool nan = false;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      nan |= std::isnan(a[i]) || std::isnan(b[i]);
+      if (a[i] > lo[i]) {
+        lo[i] = a[i];
+        lo_source[i] = source_;
+      }
+      if (b[i] < hi[i]) {
+        hi[i] = b[i];
+        hi_source[i] = source_;
+      }
+    }
+    if (nan) {
+      for (Eigen::Index i = 0; i < n; ++i) intersect_bound(static_cast<int>(i), a[i], b[i]);  // throws at the first
+    }
+  }
   /// The same for one joint.
   void intersect_bound(int joint, double lower, double upper) {
     if (joint < 0 || joint >= qp_->n() || std::isnan(lower) || std::isnan(upper)) bad_bound(joint, lower, upper);
@@ -62,6 +90,8 @@ class QpBuilder {
   }
   /// An n-vector of workspace (contents undefined on entry), so that contributions need no allocation.
   [[nodiscard]] Eigen::VectorXd& scratch() noexcept { return qp_->scratch; }
+  /// A second one.
+  [[nodiscard]] Eigen::VectorXd& scratch2() noexcept { return qp_->scratch2; }
   /// The plugin's weight.
   [[nodiscard]] double weight() const noexcept { return weight_; }
   /// The QP being built (read access).

@@ -22,6 +22,10 @@ class Scheme {
   /// Sizes `qp` for this scheme (n, m_e, m_i) and names its sources.
   void setup(QpProblem& qp) const;
   /// Clears `qp` and lets every active plugin contribute. `ctx.kinematics` must be at kinematics_level().
+  /// The plugins write without checks; then one scan checks every entry they can have written (W, zeta, the
+  /// rows; bounds are checked as they are intersected). When it finds a non-finite entry (or an asymmetric W), the
+  /// QP is built again with a check after each plugin, which throws std::invalid_argument naming the plugin and
+  /// the entry. The QP it leaves is therefore valid (QpProblem::validate() would pass).
   void build(const Context& ctx, QpProblem& qp) const;
 
   /// The deepest kinematics any plugin reads.
@@ -42,6 +46,7 @@ class Scheme {
   std::vector<int> eq_offset_, eq_rows_, in_offset_, in_rows_;
   int m_eq_ = 0, m_in_ = 0;
   KinematicsLevel level_ = KinematicsLevel::kPosition;
+  void build_into(const Context& ctx, QpProblem& qp, bool checked) const;
 };
 
 }  // namespace redres

@@ -158,15 +158,23 @@ namespace detail {
 
 // The stages of compute_kinematics(); a struct so that they may use KinematicsData's workspace.
 struct KinematicsKernels {
-  static void check(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
-                    const KinematicsData& data) {
+  // Checks the sizes and copies theta into data.theta, checking that it is finite on the way.
+  static void check_and_copy(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
+                             KinematicsData& data) {
     const int n = model.dof();
     REDRES_REQUIRE(
         theta.size() == n, "compute_kinematics",
         "theta.size() == dof() (got " + std::to_string(theta.size()) + ", expected " + std::to_string(n) + ")");
-    REDRES_REQUIRE(theta.allFinite(), "compute_kinematics", "theta is finite (it contains NaN or Inf)");
-    REDRES_REQUIRE(data.J.cols() == n && data.J.rows() == model.task_dim(), "compute_kinematics",
-                   "data was sized for this model (KinematicsData(model))");
+    REDRES_REQUIRE(data.J.cols() == n && data.J.rows() == model.task_dim() && data.theta.size() == n,
+                   "compute_kinematics", "data was sized for this model (KinematicsData(model))");
+    const double* in = theta.data();
+    double* out = data.theta.data();
+    double probe = 0.0;  // x * 0 summed: 0 while every entry is finite
+    for (int j = 0; j < n; ++j) {
+      out[j] = in[j];
+      probe += in[j] * 0.0;
+    }
+    REDRES_REQUIRE(probe == 0.0, "compute_kinematics", "theta is finite (it contains NaN or Inf)");
   }
 
   // General path: joint frames, end-effector pose and f by 3-D frame products.
@@ -280,11 +288,19 @@ struct KinematicsKernels {
       px += l * c;
       py += l * s;
     }
-    // The last link's end point, turned by phi_n, then the end effector's fixed transform.
-    Eigen::Isometry3d tip = data.link_frames[static_cast<std::size_t>(n - 1)];
-    tip.translation() << px, py, 0.0;
-    data.ee_pose = tip * model.end_effector();
-    const double ex = data.ee_pose.translation().x(), ey = data.ee_pose.translation().y();
+    // The last link's end point, turned by phi_n (c, s), then the end effector's fixed transform E:
+    // ee = [Rz(phi_n) R_E, Rz(phi_n) t_E + (px, py, 0)], written out (Rz leaves E's third row alone).
+    const Eigen::Matrix4d& E = model.end_effector().matrix();
+    Eigen::Matrix4d& P = data.ee_pose.matrix();
+    for (int col = 0; col < 4; ++col) {
+      P(0, col) = c * E(0, col) - s * E(1, col);
+      P(1, col) = s * E(0, col) + c * E(1, col);
+      P(2, col) = E(2, col);
+      P(3, col) = E(3, col);
+    }
+    P(0, 3) += px;
+    P(1, 3) += py;
+    const double ex = P(0, 3), ey = P(1, 3);
     data.f(0) = ex;
     data.f(1) = ey;
     if (model.task() == TaskRows::kPose) data.f(2) = phi + model.end_effector_angle();
@@ -335,7 +351,14 @@ struct KinematicsKernels {
     for (int r = 0; r < m; ++r) {
       for (int q = 0; q <= r; ++q) data.jjt_(r, q) = data.jjt_(q, r) = A[r][q];
     }
-    data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
+    if constexpr (M == 2) {
+      data.adj_(0, 0) = A[1][1];
+      data.adj_(1, 1) = A[0][0];
+      data.adj_(0, 1) = data.adj_(1, 0) = -A[1][0];
+      data.w = A[0][0] * A[1][1] - A[1][0] * A[1][0];
+    } else {
+      data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
+    }
     // W = adj(A) J in the x and y rows only (h is zero in the phi row).
     double adj_x[3] = {}, adj_y[3] = {};
     bool has_x = false, has_y = false;
@@ -407,8 +430,7 @@ struct KinematicsKernels {
 
   static void compute(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
                       KinematicsLevel level, bool planar_kernel) {
-    check(model, theta, data);
-    data.theta = theta;
+    check_and_copy(model, theta, data);
     const bool planar = planar_kernel && model.kind() == ChainKind::kPlanar;
     if (planar) {
       forward_planar(model, data, level >= KinematicsLevel::kJacobian);

@@ -159,8 +159,10 @@ void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::V
   segments_[j].at(std::min(s - seg_start_[j], segments_[j].length), p, tangent);
   const Eigen::Vector3d world = origin_ + rotation_ * p;
   const Eigen::Vector3d velocity = rotation_ * tangent * speed;
-  r = world.head(dim_);
-  r_dot = velocity.head(dim_);
+  for (int i = 0; i < dim_; ++i) {
+    r(i) = world(i);
+    r_dot(i) = velocity(i);
+  }
 }
 
 PathRegistry& path_registry() {

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <numbers>
 #include <sstream>
+#include <string_view>
 
 #include <Eigen/Geometry>
 
@@ -104,10 +105,13 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   Eigen::Vector3d wd_prev = Eigen::Vector3d::Zero(), w_prev = Eigen::Vector3d::Zero();
   const auto start = std::chrono::steady_clock::now();
   const int report_every = std::max(1, steps / 200);
-  const auto note = [&run](const StepOutput& o, double t) {
-    if (std::find(run.engines.begin(), run.engines.end(), o.info.engine) == run.engines.end()) {
+  std::string_view last_engine;  // the engine of the previous step (the names are static strings)
+  const auto note = [&run, &last_engine](const StepOutput& o, double t) {
+    if ((run.engines.empty() || o.info.engine.data() != last_engine.data()) &&
+        std::find(run.engines.begin(), run.engines.end(), o.info.engine) == run.engines.end()) {
       run.engines.push_back(o.info.engine);
     }
+    last_engine = o.info.engine;
     if (o.info.status != SolverStatus::kSolved && run.failures++ == 0) {
       std::ostringstream msg;
       msg << "t = " << t << " s: " << to_string(o.info.status) << ": " << o.info.diagnosis;
@@ -154,8 +158,13 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
       for (int r = 0; r < m; ++r) row[c++] = ctrl.r_d()(r);
       for (int r = 0; r < m; ++r) row[c++] = kin.f(r);
     }
-    row[c++] = all_position_rows ? (ctrl.r_d().head(position_rows) - kin.f.head(position_rows)).norm()
-                                 : tracked_norm(ctrl.r_d() - kin.f, 0, position_rows);
+    if (all_position_rows) {
+      double sum = 0.0;
+      for (int r = 0; r < position_rows; ++r) sum += (ctrl.r_d()(r) - kin.f(r)) * (ctrl.r_d()(r) - kin.f(r));
+      row[c++] = std::sqrt(sum);
+    } else {
+      row[c++] = tracked_norm(ctrl.r_d() - kin.f, 0, position_rows);
+    }
     if (orientation_rows) {
       // The angle between the desired and the actual orientation: planar |phi_d - phi|; spatial the angle of
       // R_d R' (from the rotations themselves). A subset of the orientation rows: the norm of those rows of the

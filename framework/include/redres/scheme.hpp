@@ -46,7 +46,7 @@ class Scheme {
   std::vector<int> eq_offset_, eq_rows_, in_offset_, in_rows_;
   int m_eq_ = 0, m_in_ = 0;
   KinematicsLevel level_ = KinematicsLevel::kPosition;
-  void build_into(const Context& ctx, QpProblem& qp, bool checked) const;
+  [[noreturn]] void build_checked(const Context& ctx, QpProblem& qp) const;
 };
 
 }  // namespace redres

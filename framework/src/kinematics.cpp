@@ -268,6 +268,8 @@ struct KinematicsKernels {
     double phi = model.base_angle();
     double px = model.base().translation().x(), py = model.base().translation().y();
     double c = 1.0, s = 0.0;
+    const JointSpec* joints = model.joints().data();
+    Eigen::Isometry3d* frames = data.link_frames.data();
     for (int j = 0; j < n; ++j) {
       origins[3 * j] = px;
       origins[3 * j + 1] = py;
@@ -279,12 +281,12 @@ struct KinematicsKernels {
       c = std::cos(phi);
       s = std::sin(phi);
       // The link frame: Rz(phi_j) at p_j (column-major 4 x 4).
-      double* F = data.link_frames[static_cast<std::size_t>(j)].matrix().data();
+      double* F = frames[j].matrix().data();
       F[0] = c, F[1] = s, F[2] = 0.0, F[3] = 0.0;
       F[4] = -s, F[5] = c, F[6] = 0.0, F[7] = 0.0;
       F[8] = 0.0, F[9] = 0.0, F[10] = 1.0, F[11] = 0.0;
       F[12] = px, F[13] = py, F[14] = 0.0, F[15] = 1.0;
-      const double l = model.joint(j).length;
+      const double l = joints[j].length;
       px += l * c;
       py += l * s;
     }

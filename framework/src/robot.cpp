@@ -212,10 +212,14 @@ void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta,
   const int n = dof();
   REDRES_REQUIRE(theta.size() == n && lower.size() == n && upper.size() == n, "RobotModel::velocity_limits",
                  "theta, lower and upper have size dof() = " + std::to_string(n));
+  const JointSpec* joints = spec_.joints.data();
+  const double* q = theta.data();
+  double* lo = lower.data();
+  double* hi = upper.data();
   for (int j = 0; j < n; ++j) {
-    const VelocityBounds b = spec_.joints[static_cast<std::size_t>(j)].velocity_limit->bounds(theta(j));
-    lower(j) = b.lower;
-    upper(j) = b.upper;
+    const VelocityBounds b = joints[j].velocity_limit->bounds(q[j]);
+    lo[j] = b.lower;
+    hi[j] = b.upper;
   }
 }
 

@@ -35,7 +35,8 @@ void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder) const {
   const double* q = theta.data();
   double* lo = builder.scratch().data();
   double* hi = builder.scratch2().data();
-  for (int j = 0; j < robot.dof(); ++j) {
+  const int n = robot.dof();
+  for (int j = 0; j < n; ++j) {
     lo[j] = kappa * ((lower[j] + margin[j]) - q[j]);
     hi[j] = kappa * ((upper[j] - margin[j]) - q[j]);
   }

@@ -27,14 +27,20 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
   REDRES_REQUIRE(ctx.r_d->size() == rows && ctx.r_d_dot->size() == rows, "task_tracking",
                  "r_d and r_d_dot have one entry per reference row (" + std::to_string(rows) + ")");
   const KinematicsData& k = *ctx.kinematics;
+  // J: this plugin's rows of the QP's J (column-major, leading dimension m_e), copied column by column.
   auto J = builder.equality_matrix();
-  const Eigen::Index m = k.J.rows(), n = k.J.cols();
+  const Eigen::Index m = k.J.rows(), n = k.J.cols(), ld = J.outerStride();
+  const double* from = k.J.data();
+  double* to = J.data();
   for (Eigen::Index c = 0; c < n; ++c) {
-    for (Eigen::Index r = 0; r < m; ++r) J(r, c) = k.J(r, c);
+    for (Eigen::Index r = 0; r < m; ++r) to[c * ld + r] = from[c * m + r];
   }
   // The error e = r_d - f in every reference row; a spatial orientation's is the rotation vector of R_d R'.
+  const double* r_d = ctx.r_d->data();
+  const double* r_d_dot = ctx.r_d_dot->data();
+  const double* f = k.f.data();
   double e[6];
-  for (Eigen::Index r = 0; r < rows; ++r) e[r] = (*ctx.r_d)(r)-k.f(r);
+  for (Eigen::Index r = 0; r < rows; ++r) e[r] = r_d[r] - f[r];
   if (robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows()) {
     const Eigen::AngleAxisd err(rotation_from_vector(ctx.r_d->tail<3>()) * k.ee_pose.linear().transpose());
     const Eigen::Vector3d v = err.angle() * err.axis();
@@ -43,11 +49,13 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
     e[5] = v.z();
   }
   // d = S (r_d_dot + K e): the task rows only (all of them unless the task names a subset).
-  auto d = builder.equality_rhs();
-  const std::vector<int>& task_rows = robot.task_rows();
-  for (Eigen::Index i = 0; i < gain_.size(); ++i) {
-    const int r = task_rows[static_cast<std::size_t>(i)];
-    d(i) = (*ctx.r_d_dot)(r) + gain_(i) * e[r];
+  double* d = builder.equality_rhs().data();
+  const int* task_rows = robot.task_rows().data();
+  const double* gain = gain_.data();
+  const Eigen::Index task = gain_.size();
+  for (Eigen::Index i = 0; i < task; ++i) {
+    const int r = task_rows[i];
+    d[i] = r_d_dot[r] + gain[i] * e[r];
   }
 }
 

@@ -187,8 +187,9 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
       REDRES_REQUIRE(it != all.end(), "RobotModel",
                      "task_axes name rows of the " + std::string(to_string(spec_.kind)) + " pose (got '" + name + "')");
       const int r = static_cast<int>(it - all.begin());
-      REDRES_REQUIRE(r > previous, "RobotModel",
-                     "task_axes name each row once, in the pose's order (" + join(all) + "): '" + name + "' is out of place");
+      REDRES_REQUIRE(
+          r > previous, "RobotModel",
+          "task_axes name each row once, in the pose's order (" + join(all) + "): '" + name + "' is out of place");
       previous = r;
       orientation = orientation || r >= position_rows();
     }

@@ -146,8 +146,9 @@ void Scheme::build_checked(const Context& ctx, QpProblem& qp) const {
     constraints_[k]->contribute(ctx, builder);
   }
   qp.validate();  // the checked build found nothing (a plugin that gives different values when called again)
-  throw_invalid_argument("Scheme::build", "the QP had a non-finite or asymmetric entry that a second build did not "
-                                          "reproduce (a plugin whose output changes between two calls at one state)");
+  throw_invalid_argument("Scheme::build",
+                         "the QP had a non-finite or asymmetric entry that a second build did not "
+                         "reproduce (a plugin whose output changes between two calls at one state)");
 }
 
 }  // namespace redres

@@ -1,6 +1,7 @@
-// What a plugin writes into the step's QP is checked after its contribution, whatever it wrote and wherever: a NaN
-// or an infinity in zeta, in W (on or off its diagonal), in a constraint's rows or right-hand sides, and a W that is
-// not symmetric are std::invalid_argument naming the plugin and the entry; finite contributions pass.
+// What a plugin writes into the step's QP is checked by Scheme::build, whatever it wrote and wherever: a NaN or an
+// infinity in zeta, in W (on or off its diagonal), in a constraint's rows or right-hand sides, a NaN bound, and a W
+// that is not symmetric are std::invalid_argument naming the plugin and the entry; finite contributions pass. A
+// plugin whose NaN the checked second build cannot reproduce is reported as such.
 
 #include <limits>
 
@@ -78,6 +79,44 @@ class RowWriter final : public Constraint {
   double value_;
 };
 
+// A constraint that adds to zeta (constraints may, like objectives) or intersects the bounds with a NaN at joint 3.
+class ZetaAndBoundWriter final : public Constraint {
+ public:
+  enum class Where { kZeta, kBound };
+  explicit ZetaAndBoundWriter(Where where) : Constraint("zeta_writer"), where_(where) {}
+
+ private:
+  void add_to(const Context& ctx, QpBuilder& b) const override {
+    const int n = ctx.robot->dof();
+    Eigen::VectorXd lo = Eigen::VectorXd::Constant(n, -1.0), hi = Eigen::VectorXd::Constant(n, 1.0);
+    if (where_ == Where::kZeta) {
+      lo(4) = kNaN;
+      b.add_linear(lo);
+    } else {
+      hi(2) = kNaN;
+      b.intersect_bounds(lo, hi);
+    }
+  }
+  void write_config(toml::table&) const override {}
+  Where where_;
+};
+
+// An objective whose first contribution is NaN and every later one finite: what the checked second build cannot
+// reproduce.
+class Flaky final : public Objective {
+ public:
+  Flaky() : Objective("flaky") {}
+
+ private:
+  void add_to(const Context& ctx, QpBuilder& b) const override {
+    Eigen::VectorXd z = Eigen::VectorXd::Zero(ctx.robot->dof());
+    if (calls_++ == 0) z(0) = kNaN;
+    b.add_linear(z);
+  }
+  void write_config(toml::table&) const override {}
+  mutable int calls_ = 0;
+};
+
 std::string build_error(std::unique_ptr<Objective> objective, std::unique_ptr<Constraint> constraint) {
   const RobotModel robot = load_robot(source_path("robots/paper_pushrod_6dof.toml"));
   std::vector<std::unique_ptr<Objective>> objectives;
@@ -128,6 +167,16 @@ TEST(PluginOutput, NonFiniteConstraintRowsNameThePluginAndItsRow) {
     }
     EXPECT_EQ(build_error(nullptr, std::make_unique<RowWriter>(where, 2.0)), "");
   }
+}
+
+TEST(PluginOutput, AConstraintsZetaAndBoundsAreCheckedAndAnIrreproducibleNanIsNamed) {
+  using Z = ZetaAndBoundWriter::Where;
+  const std::string zeta = build_error(nullptr, std::make_unique<ZetaAndBoundWriter>(Z::kZeta));
+  EXPECT_NE(zeta.find("constraint 'zeta_writer' produced an invalid QP: zeta(4, 0)"), std::string::npos) << zeta;
+  const std::string bound = build_error(nullptr, std::make_unique<ZetaAndBoundWriter>(Z::kBound));
+  EXPECT_NE(bound.find("a bound of joint 3 is NaN"), std::string::npos) << bound;
+  const std::string flaky = build_error(std::make_unique<Flaky>(), nullptr);
+  EXPECT_NE(flaky.find("a second build did not reproduce"), std::string::npos) << flaky;
 }
 
 }  // namespace

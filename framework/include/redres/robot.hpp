@@ -75,10 +75,10 @@ struct JointSpec {
 
 /// Everything needed to build a RobotModel; filled by the TOML loader or by code (tests, generators).
 struct RobotSpec {
-  std::string name;                                                //!< robot name
-  ChainKind kind = ChainKind::kPlanar;                             //!< planar or spatial
-  DhConvention convention = DhConvention::kStandard;               //!< spatial only
-  TaskRows task = TaskRows::kPosition;                             //!< task rows
+  std::string name;                                   //!< robot name
+  ChainKind kind = ChainKind::kPlanar;                //!< planar or spatial
+  DhConvention convention = DhConvention::kStandard;  //!< spatial only
+  TaskRows task = TaskRows::kPosition;                //!< task rows
   /// A subset of the task's rows by name, in row order (empty: every row of `task`). When given it decides `task`:
   /// pose when it names an orientation row (phi, wx, wy or wz), position otherwise.
   std::vector<std::string> task_axes;

@@ -46,15 +46,15 @@ struct SweepAxis {
 
 /// A loaded sweep file.
 struct SweepSpec {
-  std::string name;                        //!< the sweep's name (default: the file's stem)
-  std::string source;                      //!< the sweep file
-  std::filesystem::path scenario;          //!< the base scenario file
-  std::vector<std::string> set;            //!< overrides applied to every variation, before the axes'
-  bool zip = false;                        //!< axes side by side instead of crossed
-  std::vector<SweepAxis> axes;             //!< the grid
-  std::vector<Eigen::VectorXd> theta0;     //!< initial configurations (empty: the scenario's own)
-  RecordOptions record{1, true};           //!< rows of each run's trajectory.csv (with write_runs)
-  bool write_runs = false;                 //!< write runs/<index>/ for every variation
+  std::string name;                     //!< the sweep's name (default: the file's stem)
+  std::string source;                   //!< the sweep file
+  std::filesystem::path scenario;       //!< the base scenario file
+  std::vector<std::string> set;         //!< overrides applied to every variation, before the axes'
+  bool zip = false;                     //!< axes side by side instead of crossed
+  std::vector<SweepAxis> axes;          //!< the grid
+  std::vector<Eigen::VectorXd> theta0;  //!< initial configurations (empty: the scenario's own)
+  RecordOptions record{1, true};        //!< rows of each run's trajectory.csv (with write_runs)
+  bool write_runs = false;              //!< write runs/<index>/ for every variation
   /// Number of variations.
   [[nodiscard]] std::size_t size() const;
 };
@@ -62,9 +62,9 @@ struct SweepSpec {
 /// One variation: its index and the overrides that make it from the base scenario.
 struct Variation {
   std::size_t index = 0;
-  std::vector<std::string> overrides;      //!< "key=value", in axis order, then theta0
-  std::vector<std::string> values;         //!< each axis's value (TOML text)
-  std::optional<Eigen::VectorXd> theta0;   //!< when the sweep varies theta0
+  std::vector<std::string> overrides;     //!< "key=value", in axis order, then theta0
+  std::vector<std::string> values;        //!< each axis's value (TOML text)
+  std::optional<Eigen::VectorXd> theta0;  //!< when the sweep varies theta0
 };
 
 /// Loads a sweep file; the base scenario is loaded once to check it and to sample theta0 within its robot's

@@ -9,7 +9,7 @@ namespace redres {
 
 void QpProblem::resize(int n, int m_e, int m_i) {
   REDRES_REQUIRE(n > 0 && m_e >= 0 && m_i >= 0, "QpProblem::resize", "n > 0, m_e >= 0 and m_i >= 0");
-  W.resize(n, n);
+  W.setZero(n, n);
   zeta.resize(n);
   J.resize(m_e, n);
   d.resize(m_e);
@@ -27,7 +27,14 @@ void QpProblem::resize(int n, int m_e, int m_i) {
 }
 
 void QpProblem::clear() {
-  W.setZero();
+  if (w_diagonal) {
+    // Only the diagonal can be non-zero (the flag's invariant): zero it alone.
+    const Eigen::Index nn = W.rows();
+    double* w = W.data();
+    for (Eigen::Index i = 0; i < nn; ++i) w[i * (nn + 1)] = 0.0;
+  } else {
+    W.setZero();
+  }
   zeta.setZero();
   J.setZero();
   d.setZero();

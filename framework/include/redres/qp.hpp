@@ -32,7 +32,8 @@ struct QpProblem {
   Eigen::VectorXd b;                        //!< inequality right-hand side (m_i)
   Eigen::VectorXd lo;                       //!< lower bounds (n); -inf where unbounded
   Eigen::VectorXd hi;                       //!< upper bounds (n); +inf where unbounded
-  bool w_diagonal = true;                   //!< true while only diagonal terms were added to W
+  bool w_diagonal = true;                   //!< true while only diagonal terms were added to W (then every
+                                            //!< entry off W's diagonal is zero: engines and clear() rely on it)
   std::vector<int> lo_source;               //!< index of the source that set lo_i (-1: none)
   std::vector<int> hi_source;               //!< index of the source that set hi_i (-1: none)
   std::vector<std::string> source_names;    //!< names of the bound and row sources, indexed as above

@@ -397,6 +397,45 @@ struct KinematicsKernels {
     if (has_x == has_y) g[0] = 0.0;
   }
 
+  // Spatial chains of revolute joints at kGradient: w and grad w in O(m n) without the kinematic Hessian. With the
+  // revolute Hessian (kinematic_hessian_revolute) and W = adj(J J') J split into its linear rows Wl_j and angular
+  // rows Wa_j (zero where a row is not a task row), a.(b x c) = b.(c x a) turns q_i = 2 sum_j <W_j, dJ_i e_j> into
+  //   q_i = 2 (z_i . (sum_{j >= i} Jv_j x Wl_j + sum_{j > i} z_j x Wa_j) + Jv_i . sum_{j < i} Wl_j x z_j),
+  // two suffix sums and one prefix sum.
+  static void gradient_revolute(const RobotModel& model, KinematicsData& data) {
+    const int n = model.dof(), m = model.task_dim();
+    data.jjt_.noalias() = data.J * data.J.transpose();
+    data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
+    data.weighted_.noalias() = data.adj_ * data.J;
+    const Vector3d p_e = data.ee_pose.translation();
+    auto& lin = data.linear_;
+    for (int j = 0; j < n; ++j) lin.col(j) = data.axes.col(j).cross(p_e - data.origins.col(j));
+    // The suffix sums, from the tip: S_i = sum_{j >= i} Jv_j x Wl_j + sum_{j > i} z_j x Wa_j (into grad_w as
+    // z_i . S_i), then the prefix sum C_i = sum_{j < i} Wl_j x z_j.
+    const auto split = [&](int j, Vector3d& wl, Vector3d& wa) {
+      wl.setZero();
+      wa.setZero();
+      for (int r = 0; r < m; ++r) {
+        const int t = model.twist_row(r);
+        (t < 3 ? wl(t) : wa(t - 3)) = data.weighted_(r, j);
+      }
+    };
+    Vector3d suffix = Vector3d::Zero(), wl, wa;
+    for (int i = n - 1; i >= 0; --i) {
+      split(i, wl, wa);
+      const Vector3d z = data.axes.col(i);
+      suffix += lin.col(i).cross(wl);
+      data.grad_w(i) = z.dot(suffix);
+      suffix += z.cross(wa);  // counts for the joints before i only
+    }
+    Vector3d prefix = Vector3d::Zero();
+    for (int i = 0; i < n; ++i) {
+      split(i, wl, wa);
+      data.grad_w(i) = 2.0 * (data.grad_w(i) + lin.col(i).dot(prefix));
+      prefix += wl.cross(data.axes.col(i));
+    }
+  }
+
   // mu = prod s_k and d mu = sum_k (prod_{j != k} s_j) u_k' dJ v_k. With fewer joints than task rows a
   // singular value is identically zero, so mu and its gradient vanish.
   // Away from singularities, mu = sqrt(w) and grad mu = grad w / (2 mu) give the same without a singular value
@@ -431,9 +470,9 @@ struct KinematicsKernels {
   }
 
   static void compute(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
-                      KinematicsLevel level, bool planar_kernel) {
+                      KinematicsLevel level, bool kernels) {
     check_and_copy(model, theta, data);
-    const bool planar = planar_kernel && model.kind() == ChainKind::kPlanar;
+    const bool planar = kernels && model.kind() == ChainKind::kPlanar;
     if (planar) {
       forward_planar(model, data, level >= KinematicsLevel::kJacobian);
     } else {
@@ -451,6 +490,8 @@ struct KinematicsKernels {
         default: gradient_planar<3>(model, data); break;
       }
       if (level >= KinematicsLevel::kManipulability) hessian(model, data);
+    } else if (kernels && level == KinematicsLevel::kGradient && model.all_revolute()) {
+      gradient_revolute(model, data);
     } else {
       hessian(model, data);
       gradient_general(model, data);

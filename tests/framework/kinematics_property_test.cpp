@@ -166,6 +166,34 @@ RC_GTEST_PROP(KinematicsProperty, ThePlanarKernelIsTheGeneralPath, ()) {
   }
 }
 
+// Spatial chains of revolute joints at kGradient: grad w from the sums along the chain (no dJ) is the general
+// path's <adj(J J') J, dJ_i>, on random chains (their prismatic joints made revolute) with random task rows.
+RC_GTEST_PROP(KinematicsProperty, TheRevoluteGradientIsTheGeneralOne, ()) {
+  RobotSpec spec = random_spatial(*rc::gen::inRange(1, 13), *rc::gen::element(TaskRows::kPosition, TaskRows::kPose));
+  for (auto& j : spec.joints) j.type = JointType::kRevolute;
+  if (spec.task == TaskRows::kPose && *rc::gen::inRange(0, 2) == 0) {
+    const std::vector<std::string> all{"x", "y", "z", "wx", "wy", "wz"};
+    const int mask = *rc::gen::inRange(1, 64);
+    for (std::size_t r = 0; r < all.size(); ++r) {
+      if ((mask >> r) & 1) spec.task_axes.push_back(all[r]);
+    }
+  }
+  const RobotModel model(std::move(spec));
+  RC_ASSERT(model.all_revolute());
+  const Eigen::VectorXd theta = random_theta(model);
+  KinematicsData kernel(model), general(model);
+  kernel.dJ.setConstant(7.0);
+  compute_kinematics(model, theta, kernel, KinematicsLevel::kGradient);
+  compute_kinematics_general(model, theta, general, KinematicsLevel::kGradient);
+  RC_ASSERT(kernel.level == KinematicsLevel::kGradient);
+  RC_ASSERT((kernel.dJ.array() == 7.0).all());  // no Hessian
+  RC_ASSERT(std::abs(kernel.w - general.w) <= 1e-12 * (1.0 + general.w));
+  const double err = (kernel.grad_w - general.grad_w).cwiseAbs().maxCoeff();
+  if (!(err <= 1e-12 * (1.0 + general.grad_w.cwiseAbs().maxCoeff()))) {
+    RC_FAIL("grad w differs by " + std::to_string(err));
+  }
+}
+
 // mu and grad mu, whichever way compute_kinematics takes (sqrt(w) away from singularities, the singular value
 // decomposition near them), are those of the decomposition: mu = prod s_k, d mu = sum_k prod_{j != k} s_j u_k' dJ v_k.
 RC_GTEST_PROP(KinematicsProperty, YoshikawaIsThatOfTheSingularValues, ()) {

@@ -94,13 +94,14 @@ void kinematic_hessian_revolute(const RobotModel& model, KinematicsData& data);
 /// points in one pass, J's columns from p_e - p_j, and grad w in O(m n) without the kinematic Hessian. (For a
 /// planar chain dJ/dtheta_i has column j equal to h_max(i,j), h_c = -(p_e - p_c) in the x and y rows and 0 in the
 /// phi row, so q_i = 2 (h_i . sum_{j <= i} W_j + sum_{j > i} h_j . W_j) with W = adj(J J') J: one prefix and one
-/// suffix sum.) Every other chain, and planar ones through compute_kinematics_general(), take the general
-/// path: 3-D frame products, J from the axes, dJ/dtheta_i, and q_i = 2 <adj(J J') J, dJ/dtheta_i>_F. The tests
-/// check that both give the same results to rounding.
+/// suffix sum.) Spatial chains of revolute joints at kGradient get grad w the same way, from two suffix sums and a
+/// prefix sum of cross products along the chain, without dJ. Everything else, and every chain through
+/// compute_kinematics_general(), takes the general path: 3-D frame products, J from the axes, dJ/dtheta_i, and
+/// q_i = 2 <adj(J J') J, dJ/dtheta_i>_F. The tests check that both give the same results to rounding.
 void compute_kinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
                         KinematicsLevel level = KinematicsLevel::kManipulability);
 
-/// The general path for any chain (the reference the planar kernel is tested against). Same contract as
+/// The general path for any chain (the reference the kernels are tested against). Same contract as
 /// compute_kinematics().
 void compute_kinematics_general(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
                                 KinematicsData& data, KinematicsLevel level = KinematicsLevel::kManipulability);

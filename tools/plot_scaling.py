@@ -16,9 +16,12 @@ if len(sys.argv) != 3:
     sys.exit(__doc__)
 with open(sys.argv[1]) as f:
     runs = [b for b in json.load(f)["benchmarks"] if b["name"].startswith("BM_Scaling/")]
+# With --benchmark_repetitions, plot the medians; otherwise the single runs.
+if any(b.get("aggregate_name") for b in runs):
+    runs = [b for b in runs if b.get("aggregate_name") == "median"]
 series = {}
 for b in runs:
-    _, case, n = b["name"].split("/")[:3]
+    _, case, n = b["run_name"].split("/")[:3]
     engine, kind = case.rsplit("_", 1)
     series.setdefault((kind, engine), []).append((int(n), b["per_step"] * 1e6))
 fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)

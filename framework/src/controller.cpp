@@ -112,14 +112,8 @@ void Controller::solve(double t, StepOutput& out) {
   robot_->velocity_limits(kin_.theta, vlo_, vhi_);
   scheme_->build(ctx_, qp_);
   engine_->solve_valid(qp_, result_);  // build() checked every entry it wrote
-  const int n = robot_->dof();
-  for (int j = 0; j < n; ++j) out.theta_dot(j) = result_.x(j);
-  const SolverInfo& info = result_.info;
-  out.info.status = info.status;
-  out.info.iterations = info.iterations;
-  out.info.residual = info.residual;
-  out.info.engine = info.engine;
-  if (!info.diagnosis.empty() || !out.info.diagnosis.empty()) out.info.diagnosis = info.diagnosis;
+  out.theta_dot = result_.x;
+  out.info = result_.info;
 }
 
 }  // namespace redres

@@ -120,9 +120,7 @@ void kinematic_hessian_revolute(const RobotModel& model, KinematicsData& data) {
   // identity) d(z_j x (p_e - p_j))/dtheta_i = z_i x Jv_j for i <= j and z_j x Jv_i for i > j, with
   // Jv_j = z_j x (p_e - p_j); and dz_j/dtheta_i = z_i x z_j for i < j, else 0. One cross product per entry.
   const int n = model.dof();
-  const Vector3d p_e = data.ee_pose.translation();
-  auto& lin = data.linear_;
-  for (int j = 0; j < n; ++j) lin.col(j) = data.axes.col(j).cross(p_e - data.origins.col(j));
+  const auto& lin = data.linear_;  // Jv_j = z_j x (p_e - p_j), from the Jacobian stage
   if (model.kind() == ChainKind::kPlanar) {
     // Every axis is the world z: z x v = (-v_y, v_x, 0) exactly (the cross product's other terms are exact zeros),
     // and z_i x z_j = 0.
@@ -231,13 +229,16 @@ struct KinematicsKernels {
   }
 
   // General path: the geometric Jacobian, task rows only.
+  // The linear part of each column goes to linear_ too (the Hessian and the revolute kernel read it).
   static void jacobian_general(const RobotModel& model, KinematicsData& data) {
     const Vector3d p_e = data.ee_pose.translation();
     for (int j = 0; j < model.dof(); ++j) {
       const Vector3d z = data.axes.col(j);
       if (model.joint(j).type == JointType::kRevolute) {
-        put_rows(model, z.cross(p_e - data.origins.col(j)), z, data.J, j);
+        data.linear_.col(j) = z.cross(p_e - data.origins.col(j));
+        put_rows(model, data.linear_.col(j), z, data.J, j);
       } else {
+        data.linear_.col(j) = z;
         put_rows(model, z, Vector3d::Zero(), data.J, j);
       }
     }
@@ -251,11 +252,16 @@ struct KinematicsKernels {
     }
   }
 
-  // General path: w = det(J J') and q_i = 2 <adj(J J') J, dJ_i>_F, from dJ.
-  static void gradient_general(const RobotModel& model, KinematicsData& data) {
+  // w = det(J J') and W = adj(J J') J into weighted_.
+  static void det_and_weighted(KinematicsData& data) {
     data.jjt_.noalias() = data.J * data.J.transpose();
     data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
     data.weighted_.noalias() = data.adj_ * data.J;
+  }
+
+  // General path: w and q_i = 2 <adj(J J') J, dJ_i>_F, from dJ.
+  static void gradient_general(const RobotModel& model, KinematicsData& data) {
+    det_and_weighted(data);
     for (int i = 0; i < model.dof(); ++i) data.grad_w(i) = 2.0 * data.weighted_.cwiseProduct(data.dJ_block(i)).sum();
   }
 
@@ -404,12 +410,8 @@ struct KinematicsKernels {
   // two suffix sums and one prefix sum.
   static void gradient_revolute(const RobotModel& model, KinematicsData& data) {
     const int n = model.dof(), m = model.task_dim();
-    data.jjt_.noalias() = data.J * data.J.transpose();
-    data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
-    data.weighted_.noalias() = data.adj_ * data.J;
-    const Vector3d p_e = data.ee_pose.translation();
-    auto& lin = data.linear_;
-    for (int j = 0; j < n; ++j) lin.col(j) = data.axes.col(j).cross(p_e - data.origins.col(j));
+    det_and_weighted(data);
+    const auto& lin = data.linear_;  // Jv_j, from the Jacobian stage
     // The suffix sums, from the tip: S_i = sum_{j >= i} Jv_j x Wl_j + sum_{j > i} z_j x Wa_j (into grad_w as
     // z_i . S_i), then the prefix sum C_i = sum_{j < i} Wl_j x z_j.
     const auto split = [&](int j, Vector3d& wl, Vector3d& wa) {

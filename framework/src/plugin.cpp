@@ -57,29 +57,13 @@ void check_finite(const M& m, const char* kind, const std::string& name, const c
 
 // The checks after a contribution look at what the plugin can have written, and only at that: zeta if it added to it,
 // the part of W it added to (nothing, the diagonal, or all of it, then also its symmetry), and a constraint's own
-// rows. The scan is a plain loop over the entries (x * 0 is 0 exactly for finite x, NaN otherwise);
-// check_finite names the entry on failure.
-template <class M>
-bool all_finite(const M& m) {
-  const double* p = m.data();
-  const Eigen::Index rows = m.rows(), cols = m.cols(), stride = m.outerStride();
-  double acc = 0.0;
-  for (Eigen::Index c = 0; c < cols; ++c, p += stride) {
-    for (Eigen::Index r = 0; r < rows; ++r) acc += p[r] * 0.0;
-  }
-  return acc == 0.0;
-}
+// rows. The scans are finite_probe() (qp.hpp); name_culprit names the entry on failure.
 
-// Rows [offset, offset + rows) of M (column-major) and of v: finite?
-bool rows_finite(const Eigen::MatrixXd& M, const Eigen::VectorXd& v, int offset, int rows) {
-  if (rows == 0) return true;
-  double acc = 0.0;
-  const double* p = M.data() + offset;
-  for (Eigen::Index c = 0; c < M.cols(); ++c, p += M.rows()) {
-    for (int r = 0; r < rows; ++r) acc += p[r] * 0.0;
-  }
-  for (int r = 0; r < rows; ++r) acc += v(offset + r) * 0.0;
-  return acc == 0.0;
+// x * 0 summed over rows [offset, offset + rows) of M (column-major) and of v.
+double rows_probe(const Eigen::MatrixXd& M, const Eigen::VectorXd& v, int offset, int rows) {
+  double acc = finite_probe(v.data() + offset, rows);
+  for (Eigen::Index c = 0; c < M.cols(); ++c) acc += finite_probe(M.data() + c * M.rows() + offset, rows);
+  return acc;
 }
 
 // The full check with the names of the culprits; runs only when the fast scan below finds a non-finite entry.
@@ -97,22 +81,19 @@ bool rows_finite(const Eigen::MatrixXd& M, const Eigen::VectorXd& v, int offset,
 void check_contribution(const QpBuilder& builder, const char* kind, const std::string& name) {
   const QpProblem& qp = builder.problem();
   const Eigen::Index n = qp.zeta.size();
-  double acc = 0.0;  // x * 0 summed: 0 while every entry scanned is finite
-  if (builder.wrote_zeta()) {
-    for (Eigen::Index i = 0; i < n; ++i) acc += qp.zeta(i) * 0.0;
-  }
+  double acc = builder.wrote_zeta() ? finite_probe(qp.zeta.data(), n) : 0.0;
   switch (builder.written_w()) {
     case QpBuilder::WrittenW::kNone: break;
     case QpBuilder::WrittenW::kDiagonal:
       for (Eigen::Index i = 0; i < n; ++i) acc += qp.W(i, i) * 0.0;
       break;
     case QpBuilder::WrittenW::kFull:
-      if (!all_finite(qp.W)) name_culprit(builder, kind, name);
-      if (!qp.W.isApprox(qp.W.transpose(), 1e-12)) bad_output(kind, name, "W is not symmetric");
+      acc += finite_probe(qp.W.data(), qp.W.size());
+      if (acc == 0.0 && !qp.W.isApprox(qp.W.transpose(), 1e-12)) bad_output(kind, name, "W is not symmetric");
       break;
   }
-  if (builder.eq_rows() > 0 && !rows_finite(qp.J, qp.d, builder.eq_offset(), builder.eq_rows())) acc += NAN;
-  if (builder.in_rows() > 0 && !rows_finite(qp.A, qp.b, builder.in_offset(), builder.in_rows())) acc += NAN;
+  if (builder.eq_rows() > 0) acc += rows_probe(qp.J, qp.d, builder.eq_offset(), builder.eq_rows());
+  if (builder.in_rows() > 0) acc += rows_probe(qp.A, qp.b, builder.in_offset(), builder.in_rows());
   if (acc != 0.0) name_culprit(builder, kind, name);
 }
 

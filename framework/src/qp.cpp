@@ -73,9 +73,8 @@ void QpProblem::validate() const {
   REDRES_REQUIRE(J.cols() == nn && J.rows() == d.size(), "QpProblem", "J is m_e x n and d has m_e entries");
   REDRES_REQUIRE(A.cols() == nn && A.rows() == b.size(), "QpProblem", "A is m_i x n and b has m_i entries");
   REDRES_REQUIRE(lo.size() == nn && hi.size() == nn, "QpProblem", "lo and hi have n entries");
-  // Fast check first (x - x is 0 for finite x, NaN for NaN and inf, and Eigen vectorises the sums); the
-  // entry-by-entry search that names the culprit runs only on failure.
-  const auto probe = [](const auto& m) { return (m.array() - m.array()).sum(); };
+  // Fast check first (finite_probe); the entry-by-entry search that names the culprit runs only on failure.
+  const auto probe = [](const auto& m) { return finite_probe(m.data(), m.size()); };
   if (!(probe(W) + probe(zeta) + probe(J) + probe(d) + probe(A) + probe(b) == 0.0)) {
     check_finite(W, "W");
     check_finite(zeta, "zeta");

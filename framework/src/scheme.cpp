@@ -5,17 +5,6 @@
 
 namespace redres {
 
-namespace {
-
-// sum of x * 0 over the entries: 0 while every entry is finite, NaN otherwise.
-double finite_probe(const double* p, Eigen::Index size) {
-  double acc = 0.0;
-  for (Eigen::Index i = 0; i < size; ++i) acc += p[i] * 0.0;
-  return acc;
-}
-
-}  // namespace
-
 Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
                std::vector<std::unique_ptr<Constraint>> constraints)
     : robot_(&robot), objectives_(std::move(objectives)), constraints_(std::move(constraints)) {
@@ -99,24 +88,9 @@ void Scheme::build(const Context& ctx, QpProblem& qp) const {
                  "ctx.robot is the scheme's robot and ctx.kinematics is set");
   REDRES_REQUIRE(ctx.kinematics->level >= level_, "Scheme::build",
                  "ctx.kinematics was computed at kinematics_level() or deeper");
-  qp.clear();
-  QpBuilder builder(qp);
-  bool full_w = false;  // some plugin wrote off the diagonal of W (all of W is then scanned)
-  int source = 0;
-  for (const auto& o : objectives_) {
-    builder.begin(source++, o->weight(), 0, 0, 0, 0);
-    o->contribute_unchecked(ctx, builder);
-    full_w = full_w || builder.written_w() == QpBuilder::WrittenW::kFull;
-  }
-  const std::size_t constraints = constraints_.size();
-  for (std::size_t k = 0; k < constraints; ++k) {
-    // Inactive constraints leave their rows empty: 0 x = 0 and 0 x <= 0 are always met.
-    builder.begin(source++, 1.0, eq_offset_[k], eq_rows_[k], in_offset_[k], in_rows_[k]);
-    constraints_[k]->contribute_unchecked(ctx, builder);
-    full_w = full_w || builder.written_w() == QpBuilder::WrittenW::kFull;
-  }
+  const bool full_w = contribute_all(ctx, qp, false);
   // One scan of everything the plugins can have written (bounds are checked as they are intersected; W off its
-  // diagonal keeps clear()'s zeros unless a plugin wrote there). x * 0 summed is 0 while every entry is finite.
+  // diagonal keeps clear()'s zeros unless a plugin wrote there).
   const Eigen::Index n = qp.W.rows();
   double acc = 0.0;
   if (full_w) {
@@ -129,26 +103,39 @@ void Scheme::build(const Context& ctx, QpProblem& qp) const {
          finite_probe(qp.d.data(), qp.d.size()) + finite_probe(qp.A.data(), qp.A.size()) +
          finite_probe(qp.b.data(), qp.b.size());
   if (acc == 0.0 && (!full_w || qp.W.isApprox(qp.W.transpose(), 1e-12))) return;
-  build_checked(ctx, qp);
-}
-
-void Scheme::build_checked(const Context& ctx, QpProblem& qp) const {
-  // The same build with a check after each plugin, which names the plugin and the entry, and throws.
-  qp.clear();
-  QpBuilder builder(qp);
-  int source = 0;
-  for (const auto& o : objectives_) {
-    builder.begin(source++, o->weight(), 0, 0, 0, 0);
-    o->contribute(ctx, builder);
-  }
-  for (std::size_t k = 0; k < constraints_.size(); ++k) {
-    builder.begin(source++, 1.0, eq_offset_[k], eq_rows_[k], in_offset_[k], in_rows_[k]);
-    constraints_[k]->contribute(ctx, builder);
-  }
+  // Build again with a check after each plugin, which names the plugin and the entry, and throws.
+  contribute_all(ctx, qp, true);
   qp.validate();  // the checked build found nothing (a plugin that gives different values when called again)
   throw_invalid_argument("Scheme::build",
                          "the QP had a non-finite or asymmetric entry that a second build did not "
                          "reproduce (a plugin whose output changes between two calls at one state)");
+}
+
+bool Scheme::contribute_all(const Context& ctx, QpProblem& qp, bool checked) const {
+  qp.clear();
+  QpBuilder builder(qp);
+  bool full_w = false;  // some plugin wrote off the diagonal of W
+  int source = 0;
+  for (const auto& o : objectives_) {
+    builder.begin(source++, o->weight(), 0, 0, 0, 0);
+    if (checked) {
+      o->contribute(ctx, builder);
+    } else {
+      o->contribute_unchecked(ctx, builder);
+    }
+    full_w = full_w || builder.written_w() == QpBuilder::WrittenW::kFull;
+  }
+  for (std::size_t k = 0; k < constraints_.size(); ++k) {
+    // Inactive constraints leave their rows empty: 0 x = 0 and 0 x <= 0 are always met.
+    builder.begin(source++, 1.0, eq_offset_[k], eq_rows_[k], in_offset_[k], in_rows_[k]);
+    if (checked) {
+      constraints_[k]->contribute(ctx, builder);
+    } else {
+      constraints_[k]->contribute_unchecked(ctx, builder);
+    }
+    full_w = full_w || builder.written_w() == QpBuilder::WrittenW::kFull;
+  }
+  return full_w;
 }
 
 }  // namespace redres

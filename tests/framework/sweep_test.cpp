@@ -58,8 +58,7 @@ TEST(Sweep, AZippedGridWithSampledTheta0) {
 
 TEST(Sweep, TheTableDoesNotDependOnTheThreadsAndFailuresAreRows) {
   const SweepSpec spec = load_sweep(data_path("sweeps/small.toml"));
-  const auto dir = std::filesystem::temp_directory_path() / "redres_sweep_threads";
-  std::filesystem::remove_all(dir);
+  const auto dir = scratch("sweep_threads");
   std::filesystem::create_directories(dir);
   const SweepTable one = run_sweep(spec, {}, 1, dir);
   const SweepTable two = run_sweep(spec, {}, 2, dir);
@@ -97,8 +96,7 @@ TEST(Sweep, TheTableDoesNotDependOnTheThreadsAndFailuresAreRows) {
 
 TEST(Sweep, ShardsMergeIntoTheWholeTable) {
   const SweepSpec spec = load_sweep(data_path("sweeps/small.toml"));
-  const auto dir = std::filesystem::temp_directory_path() / "redres_sweep_shards";
-  std::filesystem::remove_all(dir);
+  const auto dir = scratch("sweep_shards");
   std::filesystem::create_directories(dir);
   const SweepTable whole = run_sweep(spec, {}, 2, dir);
   std::vector<SweepTable> parts;

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <string>
 
+#include "test_util.hpp"
+
 namespace redres {
 
 struct Cli {
@@ -32,11 +34,5 @@ inline Cli redres_env(const std::string& env, const std::string& args) {
 
 // The same without extra environment.
 inline Cli redres(const std::string& args) { return redres_env("", args); }
-
-inline std::filesystem::path scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("redres_cli_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  return dir;
-}
 
 }  // namespace redres

@@ -8,6 +8,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <Eigen/Core>
 
 #include "redres/robot.hpp"
@@ -23,6 +25,13 @@ inline std::filesystem::path source_path(const std::string& relative) {
 /// A path inside tests/data.
 inline std::filesystem::path data_path(const std::string& relative) {
   return std::filesystem::path(REDRES_TEST_DATA_DIR) / relative;
+}
+
+/// A temporary path for one test, removed if it exists: <tmp>/redres_cli_<name>_<pid>.
+inline std::filesystem::path scratch(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("redres_cli_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
 }
 
 /// theta(0) of the paper, section 4.

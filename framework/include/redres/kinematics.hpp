@@ -79,11 +79,11 @@ class KinematicsData {
   Eigen::VectorXd terms_;                  // planar kernel: h_j . W_j (n)
 };
 
-/// The kinematic Hessian dJ/dtheta_i into data.dJ from the frames, axes, origins and end-effector pose already in
-/// `data` (compute_kinematics at kJacobian). Two formulas, which compute_kinematics chooses between: the general one
-/// (any joints: the motion of each joint applied to every downstream axis and point), and for chains of revolute
-/// joints only the same derivative written as one cross product per entry (z_i x Jv_j). The tests check both
-/// against central differences and against each other.
+/// The kinematic Hessian dJ/dtheta_i into data.dJ from the frames, axes, origins, end-effector pose and the linear
+/// parts of J's columns already in `data` (compute_kinematics at kJacobian). Two formulas, which compute_kinematics
+/// chooses between: the general one (any joints: the motion of each joint applied to every downstream axis and point),
+/// and for chains of revolute joints only the same derivative written as one cross product per entry (z_i x Jv_j). The
+/// tests check both against central differences and against each other.
 void kinematic_hessian_general(const RobotModel& model, KinematicsData& data);
 void kinematic_hessian_revolute(const RobotModel& model, KinematicsData& data);
 

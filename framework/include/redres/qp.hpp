@@ -22,6 +22,14 @@ namespace redres {
 /// Value standing for "no bound" on a joint velocity before any constraint tightens it.
 inline constexpr double kNoBound = std::numeric_limits<double>::infinity();
 
+/// The sum of x * 0 over p[0, size): 0 while every entry is finite, NaN otherwise. The fast scan behind the QP's
+/// checks (a search that names the entry runs only when it is not 0).
+[[nodiscard]] inline double finite_probe(const double* p, Eigen::Index size) {
+  double acc = 0.0;
+  for (Eigen::Index i = 0; i < size; ++i) acc += p[i] * 0.0;
+  return acc;
+}
+
 /// One QP (eqs. 10-12 plus inequality rows). Sized once; then filled each step.
 struct QpProblem {
   Eigen::MatrixXd W;                        //!< Hessian (n x n), symmetric positive definite

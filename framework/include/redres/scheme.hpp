@@ -46,7 +46,9 @@ class Scheme {
   std::vector<int> eq_offset_, eq_rows_, in_offset_, in_rows_;
   int m_eq_ = 0, m_in_ = 0;
   KinematicsLevel level_ = KinematicsLevel::kPosition;
-  [[noreturn]] void build_checked(const Context& ctx, QpProblem& qp) const;
+  // Clears qp and lets every plugin write (checked: through contribute(), which throws naming a culprit); returns
+  // whether a plugin wrote off W's diagonal.
+  bool contribute_all(const Context& ctx, QpProblem& qp, bool checked) const;
 };
 
 }  // namespace redres

@@ -45,7 +45,11 @@ KinematicsData::KinematicsData(const RobotModel& model)
       eig_(model.task_dim()),
       svd_(model.task_dim(), model.dof(), Eigen::ComputeThinU | Eigen::ComputeThinV),
       linear_(Eigen::Matrix3Xd::Zero(3, model.dof())),
-      terms_(Eigen::VectorXd::Zero(model.dof())) {}
+      terms_(Eigen::VectorXd::Zero(model.dof())) {
+  // A planar chain's axes are z, and its frames turn about z in the plane z = 0: the planar kernel writes only the
+  // entries that move (the general path writes these same values).
+  if (model.kind() == ChainKind::kPlanar) axes.row(2).setOnes();
+}
 
 double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> adj,
                               TaskEigenSolver& eig) {
@@ -165,14 +169,8 @@ struct KinematicsKernels {
         "theta.size() == dof() (got " + std::to_string(theta.size()) + ", expected " + std::to_string(n) + ")");
     REDRES_REQUIRE(data.J.cols() == n && data.J.rows() == model.task_dim() && data.theta.size() == n,
                    "compute_kinematics", "data was sized for this model (KinematicsData(model))");
-    const double* in = theta.data();
-    double* out = data.theta.data();
-    double probe = 0.0;  // x * 0 summed: 0 while every entry is finite
-    for (int j = 0; j < n; ++j) {
-      out[j] = in[j];
-      probe += in[j] * 0.0;
-    }
-    REDRES_REQUIRE(probe == 0.0, "compute_kinematics", "theta is finite (it contains NaN or Inf)");
+    data.theta = theta;
+    REDRES_REQUIRE(finite_probe(theta.data(), n) == 0.0, "compute_kinematics", "theta is finite (it contains NaN or Inf)");
   }
 
   // General path: joint frames, end-effector pose and f by 3-D frame products.
@@ -270,28 +268,24 @@ struct KinematicsKernels {
     const int n = model.dof();
     const double* theta = data.theta.data();
     double* origins = data.origins.data();
-    double* axes = data.axes.data();
     double phi = model.base_angle();
     double px = model.base().translation().x(), py = model.base().translation().y();
     double c = 1.0, s = 0.0;
     const JointSpec* joints = model.joints().data();
     Eigen::Isometry3d* frames = data.link_frames.data();
+    // Only the entries that move are written: the axes (z), the origins' z (0) and the frames' third rows and
+    // columns (those of the identity) keep the values KinematicsData(model) gave them.
     for (int j = 0; j < n; ++j) {
       origins[3 * j] = px;
       origins[3 * j + 1] = py;
-      origins[3 * j + 2] = 0.0;
-      axes[3 * j] = 0.0;
-      axes[3 * j + 1] = 0.0;
-      axes[3 * j + 2] = 1.0;
       phi += theta[j];
       c = std::cos(phi);
       s = std::sin(phi);
       // The link frame: Rz(phi_j) at p_j (column-major 4 x 4).
       double* F = frames[j].matrix().data();
-      F[0] = c, F[1] = s, F[2] = 0.0, F[3] = 0.0;
-      F[4] = -s, F[5] = c, F[6] = 0.0, F[7] = 0.0;
-      F[8] = 0.0, F[9] = 0.0, F[10] = 1.0, F[11] = 0.0;
-      F[12] = px, F[13] = py, F[14] = 0.0, F[15] = 1.0;
+      F[0] = c, F[1] = s;
+      F[4] = -s, F[5] = c;
+      F[12] = px, F[13] = py;
       const double l = joints[j].length;
       px += l * c;
       py += l * s;
@@ -334,8 +328,7 @@ struct KinematicsKernels {
     for (int j = 0; j < n; ++j) {
       const double vx = -(ey - origins[3 * j + 1]), vy = ex - origins[3 * j];
       lin[3 * j] = vx;
-      lin[3 * j + 1] = vy;
-      lin[3 * j + 2] = 0.0;
+      lin[3 * j + 1] = vy;  // the z entry stays 0
       for (int r = 0; r < M; ++r) J[j * M + r] = rows[r] == 0 ? vx : rows[r] == 1 ? vy : 1.0;
     }
   }

@@ -144,7 +144,9 @@ void LviEngine::run(const QpProblem& qp, SolverResult& result) {
   info.engine = name();
 
   bool conflicting = false;
-  for (int i = 0; i < n_; ++i) conflicting |= qp.lo(i) > qp.hi(i);  // no early exit: the usual case is none
+  const double* lo = qp.lo.data();
+  const double* hi = qp.hi.data();
+  for (int i = 0; i < n_; ++i) conflicting |= lo[i] > hi[i];  // no early exit: the usual case is none
   if (conflicting) {
     const BoundConflict conflict = find_bound_conflict(qp);
     info.status = SolverStatus::kInfeasible;

@@ -40,13 +40,9 @@ void QpProblem::clear() {
   d.setZero();
   A.setZero();
   b.setZero();
-  const Eigen::Index nn = lo.size();
-  for (Eigen::Index i = 0; i < nn; ++i) {
-    lo(i) = -kNoBound;
-    hi(i) = kNoBound;
-    lo_source[static_cast<std::size_t>(i)] = -1;
-    hi_source[static_cast<std::size_t>(i)] = -1;
-  }
+  // The sources stay: a bound that a plugin tightens gets its source then, and an open one has none to show.
+  lo.setConstant(-kNoBound);
+  hi.setConstant(kNoBound);
   w_diagonal = true;
 }
 

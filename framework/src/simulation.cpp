@@ -60,14 +60,27 @@ std::string RunResult::engine() const {
 }
 
 RunResult simulate(Scenario& s, const ProgressCallback& progress) {
+  RunResult run;
+  simulate(s, run, progress);
+  return run;
+}
+
+void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress) {
   const RobotModel& robot = *s.robot;
   const int n = robot.dof();
   const int m = robot.reference_dim();
   const int position_rows = robot.position_rows();
   const int steps = s.steps();
-  RunResult run;
+  {
+    RunResult fresh;  // every field as a new run has it, with the old trajectory's storage
+    fresh.trajectory = std::move(run.trajectory);
+    fresh.engines = std::move(run.engines);
+    fresh.engines.clear();
+    run = std::move(fresh);
+  }
   // The plugins' own columns (e.g. collision distances) follow the standard ones.
   std::vector<std::string> columns = trajectory_columns(robot);
+  const std::size_t standard_columns = columns.size();
   std::vector<std::pair<const Plugin*, std::size_t>> recorders;  // plugin, first column
   const auto add_recorder = [&](const Plugin& p) {
     if (!p.active()) return;
@@ -82,8 +95,9 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   };
   for (const auto& o : s.scheme->objectives()) add_recorder(*o);
   for (const auto& c : s.scheme->constraints()) add_recorder(*c);
-  run.trajectory = Trajectory(std::move(columns), static_cast<std::size_t>(steps) + 1);
+  run.trajectory.reset(std::move(columns), static_cast<std::size_t>(steps) + 1);
   run.engines.reserve(4);
+  std::vector<double> row_buffer(run.trajectory.width());
 
   Controller ctrl(robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
   ctrl.set_orientation_turn(s.orientation_turn);
@@ -138,13 +152,20 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
     const QpProblem& qp = ctrl.qp();
     const Eigen::VectorXd& vlo = ctrl.velocity_lower();  // the laws at theta, as the step evaluated them
     const Eigen::VectorXd& vhi = ctrl.velocity_upper();
-    double* row = run.trajectory.append_row();
+    // The row is made in a buffer that stays in the cache, then streamed into the table (Trajectory::append_row).
+    // Every standard column is written below; the plugins' columns start at zero.
+    double* row = row_buffer.data();
+    std::fill(row_buffer.begin() + static_cast<std::ptrdiff_t>(standard_columns), row_buffer.end(), 0.0);
     std::size_t c = 0;
+    const auto put = [&row, &c, n](const Eigen::VectorXd& v) {
+      std::copy_n(v.data(), n, row + c);
+      c += static_cast<std::size_t>(n);
+    };
     row[c++] = t;
-    for (int j = 0; j < n; ++j) row[c++] = theta(j);
-    for (int j = 0; j < n; ++j) row[c++] = out.theta_dot(j);
-    for (int j = 0; j < n; ++j) row[c++] = qp.lo(j);
-    for (int j = 0; j < n; ++j) row[c++] = qp.hi(j);
+    put(theta);
+    put(out.theta_dot);
+    put(qp.lo);
+    put(qp.hi);
     if (spatial_orientation) {
       // Rotation vectors, recorded without 2 pi jumps (the controller itself uses rotations, not these vectors).
       wd_prev =
@@ -179,10 +200,11 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
     row[c++] = kin.w;
     row[c++] = out.info.iterations;
     row[c++] = out.info.residual;
-    for (int j = 0; j < n; ++j) row[c++] = vlo(j);
-    for (int j = 0; j < n; ++j) row[c++] = vhi(j);
+    put(vlo);
+    put(vhi);
     row[c++] = static_cast<double>(static_cast<int>(out.info.status));
     for (const auto& [plugin, first] : recorders) plugin->record(row + first);
+    run.trajectory.append_row(row);
     const int failures_before = run.failures;
     note(out, t);
     if (run.failures == failures_before) check_violations(t);  // one failure per step at most
@@ -208,8 +230,8 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
       theta += 0.5 * s.tau * (out.theta_dot + out2.theta_dot);
     }
   }
+  run.trajectory.publish();
   run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return run;
 }
 
 }  // namespace redres

@@ -29,17 +29,8 @@ void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder) const {
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
   const double kappa = config_.kappa;
-  const double* lower = robot.lower_limits().data();
-  const double* upper = robot.upper_limits().data();
-  const double* margin = margin_.data();
-  const double* q = theta.data();
-  double* lo = builder.scratch().data();
-  double* hi = builder.scratch2().data();
-  const int n = robot.dof();
-  for (int j = 0; j < n; ++j) {
-    lo[j] = kappa * ((lower[j] + margin[j]) - q[j]);
-    hi[j] = kappa * ((upper[j] - margin[j]) - q[j]);
-  }
+  builder.scratch() = kappa * ((robot.lower_limits() + margin_) - theta);
+  builder.scratch2() = kappa * ((robot.upper_limits() - margin_) - theta);
   builder.intersect_bounds(builder.scratch(), builder.scratch2());
 }
 

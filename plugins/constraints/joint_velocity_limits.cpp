@@ -23,13 +23,13 @@ void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder) const {
       builder.intersect_bounds(*ctx.velocity_lower, *ctx.velocity_upper);
       return;
     }
-    Eigen::VectorXd& lo = builder.scratch();
-    Eigen::VectorXd& hi = builder.scratch2();
-    for (int j = 0; j < robot.dof(); ++j) {
-      lo(j) = scale * (*ctx.velocity_lower)(j);
-      hi(j) = scale * (*ctx.velocity_upper)(j);
+    if (scale == 1.0) {
+      builder.intersect_bounds(*ctx.velocity_lower, *ctx.velocity_upper);
+      return;
     }
-    builder.intersect_bounds(lo, hi);
+    builder.scratch() = scale * *ctx.velocity_lower;
+    builder.scratch2() = scale * *ctx.velocity_upper;
+    builder.intersect_bounds(builder.scratch(), builder.scratch2());
     return;
   }
   for (int j = 0; j < robot.dof(); ++j) {

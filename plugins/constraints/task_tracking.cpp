@@ -32,8 +32,10 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
   const Eigen::Index m = k.J.rows(), n = k.J.cols(), ld = J.outerStride();
   const double* from = k.J.data();
   double* to = J.data();
-  for (Eigen::Index c = 0; c < n; ++c) {
-    for (Eigen::Index r = 0; r < m; ++r) to[c * ld + r] = from[c * m + r];
+  if (ld == m) {
+    std::copy_n(from, m * n, to);  // the QP's only equality rows: one block
+  } else {
+    for (Eigen::Index c = 0; c < n; ++c) std::copy_n(from + c * m, m, to + c * ld);
   }
   // The error e = r_d - f in every reference row; a spatial orientation's is the rotation vector of R_d R'.
   const double* r_d = ctx.r_d->data();

@@ -79,13 +79,11 @@ std::optional<double> Manipulability::potential(const Context& ctx) const {
 void Manipulability::add_to(const Context& ctx, QpBuilder& builder) const {
   const double p = coefficient(ctx.t, ctx.T);
   const KinematicsData& k = *ctx.kinematics;
-  Eigen::VectorXd& z = builder.scratch();
   switch (config_.measure) {
-    case Measure::kDet: z = -p * k.grad_w; break;
-    case Measure::kYoshikawa: z = -p * k.grad_mu; break;
-    case Measure::kLogDet: z = (-p / std::max(k.w, kLogFloor)) * k.grad_w; break;
+    case Measure::kDet: builder.add_linear(-p, k.grad_w); break;
+    case Measure::kYoshikawa: builder.add_linear(-p, k.grad_mu); break;
+    case Measure::kLogDet: builder.add_linear(-p / std::max(k.w, kLogFloor), k.grad_w); break;
   }
-  builder.add_linear(z);
 }
 
 namespace {

@@ -4,6 +4,7 @@
 /// std::invalid_argument with the violated condition in the message. Numerical outcomes (not converged,
 /// infeasible) are statuses in results, never exceptions.
 
+#include <cstddef>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -35,6 +36,14 @@ class ConfigError : public std::runtime_error {
   SourceLocation where_;
   std::string detail_;
 };
+
+/// The sum of x * 0 over p[0, size): 0 while every entry is finite, NaN otherwise. The fast scan behind the
+/// finiteness checks of the step (a search that names the entry runs only when it is not 0).
+[[nodiscard]] inline double finite_probe(const double* p, std::ptrdiff_t size) {
+  double acc = 0.0;
+  for (std::ptrdiff_t i = 0; i < size; ++i) acc += p[i] * 0.0;
+  return acc;
+}
 
 /// Throws std::invalid_argument("<function>: <condition>"). Use through REDRES_REQUIRE.
 [[noreturn]] void throw_invalid_argument(const char* function, const std::string& condition);

@@ -17,18 +17,12 @@
 
 #include <Eigen/Core>
 
+#include "redres/error.hpp"
+
 namespace redres {
 
 /// Value standing for "no bound" on a joint velocity before any constraint tightens it.
 inline constexpr double kNoBound = std::numeric_limits<double>::infinity();
-
-/// The sum of x * 0 over p[0, size): 0 while every entry is finite, NaN otherwise. The fast scan behind the QP's
-/// checks (a search that names the entry runs only when it is not 0).
-[[nodiscard]] inline double finite_probe(const double* p, Eigen::Index size) {
-  double acc = 0.0;
-  for (Eigen::Index i = 0; i < size; ++i) acc += p[i] * 0.0;
-  return acc;
-}
 
 /// One QP (eqs. 10-12 plus inequality rows). Sized once; then filled each step.
 struct QpProblem {
@@ -42,8 +36,9 @@ struct QpProblem {
   Eigen::VectorXd hi;                       //!< upper bounds (n); +inf where unbounded
   bool w_diagonal = true;                   //!< true while only diagonal terms were added to W (then every
                                             //!< entry off W's diagonal is zero: engines and clear() rely on it)
-  std::vector<int> lo_source;               //!< index of the source that set lo_i (-1: none)
-  std::vector<int> hi_source;               //!< index of the source that set hi_i (-1: none)
+  std::vector<int> lo_source;               //!< index of the source that set lo_i; meaningful where lo_i is
+                                            //!< finite (clear() opens the bounds and leaves these alone)
+  std::vector<int> hi_source;               //!< the same for hi_i
   std::vector<std::string> source_names;    //!< names of the bound and row sources, indexed as above
   std::vector<std::string> variable_names;  //!< joint names, for diagnoses (may be empty)
   std::vector<int> eq_source;               //!< source of each equality row
@@ -62,7 +57,7 @@ struct QpProblem {
   [[nodiscard]] int m_eq() const noexcept { return static_cast<int>(d.size()); }
   /// Number of inequality rows m_i.
   [[nodiscard]] int m_in() const noexcept { return static_cast<int>(b.size()); }
-  /// Zeroes W, zeta, rows, and opens the bounds (-inf, +inf) with no sources.
+  /// Zeroes W, zeta, rows, and opens the bounds (-inf, +inf): an infinite bound has no source.
   void clear();
   /// Throws std::invalid_argument naming the first wrong size or non-finite entry (NaN in a bound too).
   void validate() const;

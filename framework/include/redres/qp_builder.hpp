@@ -39,6 +39,15 @@ class QpBuilder {
     for (Eigen::Index i = 0; i < n; ++i) zeta[i] += weight_ * v[i];
     wrote_zeta_ = true;
   }
+  /// zeta += weight * (scale * z), without a scratch vector for scale * z.
+  void add_linear(double scale, const Eigen::Ref<const Eigen::VectorXd>& z) {
+    const Eigen::Index n = qp_->zeta.size();
+    if (z.size() != n) bad_size("QpBuilder::add_linear", "z.size() == n");
+    double* zeta = qp_->zeta.data();
+    const double* v = z.data();
+    for (Eigen::Index i = 0; i < n; ++i) zeta[i] += weight_ * (scale * v[i]);
+    wrote_zeta_ = true;
+  }
   /// This plugin's equality rows of J (rows x n) and d; the plugin overwrites them.
   [[nodiscard]] Eigen::Block<Eigen::MatrixXd> equality_matrix() { return qp_->J.middleRows(eq_offset_, eq_rows_); }
   [[nodiscard]] Eigen::VectorBlock<Eigen::VectorXd> equality_rhs() { return qp_->d.segment(eq_offset_, eq_rows_); }

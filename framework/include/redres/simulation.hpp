@@ -33,4 +33,8 @@ using ProgressCallback = std::function<void(double fraction, double t)>;
 /// Runs a scenario from theta0 over [0, T] with step tau. Everything is allocated before the loop.
 [[nodiscard]] RunResult simulate(Scenario& scenario, const ProgressCallback& progress = {});
 
+/// The same into `run`, which is overwritten; its trajectory's storage is reused when it has room for this run, so
+/// that repeated runs (a sweep's worker, a benchmark) skip the allocation and the first touch of the table's pages.
+void simulate(Scenario& scenario, RunResult& run, const ProgressCallback& progress = {});
+
 }  // namespace redres

@@ -2,10 +2,11 @@
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "redres/error.hpp"
+#include "redres/input_file.hpp"
 
 namespace redres {
 
@@ -43,8 +44,7 @@ std::vector<std::pair<std::string, std::uint32_t>> split(const std::string& line
 }  // namespace
 
 CsvTable read_csv(const std::filesystem::path& path, const std::vector<std::string>& required) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError({path.string(), 0, 0}, "cannot open CSV file (does it exist and is it readable?)");
+  std::istringstream in(read_input_file(path, "CSV file"));
   CsvTable table;
   table.path = path.string();
   std::string line;

@@ -15,6 +15,7 @@
 
 #include "redres/error.hpp"
 #include "redres/formula.hpp"
+#include "redres/input_file.hpp"
 #include "redres/run_summary.hpp"
 #include "redres/scenario.hpp"
 #include "redres/toml_reader.hpp"
@@ -341,11 +342,7 @@ void write_sweep_csv(const SweepTable& table, const std::filesystem::path& file)
 }
 
 SweepTable read_sweep_csv(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw ConfigError({file.string(), 0, 0}, "cannot read the file");
-  std::ostringstream whole;
-  whole << in.rdbuf();
-  const std::string text = whole.str();
+  const std::string text = read_input_file(file, "sweep CSV file");
   std::vector<std::vector<std::string>> records(1);
   std::string cell;
   bool quoted_cell = false, at_start = true;

@@ -2,10 +2,10 @@
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include "redres/formula.hpp"
+#include "redres/input_file.hpp"
 
 namespace redres {
 
@@ -29,7 +29,123 @@ std::string quoted_list(const std::vector<std::string>& names) {
   return out;
 }
 
+// TOML++ parses dotted keys, table headers and nested arrays and inline tables by recursion: a key of 40,000 parts
+// overflows the stack. This scan, run before it, bounds them: it follows the text's strings and comments, counts the
+// parts of each run of key-like tokens joined by dots (a float or a time has one dot), and the depth of the brackets
+// and braces outside strings.
+constexpr int kMaxKeyParts = 64;
+constexpr int kMaxNesting = 64;
+
+void check_shape(std::string_view text, const std::filesystem::path& path) {
+  enum class State { kNormal, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
+  State state = State::kNormal;
+  std::uint32_t line = 1;
+  std::size_t line_start = 0;
+  int dots = 0;          // dots in the current run of joined tokens
+  bool token = false;    // the last significant character ended a key-like token
+  bool joined = false;   // a dot follows that token
+  int depth = 0;
+  const auto fail = [&](std::size_t at, const std::string& message) {
+    throw ConfigError({path.string(), line, static_cast<std::uint32_t>(at - line_start + 1)}, message);
+  };
+  const auto starts = [&](std::size_t i, std::string_view s) { return text.substr(i, s.size()) == s; };
+  // A new token continues the run when a dot joins it to the last one, else starts a run.
+  const auto begin_token = [&] {
+    if (!joined) dots = 0;
+    joined = false;
+  };
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+      line_start = i + 1;
+    }
+    switch (state) {
+      case State::kComment:
+        if (c == '\n') state = State::kNormal;
+        continue;
+      case State::kBasic:
+        if (c == '\\') {
+          ++i;
+        } else if (c == '"' || c == '\n') {
+          state = State::kNormal;
+          token = true;
+        }
+        continue;
+      case State::kLiteral:
+        if (c == '\'' || c == '\n') {
+          state = State::kNormal;
+          token = true;
+        }
+        continue;
+      case State::kMultiBasic:
+        if (c == '\\') {
+          if (i + 1 < text.size() && text[i + 1] == '\n') continue;  // a line-ending backslash: the newline counts
+          ++i;
+        } else if (starts(i, "\"\"\"")) {
+          i += 2;
+          for (int extra = 0; extra < 2 && i + 1 < text.size() && text[i + 1] == '"'; ++extra) ++i;  // """a""""
+          state = State::kNormal;
+          token = false;
+        }
+        continue;
+      case State::kMultiLiteral:
+        if (starts(i, "'''")) {
+          i += 2;
+          for (int extra = 0; extra < 2 && i + 1 < text.size() && text[i + 1] == '\''; ++extra) ++i;
+          state = State::kNormal;
+          token = false;
+        }
+        continue;
+      case State::kNormal: break;
+    }
+    const bool bare = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    if (bare) {
+      if (!token || joined) begin_token();
+      token = true;
+      continue;
+    }
+    if (c == ' ' || c == '\t' || c == '\r') continue;  // TOML allows "a . b"
+    if (c == '.') {
+      if (token && !joined) {
+        joined = true;
+        if (++dots >= kMaxKeyParts) {
+          fail(i, "a dotted key or table header with more than " + std::to_string(kMaxKeyParts) +
+                      " parts (the most this reader accepts)");
+        }
+      } else {
+        dots = 0;
+        joined = false;
+      }
+      token = false;
+      continue;
+    }
+    if (c == '"' || c == '\'') {
+      begin_token();
+      const bool triple = starts(i, c == '"' ? "\"\"\"" : "'''");
+      state = c == '"' ? (triple ? State::kMultiBasic : State::kBasic) : (triple ? State::kMultiLiteral : State::kLiteral);
+      if (triple) i += 2;
+      continue;
+    }
+    // Anything else ends the run.
+    dots = 0;
+    joined = false;
+    token = false;
+    if (c == '#') {
+      state = State::kComment;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxNesting) {
+        fail(i, "arrays, inline tables and table headers nested more than " + std::to_string(kMaxNesting) +
+                    " deep (the most this reader accepts)");
+      }
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+}
+
 std::shared_ptr<TomlFile> parse(std::string_view text, const std::filesystem::path& path) {
+  check_shape(text, path);
   auto file = std::make_shared<TomlFile>();
   file->path = path;
   try {
@@ -45,11 +161,7 @@ std::shared_ptr<TomlFile> parse(std::string_view text, const std::filesystem::pa
 }  // namespace
 
 std::shared_ptr<TomlFile> parse_toml_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError({path.string(), 0, 0}, "cannot open file (does it exist and is it readable?)");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parse(buffer.str(), path);
+  return parse(read_input_file(path, "TOML file"), path);
 }
 
 std::shared_ptr<TomlFile> parse_toml_string(std::string_view text, const std::string& name) {

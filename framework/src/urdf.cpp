@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <mutex>
 #include <sstream>
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
+
+#include "redres/error.hpp"
+#include "redres/input_file.hpp"
 
 namespace redres {
 
@@ -85,11 +87,12 @@ void add_branch(const std::string& where, const urdf::ModelInterface& model, con
 UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link,
                           const std::string& tip_link) {
   const std::string where = file.string();
-  std::ifstream in(file);
-  if (!in) throw UrdfError(where + ": cannot open the URDF file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  const std::string xml = text.str();
+  std::string xml;
+  try {
+    xml = read_input_file(file, "URDF file");
+  } catch (const ConfigError& e) {
+    throw UrdfError(e.what());
+  }
 
   urdf::ModelInterfaceSharedPtr model;
   std::string messages;

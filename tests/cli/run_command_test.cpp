@@ -141,7 +141,7 @@ TEST(CliScenario, BadScenarioFilesReportFileLineColumn) {
   EXPECT_NE(r.out.find("joint 'joint2' = 0 is outside its limits"), std::string::npos) << r.out;
   r = redres("run '" + (dir / "missing.toml").string() + "' --out '" + (dir / "o").string() + "'");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("cannot open file"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("missing.toml: TOML file does not exist"), std::string::npos) << r.out;
   std::filesystem::remove_all(dir);
 }
 

@@ -197,7 +197,7 @@ std::string replace(std::string s, const std::string& from, const std::string& t
 TEST(Urdf, BadUrdfsAreErrorsNamingTheFileAndTheElement) {
   const std::string good = kTwoLinkUrdf;
   const std::vector<BadUrdf> cases = {
-      {"missing file", "", "", {"two.urdf: cannot open the URDF file"}},
+      {"missing file", "", "", {"two.urdf: URDF file does not exist"}},
       {"joint names a missing link",
        replace(good, R"(<parent link="l1"/>)", R"(<parent link="nowhere"/>)"),
        "",

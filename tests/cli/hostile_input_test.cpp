@@ -1,0 +1,117 @@
+// Hostile input files: inputs that crashed the reader, grew without bound or blocked it are one file:line:col
+// error and exit 2, from the command line and from the library; valid TOML with many dots and deep (but bounded)
+// nesting still loads.
+
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "cli_util.hpp"
+#include "redres/error.hpp"
+#include "redres/input_file.hpp"
+#include "redres/toml_reader.hpp"
+
+namespace redres {
+namespace {
+
+std::string repeat(const std::string& s, int n, const std::string& sep) {
+  std::string out;
+  for (int i = 0; i < n; ++i) out += (i ? sep : "") + s;
+  return out;
+}
+
+void write(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+// The first line of the CLI's output.
+std::string first_line(const std::string& out) { return out.substr(0, out.find('\n')); }
+
+const std::string kHead = "name = \"r\"\nkind = \"planar\"\n";
+
+TEST(HostileInput, KeysAndNestingTooDeepForTheParserAreErrorsNotCrashes) {
+  const auto dir = scratch("hostile_deep");
+  std::filesystem::create_directories(dir);
+  struct Case {
+    const char* file;
+    std::string text;
+    const char* expect;
+  };
+  const Case cases[] = {
+      {"dotted.toml", kHead + repeat("a", 40000, ".") + " = 1\n", "dotted.toml:3:"},
+      {"header.toml", kHead + "[" + repeat("a", 40000, ".") + "]\n", "header.toml:3:"},
+      {"quoted.toml", kHead + repeat("\"a\"", 20000, " . ") + " = 1\n", "quoted.toml:3:"},
+      {"inline.toml", kHead + "x = " + repeat("{a = ", 20000, "") + "1" + repeat("}", 20000, "") + "\n",
+       "inline.toml:3:"},
+      {"arrays.toml", kHead + "x = " + repeat("[", 20000, "") + repeat("]", 20000, "") + "\n", "arrays.toml:3:"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file);
+    write(dir / c.file, c.text);
+    const Cli r = redres("robot '" + (dir / c.file).string() + "'");
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(first_line(r.out).find(c.expect), std::string::npos) << r.out;
+    EXPECT_TRUE(r.out.find("parts") != std::string::npos || r.out.find("nested") != std::string::npos) << r.out;
+    EXPECT_THROW((void)parse_toml_file(dir / c.file), ConfigError);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(HostileInput, TomlWithDotsInStringsCommentsAndNumbersStillParses) {
+  const std::string many_dots = repeat("a", 200, ".");
+  const std::string text = "s = \"" + many_dots + "\"\nl = '" + many_dots + "'\n# " + many_dots + "\nm = \"\"\"\n" +
+                           many_dots + "\n\"\"\"\nn = '''" + many_dots + "'''\nq = \"\"\"x\"\"\"\"\n" +
+                           "v = [" + repeat("1.5", 500, ", ") + "]\nt = 1979-05-27T07:32:00.999Z\n" +
+                           repeat("k", 60, ".") + " = 1\n[" + repeat("h", 60, ".") + "]\nx = " +
+                           repeat("[", 60, "") + repeat("]", 60, "") + "\n";
+  const auto file = parse_toml_string(text, "ok.toml");
+  EXPECT_EQ(file->root["s"].value_or(std::string()), many_dots);
+  EXPECT_EQ(file->root["m"].value_or(std::string()), many_dots + "\n");
+  EXPECT_EQ(file->root["q"].value_or(std::string()), "x\"");
+  EXPECT_EQ(file->root["v"].as_array()->size(), 500u);
+}
+
+TEST(HostileInput, InputsThatAreNotBoundedRegularFilesAreRefusedBeforeReading) {
+  const auto dir = scratch("hostile_files");
+  std::filesystem::create_directories(dir);
+  const std::string fifo = (dir / "fifo.toml").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string big = (dir / "big.toml").string();
+  {
+    std::ofstream(big) << kHead;
+    std::filesystem::resize_file(big, kMaxInputFileBytes + 1);  // sparse: nothing is written
+  }
+  struct Case {
+    std::string path;
+    const char* expect;
+  };
+  const Case cases[] = {
+      {"/dev/zero", "/dev/zero: TOML file is a character device, expected a regular file"},
+      {dir.string(), "TOML file is a directory, expected a regular file"},
+      {fifo, "TOML file is a FIFO (named pipe), expected a regular file"},
+      {big, "more than the 16777216 bytes an input file may have"},
+      {(dir / "missing.toml").string(), "missing.toml: TOML file does not exist"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.path);
+    // The CLI would hang on the FIFO or grow without bound on /dev/zero: `timeout` turns either into a failure.
+    const Cli r = redres_env("timeout 20 ", "robot '" + c.path + "'");
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(first_line(r.out).find(c.expect), std::string::npos) << r.out;
+    EXPECT_THROW((void)read_input_file(c.path, "TOML file"), ConfigError);
+  }
+  // A table law naming /dev/zero as its CSV file.
+  write(dir / "law.toml", kHead + "[[joints]]\nname = \"j1\"\nlength = 0.3\nlimits = [-1.0, 1.0]\n"
+                                  "[joints.velocity_limit]\ntype = \"table\"\nfile = \"/dev/zero\"\n");
+  const Cli r = redres_env("timeout 20 ", "robot '" + (dir / "law.toml").string() + "'");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("/dev/zero: CSV file is a character device"), std::string::npos) << r.out;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace redres

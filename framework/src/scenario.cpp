@@ -6,6 +6,7 @@
 #include "redres/formula.hpp"
 #include "redres/overrides.hpp"
 #include "redres/plugin_loader.hpp"
+#include "redres/simulation.hpp"
 
 namespace redres {
 
@@ -53,7 +54,13 @@ Eigen::VectorXd read_theta0(const TableReader& r, const RobotModel& robot) {
 
 }  // namespace
 
-int Scenario::steps() const { return static_cast<int>(std::lround(duration / tau)); }
+int Scenario::steps() const {
+  const double ratio = duration / tau;
+  REDRES_REQUIRE(ratio >= 0.5 && ratio <= kMaxSteps, "Scenario::steps",
+                 "duration / step is in [1, " + std::to_string(static_cast<long long>(kMaxSteps)) + "] (got " +
+                     std::to_string(ratio) + ")");
+  return static_cast<int>(std::lround(ratio));
+}
 
 Scenario load_scenario(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   const std::shared_ptr<TomlFile> parsed = parse_toml_file(file);
@@ -78,6 +85,12 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   s.tau = r.number("step");
   if (!(s.duration > 0.0)) r.fail("duration", "expected a duration T > 0 s");
   if (!(s.tau > 0.0 && s.tau <= s.duration)) r.fail("step", "expected a step 0 < tau <= duration");
+  if (!(s.duration / s.tau <= kMaxSteps)) {
+    std::ostringstream m;
+    m << "expected at most " << static_cast<long long>(kMaxSteps) << " steps, got duration / step = " << s.duration
+      << " / " << s.tau << " = " << s.duration / s.tau << " (use a longer step or a shorter duration)";
+    r.fail("step", m.str());
+  }
   if (std::abs(s.steps() * s.tau - s.duration) > 1e-9 * s.duration) {
     r.fail("step", "expected a step that divides the duration (T / tau = " + std::to_string(s.duration / s.tau) + ")");
   }
@@ -93,6 +106,13 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   s.path = make_path(TableReader(path_table.file_ptr(), path_table.raw(), "path"), pc);
 
   s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot));
+  if (const double bytes = (s.steps() + 1.0) * static_cast<double>(trajectory_width(s)) * 8.0; bytes > kMaxTableBytes) {
+    std::ostringstream m;
+    m << "expected a run whose recorded table fits in " << kMaxTableBytes / (1024.0 * 1024 * 1024) << " GiB, got "
+      << s.steps() + 1 << " rows of " << trajectory_width(s) << " columns (" << bytes / (1024.0 * 1024 * 1024)
+      << " GiB; use a longer step or a shorter duration)";
+    r.fail("step", m.str());
+  }
   if (r.has("solver")) {
     const TableReader t = r.table("solver");
     const TableReader solver(t.file_ptr(), t.raw(), "solver");

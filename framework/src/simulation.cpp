@@ -48,7 +48,28 @@ std::vector<std::string> trajectory_columns(const RobotModel& robot) {
   return cols;
 }
 
+// The standard columns, then the plugins' own (e.g. collision distances), with where each plugin's start.
+std::vector<std::string> run_columns(const Scenario& s, std::vector<std::pair<const Plugin*, std::size_t>>* recorders) {
+  std::vector<std::string> columns = trajectory_columns(*s.robot);
+  const auto add_recorder = [&](const Plugin& p) {
+    if (!p.active()) return;
+    const std::vector<std::string> own = p.recorded_columns();
+    if (own.empty()) return;
+    if (recorders != nullptr) recorders->emplace_back(&p, columns.size());
+    for (const auto& c : own) {
+      // Two plugins may record the same quantity (two obstacle sets): the second gets its name as a prefix.
+      const bool taken = std::find(columns.begin(), columns.end(), c) != columns.end();
+      columns.push_back(taken ? p.name() + "." + c : c);
+    }
+  };
+  for (const auto& o : s.scheme->objectives()) add_recorder(*o);
+  for (const auto& c : s.scheme->constraints()) add_recorder(*c);
+  return columns;
+}
+
 }  // namespace
+
+std::size_t trajectory_width(const Scenario& s) { return run_columns(s, nullptr).size(); }
 
 std::string RunResult::engine() const {
   std::string out;
@@ -78,23 +99,12 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress) {
     fresh.engines.clear();
     run = std::move(fresh);
   }
-  // The plugins' own columns (e.g. collision distances) follow the standard ones.
-  std::vector<std::string> columns = trajectory_columns(robot);
-  const std::size_t standard_columns = columns.size();
+  const std::size_t standard_columns = trajectory_columns(robot).size();
   std::vector<std::pair<const Plugin*, std::size_t>> recorders;  // plugin, first column
-  const auto add_recorder = [&](const Plugin& p) {
-    if (!p.active()) return;
-    const std::vector<std::string> own = p.recorded_columns();
-    if (own.empty()) return;
-    recorders.emplace_back(&p, columns.size());
-    for (const auto& c : own) {
-      // Two plugins may record the same quantity (two obstacle sets): the second gets its name as a prefix.
-      const bool taken = std::find(columns.begin(), columns.end(), c) != columns.end();
-      columns.push_back(taken ? p.name() + "." + c : c);
-    }
-  };
-  for (const auto& o : s.scheme->objectives()) add_recorder(*o);
-  for (const auto& c : s.scheme->constraints()) add_recorder(*c);
+  std::vector<std::string> columns = run_columns(s, &recorders);
+  REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
+                 "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
+                     std::to_string(columns.size()) + " columns do not)");
   run.trajectory.reset(std::move(columns), static_cast<std::size_t>(steps) + 1);
   run.engines.reserve(4);
   std::vector<double> row_buffer(run.trajectory.width());

@@ -13,6 +13,7 @@
 #include "cli_util.hpp"
 #include "redres/error.hpp"
 #include "redres/input_file.hpp"
+#include "redres/scenario.hpp"
 #include "redres/toml_reader.hpp"
 
 namespace redres {
@@ -111,6 +112,33 @@ TEST(HostileInput, InputsThatAreNotBoundedRegularFilesAreRefusedBeforeReading) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("/dev/zero: CSV file is a character device"), std::string::npos) << r.out;
   std::filesystem::remove_all(dir);
+}
+
+// A step count that overflowed an int, or a table of gigabytes made before the loop, is an error at the key.
+TEST(HostileInput, StepCountsAndTheTableAreBoundedAtLoad) {
+  const auto scenario = source_path("configs/paper_r_fast.toml");
+  const auto message = [&](const std::vector<std::string>& overrides) {
+    try {
+      (void)load_scenario(scenario, overrides);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(loaded)");
+  };
+  std::string m = message({"duration=2147483647.0", "step=1.0"});
+  EXPECT_NE(m.find("--set step:1:5: scenario: key 'step': expected at most 10000000 steps"), std::string::npos) << m;
+  m = message({"duration=1e300", "step=1e-300"});
+  EXPECT_NE(m.find("expected at most 10000000 steps"), std::string::npos) << m;
+  m = message({"duration=1e7", "step=1.0"});
+  EXPECT_NE(m.find("key 'step': expected a run whose recorded table fits in 2 GiB, got 10000001 rows"),
+            std::string::npos)
+      << m;
+  // The largest run that fits still loads, and nothing is allocated for it until it runs.
+  EXPECT_EQ(message({"duration=4e6", "step=1.0"}), "(loaded)");
+  // A scenario put together in code is checked where the count is taken.
+  Scenario s = load_scenario(scenario);
+  s.duration = 1e12;
+  EXPECT_THROW((void)s.steps(), std::invalid_argument);
 }
 
 }  // namespace

@@ -54,9 +54,15 @@ struct Scenario {
   bool plots = false;    //!< [output] plots
   bool animate = false;  //!< [output] animate
 
-  /// Number of control steps N = round(T / tau); the run records N + 1 rows, t = 0 .. T.
+  /// Number of control steps N = round(T / tau); the run records N + 1 rows, t = 0 .. T. Throws
+  /// std::invalid_argument when T / tau is not in [1, kMaxSteps].
   [[nodiscard]] int steps() const;
 };
+
+/// The most control steps a run may have (duration / step).
+inline constexpr double kMaxSteps = 10'000'000;
+/// The most memory a run's recorded table may take (2 GiB): rows x columns x 8 bytes, made before the loop.
+inline constexpr double kMaxTableBytes = 2.0 * 1024 * 1024 * 1024;
 
 /// Loads and checks a scenario. `overrides` are "key.path=value" strings (TOML values; a bare word is a string;
 /// array entries by 0-based index, e.g. "objectives.1.p=1"). Every problem is a ConfigError at file:line:col.

@@ -30,6 +30,9 @@ struct RunResult {
 /// Progress of a run: fraction done in [0, 1] and the simulated time.
 using ProgressCallback = std::function<void(double fraction, double t)>;
 
+/// The number of columns a run of `scenario` records (the standard ones and the plugins' own).
+[[nodiscard]] std::size_t trajectory_width(const Scenario& scenario);
+
 /// Runs a scenario from theta0 over [0, T] with step tau. Everything is allocated before the loop.
 [[nodiscard]] RunResult simulate(Scenario& scenario, const ProgressCallback& progress = {});
 

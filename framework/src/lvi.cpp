@@ -194,8 +194,9 @@ void LviEngine::set_settings(const SolverSettings& s) {
 const Schema<SolverSettings>& SolverSettings::schema() {
   using C = SolverSettings;
   static const Schema<C> s{
-      {field("tolerance", &C::tolerance, "", "stopping test ||e(u)||_2 <= tolerance", greater(0.0)),
-       field("varpi", &C::varpi, "", "bound on the duals standing for infinity", greater(0.0)),
+      {field("tolerance", &C::tolerance, "", "stopping test ||e(u)||_2 <= tolerance (below 1e-14 rounding decides)",
+             between(1e-14, 1.0)),
+       field("varpi", &C::varpi, "", "bound on the duals standing for infinity", between(1.0, 1e12)),
        field("max_iterations", &C::max_iterations, "", "iteration cap per solve", at_least<int>(1)),
        field("warm_start", &C::warm_start, "", "start each solve from the previous u")}};
   return s;

@@ -131,7 +131,7 @@ struct ObjectiveCommon {
   static const Schema<ObjectiveCommon>& schema() {
     static const Schema<ObjectiveCommon> s{
         {field("name", &ObjectiveCommon::name, "", "instance name, used in diagnoses (default: the type)"),
-         field("weight", &ObjectiveCommon::weight, "", "scales W and zeta", at_least(0.0)),
+         field("weight", &ObjectiveCommon::weight, "", "scales W and zeta", between(0.0, 1e6)),
          field("active", &ObjectiveCommon::active, "", "false builds the plugin but leaves it out of the QP")}};
     return s;
   }

@@ -237,16 +237,31 @@ bool RobotModel::self_collision_pair(int i, int j) const {
 
 namespace {
 
+// A length, offset or position in metres, within the physical range of config.hpp's physical_bound("m").
+double length_value(const TableReader& r, const char* key, double value) {
+  const double bound = *physical_bound("m");
+  if (!(std::abs(value) <= bound)) {
+    r.fail(key, "expected |x| <= " + num(bound) + " m (a physical range), got " + num(value));
+  }
+  return value;
+}
+
+std::vector<double> length_values(const TableReader& r, const char* key, std::vector<double> values) {
+  for (double v : values) length_value(r, key, v);
+  return values;
+}
+
 // A pose table: spatial `xyz` (m) and `rpy` (rad, roll-pitch-yaw about the fixed x, y, z axes); planar `xyz`
 // ([x, y], m) and `angle` (rad, about z). `position` is accepted for `xyz` (the end effector's older key).
 Isometry3d read_pose(const TableReader& t, bool planar) {
   if (t.has("xyz") && t.has("position")) t.fail("position", "give `xyz` or `position`, not both");
   const char* key = t.has("position") ? "position" : "xyz";
   if (planar) {
-    const std::vector<double> p = t.has(key) ? t.numbers(key, 2) : std::vector<double>{0.0, 0.0};
+    const std::vector<double> p = t.has(key) ? length_values(t, key, t.numbers(key, 2)) : std::vector<double>{0.0, 0.0};
     return trans(p[0], p[1], 0.0) * rot_z(t.number("angle", 0.0));
   }
-  const std::vector<double> p = t.has(key) ? t.numbers(key, 3) : std::vector<double>{0.0, 0.0, 0.0};
+  const std::vector<double> p =
+      t.has(key) ? length_values(t, key, t.numbers(key, 3)) : std::vector<double>{0.0, 0.0, 0.0};
   const std::vector<double> rpy = t.has("rpy") ? t.numbers("rpy", 3) : std::vector<double>{0.0, 0.0, 0.0};
   return trans(p[0], p[1], p[2]) * Isometry3d(rpy_matrix({rpy[0], rpy[1], rpy[2]}));
 }
@@ -306,6 +321,7 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
   if (kind == ChainKind::kPlanar) {
     jt.length = r.number("length");
     if (!(jt.length > 0.0)) r.fail("length", "expected a link length > 0 m, got " + num(jt.length));
+    length_value(r, "length", jt.length);
   } else if (convention == DhConvention::kJointFrames) {
     if (auto origin = r.optional_table("origin")) {
       const TableReader o(origin->file_ptr(), origin->raw(), "joint '" + jt.name + "' origin");
@@ -319,9 +335,9 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
       jt.axis.normalize();
     }
   } else {
-    jt.a = r.number("a", 0.0);
+    jt.a = length_value(r, "a", r.number("a", 0.0));
     jt.alpha = r.number("alpha", 0.0);
-    jt.d = r.number("d", 0.0);
+    jt.d = length_value(r, "d", r.number("d", 0.0));
     jt.theta_offset = r.number("theta_offset", 0.0);
   }
 

@@ -12,7 +12,7 @@ const Schema<ManipulabilityConfig>& ManipulabilityConfig::schema() {
       {field("measure", &C::measure, "",
              "w = det(JJ') (the paper), Yoshikawa's sqrt(det(JJ')), or log det(JJ') (scale-free)"),
        field("schedule", &C::schedule, "", "p(t): constant p, p sin(pi t/T), smoothstep ramps, or a formula"),
-       field("p", &C::p, "", "coefficient magnitude (not used by the expression schedule)"),
+       field("p", &C::p, "", "coefficient magnitude (not used by the expression schedule)", between(-1e6, 1e6)),
        field("ramp_fraction", &C::ramp_fraction, "", "smoothstep: each ramp's share of T",
              rule<double>("in (0, 0.5]", [](double v) { return v > 0.0 && v <= 0.5; })),
        field("formula", &C::formula, "",

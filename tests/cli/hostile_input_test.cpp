@@ -141,5 +141,53 @@ TEST(HostileInput, StepCountsAndTheTableAreBoundedAtLoad) {
   EXPECT_THROW((void)s.steps(), std::invalid_argument);
 }
 
+// Values that passed the type checks but overflowed the step (inf in trajectory.csv, null in summary.json) are
+// refused at load, at their key, with the range: a unit's physical range, or the key's own sane range.
+TEST(HostileInput, ValuesOutsidePhysicalOrSaneRangesAreRefusedAtTheirKey) {
+  const auto scenario = source_path("configs/paper_r_fast.toml");
+  struct Case {
+    std::string set;
+    std::string expect;
+  };
+  const Case cases[] = {
+      {"path.height=1e300", "key 'height': expected |x| <= 1000 m (a physical range), got 1e+300"},
+      {"constraints.0.gain=1e308", "key 'gain': expected |x| <= 1e+06 1/s (a physical range), got 1e+308"},
+      {"constraints.1.kappa=1e300", "key 'kappa': expected |x| <= 1e+06 1/s (a physical range)"},
+      {"objectives.0.weight=1e308", "key 'weight': expected in [0, 1e+06], got 1e+308"},
+      {"objectives.1.p=1e308", "key 'p': expected in [-1e+06, 1e+06], got 1e+308"},
+      {"solver.tolerance=1e-300", "key 'tolerance': expected in [1e-14, 1], got 1e-300"},
+      {"solver.varpi=1e-300", "key 'varpi': expected in [1, 1e+12], got 1e-300"},
+  };
+  for (const Case& c : cases) {
+    if (c.expect.empty()) continue;
+    SCOPED_TRACE(c.set);
+    try {
+      (void)load_scenario(scenario, {c.set});
+      ADD_FAILURE() << "loaded";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind("--set " + c.set.substr(0, c.set.find('=')) + ":1:", 0), 0u) << e.what();
+    }
+  }
+  const Cli origin = redres("validate configs/planar_4link_circle.toml --set 'path.origin=[1e300, 0]'");
+  EXPECT_EQ(origin.code, 2) << origin.out;
+  EXPECT_NE(origin.out.find("key 'origin': expected |x| <= 1000 m (a physical range), got [1e+300, 0.0]"),
+            std::string::npos)
+      << origin.out;
+  const Cli radius = redres("validate configs/planar_4link_circle.toml --set path.radius=1e200");
+  EXPECT_EQ(radius.code, 2) << radius.out;
+  EXPECT_NE(radius.out.find("key 'radius': expected |x| <= 1000 m"), std::string::npos) << radius.out;
+  // A link of 1e308 m in a robot file.
+  const auto dir = scratch("hostile_ranges");
+  std::filesystem::create_directories(dir);
+  write(dir / "long.toml", kHead + "[[joints]]\nname = \"j1\"\nlength = 1e308\nlimits = [-1.0, 1.0]\n");
+  const Cli robot = redres("robot '" + (dir / "long.toml").string() + "'");
+  EXPECT_EQ(robot.code, 2) << robot.out;
+  EXPECT_NE(first_line(robot.out).find("long.toml:5:10:"), std::string::npos) << robot.out;
+  EXPECT_NE(robot.out.find("key 'length': expected |x| <= 1000 m (a physical range), got 1e+308"), std::string::npos)
+      << robot.out;
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace redres

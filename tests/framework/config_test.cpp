@@ -157,7 +157,7 @@ TEST(Config, ListingDerivesDefaultsAndPresenceFromTheStruct) {
     return KeyInfo{};
   };
   EXPECT_EQ(key("gain").default_text, "2.5");
-  EXPECT_EQ(key("gain").rule, "> 0");
+  EXPECT_EQ(key("gain").rule, "> 0; |x| <= 1e+06 1/s");  // the unit adds its physical range
   EXPECT_EQ(key("gain").unit, "1/s");
   EXPECT_EQ(key("colour").default_text, "'green'");
   EXPECT_EQ(key("colour").type, "one of 'red', 'green'");

@@ -334,7 +334,41 @@ std::string value_text(const T& v) {
 }
 }  // namespace detail
 
-/// A field for member `member` of C. `rule` (optional) is a validity rule for the member's value.
+/// The physical range of a quantity by its unit: |value| <= the bound, for every number a key with that unit holds.
+/// Values beyond it (a 1e200 m radius, a 1e308 1/s gain) are no robot's and overflow the step's arithmetic, so they
+/// are refused at load. docs/scenario_format.md lists the bounds.
+[[nodiscard]] inline std::optional<double> physical_bound(std::string_view unit) {
+  if (unit == "m" || unit == "m/s" || unit == "rad or m" || unit == "rad/s or m/s" || unit == "m/rot") return 1e3;
+  if (unit == "1/s" || unit == "rad" || unit == "deg" || unit == "rot/s") return 1e6;
+  return std::nullopt;
+}
+
+namespace detail {
+// Whether every number in v (a number, an array, per-joint values, an optional of these) has |x| <= bound; other
+// types hold no number and pass.
+template <class T>
+bool within(const T& v, double bound) {
+  if constexpr (std::is_arithmetic_v<T>) {
+    return !std::is_floating_point_v<T> || std::abs(static_cast<double>(v)) <= bound;
+  } else if constexpr (std::is_same_v<T, PerJoint>) {
+    return within(v.values, bound);
+  } else if constexpr (std::is_convertible_v<const T&, std::string_view> || std::is_same_v<T, std::filesystem::path>) {
+    return true;
+  } else if constexpr (requires { v.has_value(); *v; }) {
+    return !v.has_value() || within(*v, bound);
+  } else if constexpr (requires { v.begin(); v.end(); }) {
+    for (const auto& x : v) {
+      if (!within(x, bound)) return false;
+    }
+    return true;
+  } else {
+    return true;  // a type that holds no number (an enum, a path, a table of its own)
+  }
+}
+}  // namespace detail
+
+/// A field for member `member` of C. `rule` (optional) is a validity rule for the member's value; a unit with a
+/// physical range (physical_bound) adds |value| <= that range.
 template <class C, class T>
 Field<C> field(std::string name, T C::*member, std::string unit, std::string help, Rule<T> rule = {}) {
   Field<C> f;
@@ -347,10 +381,22 @@ Field<C> field(std::string name, T C::*member, std::string unit, std::string hel
   f.read = [member, key](const TableReader& r, C& c) { config_io::read(r, key, c.*member); };
   f.write = [member, key](const C& c, toml::table& t) { config_io::write(t, key, c.*member); };
   f.given = [member](const C& c) { return config_io::given(c.*member); };
-  if (rule.ok) {
-    f.check = [member, rule](const C& c) -> std::optional<std::string> {
-      if (!config_io::given(c.*member) || rule.ok(c.*member)) return std::nullopt;
-      return "expected " + rule.text + ", got " + detail::value_text(c.*member);
+  const std::optional<double> bound = physical_bound(f.unit);
+  std::string range;
+  if (bound) {
+    std::ostringstream s;
+    s << "|x| <= " << *bound << " " << f.unit;
+    range = s.str();
+    f.rule = f.rule.empty() ? range : f.rule + "; " + range;
+  }
+  if (rule.ok || bound) {
+    f.check = [member, rule, bound, range](const C& c) -> std::optional<std::string> {
+      if (!config_io::given(c.*member)) return std::nullopt;
+      if (rule.ok && !rule.ok(c.*member)) return "expected " + rule.text + ", got " + detail::value_text(c.*member);
+      if (bound && !detail::within(c.*member, *bound)) {
+        return "expected " + range + " (a physical range), got " + detail::value_text(c.*member);
+      }
+      return std::nullopt;
     };
   }
   return f;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <Eigen/Geometry>
 
@@ -109,8 +110,21 @@ void Controller::solve(double t, StepOutput& out) {
   REDRES_REQUIRE(out.theta_dot.size() == robot_->dof(), "Controller::step",
                  "out was made by make_output() (theta_dot has n entries)");
   ctx_.t = t;
-  robot_->velocity_limits(kin_.theta, vlo_, vhi_);
-  scheme_->build(ctx_, qp_);
+  try {
+    robot_->velocity_limits(kin_.theta, vlo_, vhi_);
+    scheme_->build(ctx_, qp_);
+  } catch (const std::invalid_argument& e) {
+    // A plugin or a law gave NaN or inf at this state (a user formula that is NaN in a narrow window): a failed step
+    // that moves nothing, not the end of the run. The controller's own calls meet build()'s other conditions.
+    out.theta_dot.setZero();
+    out.info.status = SolverStatus::kInvalidProblem;
+    out.info.iterations = 0;
+    out.info.residual = 0.0;
+    out.info.engine = engine_->name();
+    out.info.diagnosis = e.what();
+    engine_->reset();  // the next step starts cold
+    return;
+  }
   engine_->solve_valid(qp_, result_);  // build() checked every entry it wrote
   out.theta_dot = result_.x;
   out.info = result_.info;

@@ -13,6 +13,7 @@ const char* to_string(SolverStatus status) {
     case SolverStatus::kInfeasible: return "infeasible";
     case SolverStatus::kNumericalError: return "numerical_error";
     case SolverStatus::kNotRun: return "not_run";
+    case SolverStatus::kInvalidProblem: return "invalid_problem";
   }
   return "unknown";
 }

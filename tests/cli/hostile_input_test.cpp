@@ -4,6 +4,7 @@
 
 #include <sys/stat.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -14,6 +15,7 @@
 #include "redres/error.hpp"
 #include "redres/input_file.hpp"
 #include "redres/scenario.hpp"
+#include "redres/simulation.hpp"
 #include "redres/toml_reader.hpp"
 
 namespace redres {
@@ -187,6 +189,51 @@ TEST(HostileInput, ValuesOutsidePhysicalOrSaneRangesAreRefusedAtTheirKey) {
   EXPECT_NE(robot.out.find("key 'length': expected |x| <= 1000 m (a physical range), got 1e+308"), std::string::npos)
       << robot.out;
   std::filesystem::remove_all(dir);
+}
+
+// A user formula that is NaN for t < 1 s: those steps fail with a diagnosis naming the plugin and move nothing, and
+// the run goes on to the end with every recorded value finite.
+TEST(HostileInput, ANonFiniteValueMidRunIsAFailedStepNotTheEndOfTheRun) {
+  Scenario s = load_scenario(source_path("configs/paper_r_fast.toml"),
+                             {"objectives.1.schedule=expression", "objectives.1.formula=sqrt(t-1)"});
+  const RunResult run = simulate(s);
+  ASSERT_EQ(run.trajectory.size(), static_cast<std::size_t>(s.steps()) + 1);
+  EXPECT_GE(run.failures, 1000);
+  EXPECT_EQ(run.first_failure.rfind("t = 0 s: invalid_problem: objective 'manipulability'", 0), 0u)
+      << run.first_failure;
+  const std::size_t status = run.trajectory.column("solver_status");
+  const std::size_t t = run.trajectory.column("t");
+  int invalid = 0;
+  for (std::size_t r = 0; r < run.trajectory.size(); ++r) {
+    // (lo_ and hi_ are the QP's bounds, which are infinite where nothing bounds a joint: a build that stopped at
+    // the first plugin leaves them open.)
+    for (std::size_t c = 0; c < run.trajectory.width(); ++c) {
+      const std::string& name = run.trajectory.columns()[c];
+      if (name.rfind("lo_", 0) == 0 || name.rfind("hi_", 0) == 0) continue;
+      ASSERT_TRUE(std::isfinite(run.trajectory(r, c))) << name << " at row " << r;
+    }
+    const bool bad = run.trajectory(r, status) == static_cast<double>(static_cast<int>(SolverStatus::kInvalidProblem));
+    EXPECT_EQ(bad, run.trajectory(r, t) < 1.0 - 1e-12) << "t = " << run.trajectory(r, t);
+    if (!bad) continue;
+    ++invalid;
+    for (int j = 1; j <= s.robot->dof(); ++j) {
+      EXPECT_EQ(run.trajectory.at(r, "theta_dot_" + std::to_string(j)), 0.0);
+      if (r + 1 < run.trajectory.size()) {
+        EXPECT_EQ(run.trajectory.at(r + 1, "theta_" + std::to_string(j)), run.trajectory.at(r, "theta_" + std::to_string(j)));
+      }
+    }
+  }
+  EXPECT_EQ(invalid, 1000);
+  // The CLI writes the run and exits 1 (failed steps), with or without --quiet.
+  for (const char* quiet : {"", " --quiet"}) {
+    const auto out = scratch("hostile_nan_mid_run");
+    const Cli r = redres("run configs/paper_r_fast.toml --set objectives.1.schedule=expression --set "
+                         "'objectives.1.formula=sqrt(t-1)' --out '" + out.string() + "'" + quiet);
+    EXPECT_EQ(r.code, 1) << r.out;
+    EXPECT_TRUE(std::filesystem::exists(out / "summary.json"));
+    EXPECT_TRUE(std::filesystem::exists(out / "trajectory.csv"));
+    std::filesystem::remove_all(out);
+  }
 }
 
 }  // namespace

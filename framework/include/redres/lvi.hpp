@@ -45,9 +45,11 @@ enum class SolverStatus {
   kInfeasible,      //!< bounds conflict, or J x = d cannot be met inside the bounds
   kNumericalError,  //!< the iteration broke down (e.g. a zero step); see the diagnosis
   kNotRun,          //!< no solve has run yet (recorded codes 0-3 keep their meaning)
+  kInvalidProblem,  //!< the step's QP could not be built: a plugin or a velocity-limit law gave a non-finite value
+                    //!< there (Controller; the diagnosis names which); nothing was solved
 };
 
-/// "solved", "max_iterations", "infeasible", "numerical_error", "not_run".
+/// "solved", "max_iterations", "infeasible", "numerical_error", "not_run", "invalid_problem".
 [[nodiscard]] const char* to_string(SolverStatus status);
 
 /// What a solve reports besides its answer.

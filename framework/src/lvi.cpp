@@ -151,7 +151,9 @@ void LviEngine::run(const QpProblem& qp, SolverResult& result) {
   if (conflicting) {
     const BoundConflict conflict = find_bound_conflict(qp);
     info.status = SolverStatus::kInfeasible;
-    info.residual = std::numeric_limits<double>::infinity();
+    double gap = 0.0;
+    for (int i = 0; i < n_; ++i) gap = std::max(gap, lo[i] - hi[i]);
+    info.residual = std::isfinite(gap) ? gap : std::numeric_limits<double>::max();
     info.diagnosis = "bounds conflict at " + describe(conflict, qp.variable_names);
     result.x.setZero();  // a definite value; callers must check the status
     result.y.setZero();

@@ -293,6 +293,9 @@ TEST(LviInfeasible, BoundConflictNamesTheJointAndThePlugins) {
     EXPECT_NE(why.find("'joint_velocity_limits'"), std::string::npos) << engine << ": " << why;
     EXPECT_NE(why.find("'joint_angle_margin'"), std::string::npos) << engine << ": " << why;
     EXPECT_TRUE(s.result.x.allFinite()) << engine;
+    // The residual of a conflict is how far apart the bounds are: a number, so that summaries stay numbers.
+    EXPECT_EQ(s.result.info.residual, (step->qp.lo - step->qp.hi).maxCoeff()) << engine;
+    EXPECT_GT(s.result.info.residual, 0.0) << engine;
   }
 }
 

@@ -56,7 +56,8 @@ enum class SolverStatus {
 struct SolverInfo {
   SolverStatus status = SolverStatus::kNotRun;  //!< outcome
   int iterations = 0;                           //!< iterations of the engine that ran
-  double residual = 0.0;                        //!< ||e(u)||_2 at the returned u
+  double residual = 0.0;                        //!< ||e(u)||_2 at the returned u; for a bound conflict, the
+                                                //!< largest lo_i - hi_i (finite, so that summaries stay numbers)
   std::string_view engine;                      //!< the engine that actually ran (a fallback names itself);
                                                 //!< compares by value; refers to the engine's static name
   std::string diagnosis;                        //!< empty when solved; otherwise which joint, bound, plugin

@@ -24,6 +24,27 @@ int main(int argc, char** argv) {
   redres::cli::add_plugins_command(app, action);
   redres::cli::add_run_commands(app, action);
   redres::cli::add_sweep_command(app, action);
+  // The first word that is not an option must be a command: an unknown one names itself and lists the known ones
+  // (CLI11 would say only "A subcommand is required").
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.empty() || word[0] == '-') {
+      if (word == "--plugin") ++i;  // its value
+      continue;
+    }
+    bool known = false;
+    std::string names;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      known = known || sub->get_name() == word;
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << "redres: unknown command '" << word << "'; the commands are " << names
+                << " (redres --help describes them)\n";
+      return redres::cli::kExitBadInput;
+    }
+    break;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -39,6 +39,15 @@ Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model) {
   }
   Eigen::VectorXd theta = Eigen::Map<Eigen::VectorXd>(values.data(), model.dof());
   REDRES_REQUIRE(theta.allFinite(), "--theta", "every value is finite");
+  for (int j = 0; j < model.dof(); ++j) {
+    const JointSpec& jt = model.joint(j);
+    if (theta(j) < jt.lower || theta(j) > jt.upper) {
+      std::ostringstream m;
+      m << "--theta: joint " << j + 1 << " ('" << jt.name << "') = " << theta(j) << " is outside its limits ["
+        << jt.lower << ", " << jt.upper << "]";
+      throw std::invalid_argument(m.str());
+    }
+  }
   return theta;
 }
 

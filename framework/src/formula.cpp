@@ -32,6 +32,20 @@ Formula::Formula(std::string text, std::vector<std::string> variables) : impl_(s
     impl_->parser.DefineConst("e", std::numbers::e);
     impl_->parser.SetExpr(impl_->text);
     (void)impl_->parser.Eval();  // compiles now, so syntax errors and unknown names surface at load
+    // muParser also takes "a, b" (several results, the last one used) and "x = 5" (an assignment to a variable):
+    // neither is a formula of one value.
+    if (impl_->parser.GetNumResults() != 1) {
+      throw std::invalid_argument("\"" + impl_->text + "\" is not a valid formula: expected one expression, got " +
+                                  std::to_string(impl_->parser.GetNumResults()) + " separated by commas");
+    }
+    for (std::size_t i = 0; i < impl_->text.size(); ++i) {
+      const char c = impl_->text[i];
+      const char before = i > 0 ? impl_->text[i - 1] : ' ', after = i + 1 < impl_->text.size() ? impl_->text[i + 1] : ' ';
+      if (c == '=' && before != '=' && before != '<' && before != '>' && before != '!' && after != '=') {
+        throw std::invalid_argument("\"" + impl_->text +
+                                    "\" is not a valid formula: '=' assigns to a variable (compare with ==)");
+      }
+    }
   } catch (const mu::Parser::exception_type& e) {
     std::string known;
     for (const auto& n : impl_->names) known += (known.empty() ? "" : ", ") + n;

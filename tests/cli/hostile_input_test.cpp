@@ -236,5 +236,42 @@ TEST(HostileInput, ANonFiniteValueMidRunIsAFailedStepNotTheEndOfTheRun) {
   }
 }
 
+// Each message is about what is wrong, where it is: the command line's own words are named as such.
+TEST(HostileInput, CommandLineMistakesAreNamedAsTheyWereGiven) {
+  struct Case {
+    std::string args;
+    std::string first_line;
+  };
+  const std::string v = "validate configs/paper_r_fast.toml ";
+  const Case cases[] = {
+      {"frobnicate", "redres: unknown command 'frobnicate'; the commands are robot, plugins, run, validate"},
+      {v + "--set duration=1e400", "--set duration=1e400: '1e400' is out of range for a number"},
+      {v + "--set objectives.1xyz.p=1", "'1xyz' is not an index into the array 'objectives' (expected digits"},
+      {v + "--set objectives.1e0.p=1", "'1e0' is not an index into the array 'objectives'"},
+      {v + "--set 'duration=2.5 # two'", "expected one value after '=', got extra text in '2.5 # two'"},
+      {v + "--set 'name=\"r\" x'", "'\"r\" x' is not a TOML value"},
+      {v + "--set objectives.1.schedule=expression --set 'objectives.1.formula=t = 5'",
+       "\"t = 5\" is not a valid formula: '=' assigns to a variable"},
+      {v + "--set objectives.1.schedule=expression --set 'objectives.1.formula=1, 2'",
+       "\"1, 2\" is not a valid formula: expected one expression, got 2"},
+      {"robot robots/paper_pushrod_6dof.toml --theta 0.1,0.1", "--theta: expected 6 comma-separated values"},
+      {"robot robots/paper_pushrod_6dof.toml --theta 9,0.1,0.1,0.1,0.1,0.1",
+       "--theta: joint 1 ('joint1') = 9 is outside its limits [-1.536, 1.431]"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const Cli r = redres(c.args);
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(first_line(r.out).find(c.first_line), std::string::npos) << r.out;
+  }
+  // What is right still is: a bare word, a quoted string with a code point past ASCII, comparisons in formulas.
+  for (const std::string ok : {"--set 'name=bare words'", "--set 'name=\"\u03a9mega\"'",
+                               "--set objectives.1.schedule=expression --set 'objectives.1.formula=(t >= 1) * min(t, 2)'"}) {
+    SCOPED_TRACE(ok);
+    const Cli r = redres(v + ok);
+    EXPECT_EQ(r.code, 0) << r.out;
+  }
+}
+
 }  // namespace
 }  // namespace redres

@@ -5,6 +5,10 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
+
+#include <unistd.h>
 
 #include "redres/error.hpp"
 #include "redres/kinematics.hpp"
@@ -16,9 +20,11 @@ namespace {
 // A table as comma-separated text with one header line. Numbers are written by std::to_chars in their shortest
 // round-trip form (reading the text back gives the same doubles, bit for bit), into a buffer written in large
 // blocks: several times faster than printf("%.17g").
-void write_csv(const Trajectory& table, const std::filesystem::path& file, std::size_t every = 1) {
+// `shown` is the name errors give (the final name of a staged file).
+void write_csv(const Trajectory& table, const std::filesystem::path& file, const std::filesystem::path& shown,
+               std::size_t every = 1) {
   std::FILE* f = std::fopen(file.string().c_str(), "w");
-  if (f == nullptr) throw std::runtime_error("cannot write " + file.string());
+  if (f == nullptr) throw std::runtime_error("cannot write " + shown.string());
   constexpr std::size_t kBlock = 1 << 16;
   std::string out;
   out.reserve(kBlock + 4096);
@@ -43,7 +49,13 @@ void write_csv(const Trajectory& table, const std::filesystem::path& file, std::
     if (out.size() >= kBlock) flush();
   }
   flush();
-  if (std::fclose(f) != 0 || !ok) throw std::runtime_error("cannot write " + file.string());
+  if (std::fclose(f) != 0 || !ok) throw std::runtime_error("cannot write " + shown.string());
+}
+
+// Where `file` is written before it is renamed into place: beside it (rename is atomic within a directory), hidden,
+// and unique to this process.
+std::filesystem::path staging_path(const std::filesystem::path& file) {
+  return file.parent_path() / ("." + file.filename().string() + ".tmp." + std::to_string(::getpid()));
 }
 
 // Columns per joint in frames.csv: origin, then the rotation row by row.
@@ -103,15 +115,35 @@ void write_run(const RobotModel& robot, const RunResult& run, const RunSummary& 
                const std::filesystem::path& dir, const RecordOptions& record) {
   REDRES_REQUIRE(record.every >= 1, "write_run", "record.every >= 1");
   std::filesystem::create_directories(dir);
+  // Every file is written to a temporary beside it first, so that a failed write (a full disk, a read-only
+  // directory) leaves the directory as it was. Then the old summary goes, the tables are renamed into place, and
+  // the summary comes last: a reader that finds summary.json finds the complete tables of the same run.
+  const std::filesystem::path summary_file = dir / "summary.json";
+  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged;  // temporary, final
+  const auto stage = [&staged](const std::filesystem::path& file) {
+    staged.emplace_back(staging_path(file), file);
+    return staged.back().first;
+  };
+  try {
+    if (!record.none) {
+      write_csv(run.trajectory, stage(dir / "trajectory.csv"), dir / "trajectory.csv", record.every);
+      write_csv(joint_frames(robot, run.trajectory), stage(dir / "frames.csv"), dir / "frames.csv");
+    }
+    const std::filesystem::path js_file = stage(summary_file);
+    std::ofstream js(js_file);
+    js << to_json(summary) << "\n";
+    js.close();
+    if (!js) throw std::runtime_error("cannot write " + summary_file.string());
+  } catch (...) {
+    std::error_code ignored;
+    for (const auto& [tmp, file] : staged) std::filesystem::remove(tmp, ignored);
+    throw;
+  }
+  std::filesystem::remove(summary_file);
   if (record.none) {
     for (const char* stale : {"trajectory.csv", "frames.csv"}) std::filesystem::remove(dir / stale);
-  } else {
-    write_csv(run.trajectory, dir / "trajectory.csv", record.every);
-    write_csv(joint_frames(robot, run.trajectory), dir / "frames.csv");
   }
-  std::ofstream js(dir / "summary.json");
-  js << to_json(summary) << "\n";
-  if (!js) throw std::runtime_error("cannot write " + (dir / "summary.json").string());
+  for (const auto& [tmp, file] : staged) std::filesystem::rename(tmp, file);  // summary.json last
 }
 
 }  // namespace redres

@@ -1,6 +1,7 @@
 // joint_frames (frames.csv): the rows it keeps and the frames it computes; trajectory.csv read back gives the
 // recorded doubles bit for bit.
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -8,6 +9,9 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <tuple>
+
+#include <unistd.h>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -140,6 +144,58 @@ TEST(TrajectoryCsv, ReadsBackBitForBit) {
   }
   EXPECT_EQ(r, run.trajectory.size());
   EXPECT_GT(checked, 1000u);
+  std::filesystem::remove_all(dir);
+}
+
+std::string file_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The names in a directory that start with a dot (the staging files).
+std::vector<std::string> hidden(const std::filesystem::path& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    if (e.path().filename().string()[0] == '.') out.push_back(e.path().filename().string());
+  }
+  return out;
+}
+
+TEST(RunOutput, FilesAreReplacedWholeAndAFailedWriteLeavesTheDirectoryAsItWas) {
+  const auto dir = std::filesystem::temp_directory_path() / ("redres_atomic_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  const auto run_of = [](const char* duration) {
+    Scenario s = load_scenario(source_path("configs/paper_r_fast.toml"), {std::string("duration=") + duration});
+    RunResult run = simulate(s);
+    RunSummary summary = summarise(s, run);
+    return std::make_tuple(std::move(s), std::move(run), std::move(summary));
+  };
+  auto [sa, ra, ma] = run_of("0.5");
+  write_run(*sa.robot, ra, ma, dir);
+  auto [sb, rb, mb] = run_of("1.0");
+  write_run(*sb.robot, rb, mb, dir);
+  EXPECT_TRUE(hidden(dir).empty());
+  EXPECT_NE(file_text(dir / "summary.json").find("\"steps\": 1000"), std::string::npos);
+  const std::string trajectory = file_text(dir / "trajectory.csv"), frames = file_text(dir / "frames.csv"),
+                    summary = file_text(dir / "summary.json");
+  EXPECT_EQ(std::count(trajectory.begin(), trajectory.end(), '\n'), 1002);  // header and 1,001 rows
+  // A write that fails half-way (here frames.csv cannot be created) changes nothing and leaves no temporary.
+  const auto blocker = dir / (".frames.csv.tmp." + std::to_string(::getpid()));
+  std::filesystem::create_directory(blocker);
+  EXPECT_THROW(write_run(*sa.robot, ra, ma, dir), std::runtime_error);
+  std::filesystem::remove(blocker);
+  EXPECT_TRUE(hidden(dir).empty());
+  EXPECT_EQ(file_text(dir / "trajectory.csv"), trajectory);
+  EXPECT_EQ(file_text(dir / "frames.csv"), frames);
+  EXPECT_EQ(file_text(dir / "summary.json"), summary);
+  // A read-only summary from an earlier run is replaced with the rest, not left beside new tables.
+  std::filesystem::permissions(dir / "summary.json", std::filesystem::perms::owner_read);
+  write_run(*sa.robot, ra, ma, dir);
+  EXPECT_NE(file_text(dir / "summary.json").find("\"steps\": 500"), std::string::npos);
+  const std::string replaced = file_text(dir / "trajectory.csv");
+  EXPECT_EQ(std::count(replaced.begin(), replaced.end(), '\n'), 502);
   std::filesystem::remove_all(dir);
 }
 

@@ -27,7 +27,9 @@ inline constexpr std::size_t kFramesMaxRows = 500;
 /// Writes DIR/trajectory.csv (the rows `record` keeps), DIR/frames.csv (joint_frames of `robot`, the run's robot)
 /// and DIR/summary.json, creating DIR; std::runtime_error naming the file on failure. With record.none, only
 /// summary.json, and a trajectory.csv or frames.csv left in DIR by an earlier run is removed (it would not belong
-/// to this summary).
+/// to this summary). Each file is written to a hidden temporary beside it and renamed into place, summary.json
+/// last: a failed write leaves DIR as it was, and a reader never sees a half-written file or new tables beside an
+/// old summary.
 void write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
                const std::filesystem::path& dir, const RecordOptions& record = {});
 

@@ -14,6 +14,8 @@ namespace redres::cli {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailedSteps = 1;
 inline constexpr int kExitBadInput = 2;
+/// `run` ended by SIGINT or SIGTERM: what it wrote is complete and its summary says "interrupted" (128 + SIGINT).
+inline constexpr int kExitInterrupted = 130;
 
 /// An action run after parsing; returns the exit code.
 using Action = std::function<int()>;

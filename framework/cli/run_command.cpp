@@ -1,9 +1,11 @@
 // `redres run`, `redres validate` and `redres compare`: scenarios from the command line.
 
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -160,15 +162,46 @@ struct Outcome {
   RunSummary summary;
 };
 
+// SIGINT and SIGTERM during a run set this flag; the run ends after its current step and writes what it has.
+std::atomic<bool> g_stop_requested{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the flag is set from a signal handler");
+
+extern "C" void request_stop(int /*signal*/) { g_stop_requested.store(true, std::memory_order_relaxed); }
+
+// Routes SIGINT and SIGTERM to request_stop() while it lives, then puts back what was there.
+class StopOnSignals {
+ public:
+  StopOnSignals() {
+    struct sigaction action {};
+    action.sa_handler = request_stop;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(SIGINT, &action, &old_int_);
+    ::sigaction(SIGTERM, &action, &old_term_);
+  }
+  ~StopOnSignals() {
+    ::sigaction(SIGINT, &old_int_, nullptr);
+    ::sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopOnSignals(const StopOnSignals&) = delete;
+  StopOnSignals& operator=(const StopOnSignals&) = delete;
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
 Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet, const RecordOptions& record = {}) {
   Outcome o{std::move(scenario), {}, {}};
   {
     ProgressBar bar(o.scenario.name, quiet);
-    o.run = simulate(o.scenario, [&bar](double f, double t) {
-      char where[32];
-      std::snprintf(where, sizeof where, "t = %.2f s", t);
-      bar.update(f, where);
-    });
+    const StopOnSignals signals;
+    simulate(
+        o.scenario, o.run,
+        [&bar](double f, double t) {
+          char where[32];
+          std::snprintf(where, sizeof where, "t = %.2f s", t);
+          bar.update(f, where);
+        },
+        &g_stop_requested);
   }
   o.summary = summarise(o.scenario, o.run);
   write_run(*o.scenario.robot, o.run, o.summary, out, record);
@@ -179,6 +212,10 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet,
               << s.manipulability.initial << " -> " << s.manipulability.final << ", " << s.solver.failures
               << " failed steps, " << s.wall_time_s << " s -> " << out.string() << "\n";
     if (s.solver.failures > 0) std::cout << "  first failure: " << s.solver.first_failure << "\n";
+  }
+  if (o.run.interrupted) {
+    std::cerr << o.scenario.name << ": interrupted at t = " << o.run.trajectory.at(o.run.trajectory.size() - 1, "t")
+              << " s; " << out.string() << " holds the run up to there (summary.json: \"status\": \"interrupted\")\n";
   }
   return o;
 }
@@ -237,6 +274,7 @@ void add_run_commands(CLI::App& app, Action& action) {
         animator = find_plotter(opts->animate ? "--animate" : opts->scenarios.front() + ": [output] animate = true");
       }
       const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet, record);
+      if (o.run.interrupted) return kExitInterrupted;  // no figures: the user asked it to stop
       const std::string written = "trajectory.csv, frames.csv and summary.json in " + opts->out;
       if (plotter) render_plots(*plotter, {opts->out}, opts->quiet, written);
       if (animator) {

@@ -70,6 +70,7 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   RunSummary out;
   out.name = s.name;
   out.source = s.source;
+  out.status = run.interrupted ? "interrupted" : run.stopped ? "stopped" : "complete";
   out.steps = s.steps();
   out.tau = s.tau;
   out.duration = s.duration;
@@ -169,6 +170,7 @@ std::string to_json(const RunSummary& s) {
   const nlohmann::json j = {
       {"name", s.name},
       {"source", s.source},
+      {"status", s.status},
       {"steps", s.steps},
       {"tau", s.tau},
       {"duration", s.duration},

@@ -86,7 +86,7 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
   return run;
 }
 
-void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress) {
+void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, const std::atomic<bool>* stop) {
   const RobotModel& robot = *s.robot;
   const int n = robot.dof();
   const int m = robot.reference_dim();
@@ -220,6 +220,10 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress) {
     if (run.failures == failures_before) check_violations(t);  // one failure per step at most
     if (progress && (k % report_every == 0 || k == steps)) progress(static_cast<double>(k) / steps, t);
     if (k == steps) break;
+    if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
+      run.interrupted = true;  // the row of this step is the last
+      break;
+    }
     if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before) {
       run.stopped = true;  // the row of the failed step is the last
       break;

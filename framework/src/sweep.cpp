@@ -168,7 +168,8 @@ Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesy
     status = run.failures == 0 ? "ok" : "failed_steps";
     diagnosis = run.first_failure;
     nlohmann::json j = nlohmann::json::parse(to_json(summary));
-    for (const char* skip : {"wall_time_s", "source", "robot", "obstacles", "name"}) j.erase(skip);
+    // (The run's own "status" is the sweep's status column and solver.stopped.)
+    for (const char* skip : {"wall_time_s", "source", "robot", "obstacles", "name", "status"}) j.erase(skip);
     flatten(j, "", figures);
   } catch (const std::exception& e) {
     diagnosis = e.what();

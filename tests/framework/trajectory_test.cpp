@@ -1,6 +1,7 @@
 // Trajectory: rows copied in bit for bit (the streaming copy included, at every alignment), storage kept by reset(),
 // growth past the reserve; simulate() into a reused RunResult gives the run a fresh one gives.
 
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -8,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "redres/run_summary.hpp"
 #include "redres/simulation.hpp"
 #include "test_util.hpp"
 
@@ -97,6 +99,30 @@ TEST(Trajectory, ARunIntoAReusedResultIsTheRunIntoAFreshOne) {
     EXPECT_EQ(reused.engine(), fresh.engine());
     EXPECT_EQ(reused.stopped, fresh.stopped);
   }
+}
+
+// A stop request (the CLI sets it from SIGINT and SIGTERM) ends the run after the current step, with every row up to
+// it recorded and the summary saying so.
+TEST(Trajectory, AStopRequestEndsTheRunWithTheRowsUpToItAndSaysSo) {
+  Scenario s = load_scenario(source_path("configs/paper_r_fast.toml"));
+  std::atomic<bool> stop{false};
+  RunResult run;
+  simulate(
+      s, run, [&stop](double fraction, double) { stop = stop || fraction >= 0.5; }, &stop);
+  EXPECT_TRUE(run.interrupted);
+  EXPECT_FALSE(run.stopped);
+  const std::size_t full = static_cast<std::size_t>(s.steps()) + 1;
+  EXPECT_GT(run.trajectory.size(), full / 2 - 1);
+  EXPECT_LT(run.trajectory.size(), full / 2 + 20);  // the progress callback runs every steps / 200 steps
+  const RunSummary summary = summarise(s, run);
+  EXPECT_EQ(summary.status, "interrupted");
+  EXPECT_NE(to_json(summary).find("\"status\": \"interrupted\""), std::string::npos);
+  // The rows it has are the rows of the whole run.
+  const RunResult whole = simulate(s);
+  EXPECT_EQ(summarise(s, whole).status, "complete");
+  EXPECT_EQ(std::memcmp(run.trajectory.values().data(), whole.trajectory.values().data(),
+                        run.trajectory.values().size() * sizeof(double)),
+            0);
 }
 
 }  // namespace

@@ -63,6 +63,7 @@ struct ObstacleFacts {
 struct RunSummary {
   std::string name;                           //!< scenario name
   std::string source;                         //!< scenario file
+  std::string status;                         //!< "complete", "stopped" (at a failed step) or "interrupted"
   int steps = 0;                              //!< control steps N (N + 1 rows)
   double tau = 0.0;                           //!< step (s)
   double duration = 0.0;                      //!< T (s)

@@ -3,6 +3,7 @@
 /// The simulation of a scenario: from theta(0), one Controller step per control step, integrated with Euler's or
 /// Heun's method, each step recorded into a Trajectory (columns in docs/output_formats.md).
 
+#include <atomic>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -22,6 +23,7 @@ struct RunResult {
   double wall_time_s = 0.0;               //!< time spent in the loop (s)
   std::vector<std::string_view> engines;  //!< engines that ran, in order of first use (a fallback adds one)
   bool stopped = false;                   //!< ended at the first failed step ([solver] on_infeasible = "stop")
+  bool interrupted = false;               //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
 
   /// "projection", or "newton+projection" when a fallback ran.
   [[nodiscard]] std::string engine() const;
@@ -38,6 +40,9 @@ using ProgressCallback = std::function<void(double fraction, double t)>;
 
 /// The same into `run`, which is overwritten; its trajectory's storage is reused when it has room for this run, so
 /// that repeated runs (a sweep's worker, a benchmark) skip the allocation and the first touch of the table's pages.
-void simulate(Scenario& scenario, RunResult& run, const ProgressCallback& progress = {});
+/// `stop`, when given, is read after each recorded step: once it is true the run ends there, with every row up to
+/// that step and `interrupted` set (a signal handler may set it).
+void simulate(Scenario& scenario, RunResult& run, const ProgressCallback& progress = {},
+              const std::atomic<bool>* stop = nullptr);
 
 }  // namespace redres

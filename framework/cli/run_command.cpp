@@ -186,7 +186,8 @@ class StopOnSignals {
   StopOnSignals& operator=(const StopOnSignals&) = delete;
 
  private:
-  struct sigaction old_int_ {}, old_term_ {};
+  struct sigaction old_int_ {
+  }, old_term_{};
 };
 
 Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet, const RecordOptions& record = {}) {
@@ -263,8 +264,9 @@ void add_run_commands(CLI::App& app, Action& action) {
         }
       }
       if (record.none && (opts->plots || opts->animate || scenario.plots || scenario.animate)) {
-        throw std::runtime_error("the figures and the animation are made from trajectory.csv and frames.csv, which "
-                                 "--record none does not write: use --record every=N");
+        throw std::runtime_error(
+            "the figures and the animation are made from trajectory.csv and frames.csv, which "
+            "--record none does not write: use --record every=N");
       }
       std::optional<Plotter> plotter, animator;
       if (opts->plots || scenario.plots) {

@@ -40,7 +40,8 @@ Formula::Formula(std::string text, std::vector<std::string> variables) : impl_(s
     }
     for (std::size_t i = 0; i < impl_->text.size(); ++i) {
       const char c = impl_->text[i];
-      const char before = i > 0 ? impl_->text[i - 1] : ' ', after = i + 1 < impl_->text.size() ? impl_->text[i + 1] : ' ';
+      const char before = i > 0 ? impl_->text[i - 1] : ' ',
+                 after = i + 1 < impl_->text.size() ? impl_->text[i + 1] : ' ';
       if (c == '=' && before != '=' && before != '<' && before != '>' && before != '!' && after != '=') {
         throw std::invalid_argument("\"" + impl_->text +
                                     "\" is not a valid formula: '=' assigns to a variable (compare with ==)");

@@ -79,8 +79,8 @@ void apply_override(toml::table& root, const std::string& text) {
     } else if (auto* a = cur->as_array()) {
       // An index is digits only: "1xyz" and "1e0" are not indices.
       if (part.size() > 9 || part.find_first_not_of("0123456789") != std::string::npos) {
-        bad_override(text, "'" + part + "' is not an index into the array '" + parts[i - 1] +
-                               "' (expected digits, 0-based)");
+        bad_override(text,
+                     "'" + part + "' is not an index into the array '" + parts[i - 1] + "' (expected digits, 0-based)");
       }
       const std::size_t idx = std::stoul(part);
       if (idx >= a->size()) {

@@ -85,7 +85,7 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   out.max_joint_velocity_violation = std::max(0.0, vel_viol);
   out.steps_with_active_bounds = active_steps;
   for (int j = 0; j < n; ++j) out.final_theta.push_back(tr(rows - 1, c_th[static_cast<std::size_t>(j)]));
-  out.solver = {run.engine(),  it_sum / static_cast<double>(rows), it_max, max_res, run.failures, run.first_failure,
+  out.solver = {run.engine(), it_sum / static_cast<double>(rows), it_max, max_res, run.failures, run.first_failure,
                 run.stopped};
   out.wall_time_s = run.wall_time_s;
   out.robot.name = robot.name();

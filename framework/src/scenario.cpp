@@ -106,10 +106,11 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   s.path = make_path(TableReader(path_table.file_ptr(), path_table.raw(), "path"), pc);
 
   s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot));
-  if (const double bytes = (s.steps() + 1.0) * static_cast<double>(trajectory_width(s)) * 8.0; bytes > kMaxTableBytes) {
+  const std::size_t width = trajectory_width(s);
+  if (const double bytes = (s.steps() + 1.0) * static_cast<double>(width) * 8.0; bytes > kMaxTableBytes) {
     std::ostringstream m;
     m << "expected a run whose recorded table fits in " << kMaxTableBytes / (1024.0 * 1024 * 1024) << " GiB, got "
-      << s.steps() + 1 << " rows of " << trajectory_width(s) << " columns (" << bytes / (1024.0 * 1024 * 1024)
+      << s.steps() + 1 << " rows of " << width << " columns (" << bytes / (1024.0 * 1024 * 1024)
       << " GiB; use a longer step or a shorter duration)";
     r.fail("step", m.str());
   }

@@ -93,15 +93,13 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
   const int position_rows = robot.position_rows();
   const int steps = s.steps();
   {
-    RunResult fresh;  // every field as a new run has it, with the old trajectory's storage
-    fresh.trajectory = std::move(run.trajectory);
-    fresh.engines = std::move(run.engines);
-    fresh.engines.clear();
-    run = std::move(fresh);
+    Trajectory storage = std::move(run.trajectory);  // every field as a new run has it, but the table's storage
+    run = RunResult{};
+    run.trajectory = std::move(storage);
   }
-  const std::size_t standard_columns = trajectory_columns(robot).size();
   std::vector<std::pair<const Plugin*, std::size_t>> recorders;  // plugin, first column
   std::vector<std::string> columns = run_columns(s, &recorders);
+  const std::size_t standard_columns = recorders.empty() ? columns.size() : recorders.front().second;
   REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
                  "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
                      std::to_string(columns.size()) + " columns do not)");

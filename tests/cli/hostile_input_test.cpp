@@ -27,9 +27,7 @@ std::string repeat(const std::string& s, int n, const std::string& sep) {
   return out;
 }
 
-void write(const std::filesystem::path& p, const std::string& text) {
-  std::ofstream(p, std::ios::binary) << text;
-}
+void write(const std::filesystem::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
 // The first line of the CLI's output.
 std::string first_line(const std::string& out) { return out.substr(0, out.find('\n')); }
@@ -67,10 +65,10 @@ TEST(HostileInput, KeysAndNestingTooDeepForTheParserAreErrorsNotCrashes) {
 TEST(HostileInput, TomlWithDotsInStringsCommentsAndNumbersStillParses) {
   const std::string many_dots = repeat("a", 200, ".");
   const std::string text = "s = \"" + many_dots + "\"\nl = '" + many_dots + "'\n# " + many_dots + "\nm = \"\"\"\n" +
-                           many_dots + "\n\"\"\"\nn = '''" + many_dots + "'''\nq = \"\"\"x\"\"\"\"\n" +
-                           "v = [" + repeat("1.5", 500, ", ") + "]\nt = 1979-05-27T07:32:00.999Z\n" +
-                           repeat("k", 60, ".") + " = 1\n[" + repeat("h", 60, ".") + "]\nx = " +
-                           repeat("[", 60, "") + repeat("]", 60, "") + "\n";
+                           many_dots + "\n\"\"\"\nn = '''" + many_dots + "'''\nq = \"\"\"x\"\"\"\"\n" + "v = [" +
+                           repeat("1.5", 500, ", ") + "]\nt = 1979-05-27T07:32:00.999Z\n" + repeat("k", 60, ".") +
+                           " = 1\n[" + repeat("h", 60, ".") + "]\nx = " + repeat("[", 60, "") + repeat("]", 60, "") +
+                           "\n";
   const auto file = parse_toml_string(text, "ok.toml");
   EXPECT_EQ(file->root["s"].value_or(std::string()), many_dots);
   EXPECT_EQ(file->root["m"].value_or(std::string()), many_dots + "\n");
@@ -108,8 +106,9 @@ TEST(HostileInput, InputsThatAreNotBoundedRegularFilesAreRefusedBeforeReading) {
     EXPECT_THROW((void)read_input_file(c.path, "TOML file"), ConfigError);
   }
   // A table law naming /dev/zero as its CSV file.
-  write(dir / "law.toml", kHead + "[[joints]]\nname = \"j1\"\nlength = 0.3\nlimits = [-1.0, 1.0]\n"
-                                  "[joints.velocity_limit]\ntype = \"table\"\nfile = \"/dev/zero\"\n");
+  write(dir / "law.toml", kHead +
+                              "[[joints]]\nname = \"j1\"\nlength = 0.3\nlimits = [-1.0, 1.0]\n"
+                              "[joints.velocity_limit]\ntype = \"table\"\nfile = \"/dev/zero\"\n");
   const Cli r = redres_env("timeout 20 ", "robot '" + (dir / "law.toml").string() + "'");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("/dev/zero: CSV file is a character device"), std::string::npos) << r.out;
@@ -219,7 +218,8 @@ TEST(HostileInput, ANonFiniteValueMidRunIsAFailedStepNotTheEndOfTheRun) {
     for (int j = 1; j <= s.robot->dof(); ++j) {
       EXPECT_EQ(run.trajectory.at(r, "theta_dot_" + std::to_string(j)), 0.0);
       if (r + 1 < run.trajectory.size()) {
-        EXPECT_EQ(run.trajectory.at(r + 1, "theta_" + std::to_string(j)), run.trajectory.at(r, "theta_" + std::to_string(j)));
+        EXPECT_EQ(run.trajectory.at(r + 1, "theta_" + std::to_string(j)),
+                  run.trajectory.at(r, "theta_" + std::to_string(j)));
       }
     }
   }
@@ -227,8 +227,10 @@ TEST(HostileInput, ANonFiniteValueMidRunIsAFailedStepNotTheEndOfTheRun) {
   // The CLI writes the run and exits 1 (failed steps), with or without --quiet.
   for (const char* quiet : {"", " --quiet"}) {
     const auto out = scratch("hostile_nan_mid_run");
-    const Cli r = redres("run configs/paper_r_fast.toml --set objectives.1.schedule=expression --set "
-                         "'objectives.1.formula=sqrt(t-1)' --out '" + out.string() + "'" + quiet);
+    const Cli r = redres(
+        "run configs/paper_r_fast.toml --set objectives.1.schedule=expression --set "
+        "'objectives.1.formula=sqrt(t-1)' --out '" +
+        out.string() + "'" + quiet);
     EXPECT_EQ(r.code, 1) << r.out;
     EXPECT_TRUE(std::filesystem::exists(out / "summary.json"));
     EXPECT_TRUE(std::filesystem::exists(out / "trajectory.csv"));
@@ -265,8 +267,9 @@ TEST(HostileInput, CommandLineMistakesAreNamedAsTheyWereGiven) {
     EXPECT_NE(first_line(r.out).find(c.first_line), std::string::npos) << r.out;
   }
   // What is right still is: a bare word, a quoted string with a code point past ASCII, comparisons in formulas.
-  for (const std::string ok : {"--set 'name=bare words'", "--set 'name=\"\u03a9mega\"'",
-                               "--set objectives.1.schedule=expression --set 'objectives.1.formula=(t >= 1) * min(t, 2)'"}) {
+  for (const std::string ok :
+       {"--set 'name=bare words'", "--set 'name=\"\u03a9mega\"'",
+        "--set objectives.1.schedule=expression --set 'objectives.1.formula=(t >= 1) * min(t, 2)'"}) {
     SCOPED_TRACE(ok);
     const Cli r = redres(v + ok);
     EXPECT_EQ(r.code, 0) << r.out;

@@ -96,9 +96,19 @@ TEST(TrajectoryCsv, ReadsBackBitForBit) {
   const RunSummary summary = summarise(s, run);
   std::mt19937_64 rng(11);
   const double lim = std::numeric_limits<double>::max();
-  const double specials[] = {0.0, -0.0, std::numeric_limits<double>::denorm_min(), -5e-324, 2.2250738585072014e-308,
-                             lim, -lim, std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
-                             0.1, 1.0 / 3.0, 1e22, 123456789012345678.0};
+  const double specials[] = {0.0,
+                             -0.0,
+                             std::numeric_limits<double>::denorm_min(),
+                             -5e-324,
+                             2.2250738585072014e-308,
+                             lim,
+                             -lim,
+                             std::numeric_limits<double>::infinity(),
+                             -std::numeric_limits<double>::infinity(),
+                             0.1,
+                             1.0 / 3.0,
+                             1e22,
+                             123456789012345678.0};
   for (int extra = 0; extra < 50; ++extra) {
     double* row = run.trajectory.append_row();
     for (std::size_t c = 0; c < run.trajectory.width(); ++c) {

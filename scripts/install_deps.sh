@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages redres needs. Idempotent: installs only what is missing and runs
-# `apt-get update` only when something must be installed.
+# `apt-get update` only when something must be installed. Extra package names as arguments are installed too
+# (scripts/fuzz.sh passes clang's).
 set -euo pipefail
 
 packages=(
@@ -10,6 +11,7 @@ packages=(
   libgtest-dev libgmock-dev librapidcheck-dev libbenchmark-dev liborocos-kdl-dev
   python3 python3-dev python3-matplotlib python3-numpy python3-pil
   pybind11-dev python3-pybind11 python3-pytest
+  "$@"
 )
 
 missing=()

@@ -1,0 +1,37 @@
+// libFuzzer target: the scenario loader and a short run (docs/fuzzing.md).
+//
+// The input is a scenario TOML file. It is written into the scratch directory (fuzz_util.hpp), where the configs'
+// `robot = "../robots/..."` and the test corpora's "../../../robots/..." resolve, and loaded with
+// load_scenario(path), the entry point of `redres run` and `redres validate`. A scenario that loads runs for at
+// most kMaxSteps control steps (its duration is cut to kMaxSteps * step after loading, so the path, the scheme and
+// the solver are the ones the file asked for), and the run is summarised and serialised as summary.json would be.
+//
+// Exceptions derived from std::exception are the loader's answers to bad input and are expected; a run's failed
+// steps are results, not errors. Crashes, sanitizer reports, leaks, timeouts and out-of-memory are findings.
+
+#include <algorithm>
+#include <cstdint>
+#include <exception>
+
+#include "fuzz_util.hpp"
+#include "redres/run_summary.hpp"
+#include "redres/scenario.hpp"
+#include "redres/simulation.hpp"
+
+namespace {
+constexpr int kMaxSteps = 20;
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const auto file = redres::fuzz::scratch().write("input.toml", data, size);
+  try {
+    redres::Scenario scenario = redres::load_scenario(file);
+    scenario.duration = std::min(scenario.duration, kMaxSteps * scenario.tau);
+    const redres::RunResult run = redres::simulate(scenario);
+    const redres::RunSummary summary = redres::summarise(scenario, run);
+    (void)redres::to_json(summary);
+  } catch (const std::exception&) {
+    // Bad input, reported as a ConfigError, std::invalid_argument, ...
+  }
+  return 0;
+}

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -19,11 +20,15 @@
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
+#include <tuple>
+#include <vector>
 
 #include "commands.hpp"
 #include "progress.hpp"
+#include "redres/csv.hpp"
 #include "redres/run_output.hpp"
 #include "redres/scenario.hpp"
+#include "stop_signals.hpp"
 
 extern char** environ;  // the environment plot_run.py inherits (POSIX leaves the declaration to the program)
 
@@ -162,39 +167,13 @@ struct Outcome {
   RunSummary summary;
 };
 
-// SIGINT and SIGTERM during a run set this flag; the run ends after its current step and writes what it has.
-std::atomic<bool> g_stop_requested{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "the flag is set from a signal handler");
-
-extern "C" void request_stop(int /*signal*/) { g_stop_requested.store(true, std::memory_order_relaxed); }
-
-// Routes SIGINT and SIGTERM to request_stop() while it lives, then puts back what was there.
-class StopOnSignals {
- public:
-  StopOnSignals() {
-    struct sigaction action {};
-    action.sa_handler = request_stop;
-    sigemptyset(&action.sa_mask);
-    ::sigaction(SIGINT, &action, &old_int_);
-    ::sigaction(SIGTERM, &action, &old_term_);
-  }
-  ~StopOnSignals() {
-    ::sigaction(SIGINT, &old_int_, nullptr);
-    ::sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  StopOnSignals(const StopOnSignals&) = delete;
-  StopOnSignals& operator=(const StopOnSignals&) = delete;
-
- private:
-  struct sigaction old_int_ {
-  }, old_term_{};
-};
-
 Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet, const RecordOptions& record = {}) {
   Outcome o{std::move(scenario), {}, {}};
+  // From the first step until the files are written, SIGINT and SIGTERM only set the flag: the run ends after its
+  // current step, and a signal while the files are written lets the writing finish (no temporaries left behind).
+  const StopOnSignals signals;
   {
     ProgressBar bar(o.scenario.name, quiet);
-    const StopOnSignals signals;
     simulate(
         o.scenario, o.run,
         [&bar](double f, double t) {
@@ -205,20 +184,69 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet,
         &g_stop_requested);
   }
   o.summary = summarise(o.scenario, o.run);
-  write_run(*o.scenario.robot, o.run, o.summary, out, record);
+  (void)write_run(*o.scenario.robot, o.run, o.summary, out, record);
   if (!quiet) {
     const RunSummary& s = o.summary;
     std::cout << std::setprecision(4) << s.name << ": " << s.steps << " steps of " << s.tau << " s, engine "
               << s.solver.engine << ", max position error " << s.max_position_error << " m, w "
               << s.manipulability.initial << " -> " << s.manipulability.final << ", " << s.solver.failures
               << " failed steps, " << s.wall_time_s << " s -> " << out.string() << "\n";
-    if (s.solver.failures > 0) std::cout << "  first failure: " << s.solver.first_failure << "\n";
+    if (s.solver.relaxed_steps > 0) {
+      std::cout << "  " << s.solver.relaxed_steps << " steps relaxed (rows missed by "
+                << s.solver.max_relaxed_task_error << " at most); first: " << s.solver.first_relaxed << "\n";
+    }
+  }
+  // The diagnosis of a failed run goes to stderr, with --quiet too: a script that checks the exit code sees why.
+  if (o.summary.solver.failures > 0) {
+    const SolverStats& st = o.summary.solver;
+    std::cerr << o.scenario.name << ": " << st.failures << " failed step" << (st.failures == 1 ? "" : "s")
+              << " (on_infeasible = \"" << st.on_infeasible << "\"";
+    if (st.held_steps > 0) std::cerr << ", " << st.held_steps << " held with theta_dot = 0";
+    if (st.stopped) std::cerr << ", the run stopped at the first";
+    std::cerr << "); first failure: " << st.first_failure << "\n";
   }
   if (o.run.interrupted) {
     std::cerr << o.scenario.name << ": interrupted at t = " << o.run.trajectory.at(o.run.trajectory.size() - 1, "t")
               << " s; " << out.string() << " holds the run up to there (summary.json: \"status\": \"interrupted\")\n";
   }
   return o;
+}
+
+// The regular files of a directory with their modification times and sizes, to tell which files a figure step
+// wrote.
+using Listing = std::vector<std::tuple<std::string, std::filesystem::file_time_type, std::uintmax_t>>;
+Listing list_files(const std::filesystem::path& dir) {
+  Listing files;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    if (!e.is_regular_file(ec)) continue;
+    files.emplace_back(e.path().filename().string(), e.last_write_time(ec), e.file_size(ec));
+  }
+  return files;
+}
+
+// Adds the files that are new or changed since `before` to the directory's manifest: the figures just made, which
+// the next run into the directory removes if it does not make them again.
+void record_new_files(const std::filesystem::path& dir, const Listing& before) {
+  std::vector<std::string> added;
+  for (const auto& file : list_files(dir)) {
+    if (std::find(before.begin(), before.end(), file) == before.end()) added.push_back(std::get<0>(file));
+  }
+  add_to_output_manifest(dir, added);
+}
+
+// Writes text to a file through a temporary beside it; std::runtime_error naming the file when it fails.
+void write_text(const std::filesystem::path& file, const std::string& text) {
+  const std::filesystem::path tmp = file.parent_path() / ("." + file.filename().string() + ".tmp");
+  std::ofstream out(tmp);
+  out << text;
+  out.close();
+  if (!out) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
+  }
+  std::filesystem::rename(tmp, file);
 }
 
 std::string table_row(const std::vector<std::string>& cells) {
@@ -275,14 +303,17 @@ void add_run_commands(CLI::App& app, Action& action) {
       if (opts->animate || scenario.animate) {
         animator = find_plotter(opts->animate ? "--animate" : opts->scenarios.front() + ": [output] animate = true");
       }
+      prepare_output_dir(opts->out);  // before the run, so that a bad --out does not cost the run
       const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet, record);
-      if (o.run.interrupted) return kExitInterrupted;  // no figures: the user asked it to stop
+      if (o.run.interrupted || g_stop_requested.load()) return kExitInterrupted;  // no figures: asked to stop
       const std::string written = "trajectory.csv, frames.csv and summary.json in " + opts->out;
+      const Listing before = list_files(opts->out);
       if (plotter) render_plots(*plotter, {opts->out}, opts->quiet, written);
       if (animator) {
         const std::filesystem::path file = render_animation(*animator, opts->out, opts->quiet, written);
         if (!opts->quiet) std::cout << "animation: " << file.string() << "\n";
       }
+      if (plotter || animator) record_new_files(opts->out, before);
       return o.run.failures > 0 ? kExitFailedSteps : kExitOk;
     };
   });
@@ -313,7 +344,20 @@ void add_run_commands(CLI::App& app, Action& action) {
       const std::filesystem::path out = opts->out;
       std::optional<Plotter> plotter;
       if (!opts->no_plots) plotter = find_plotter("compare (--no-plots skips the figures)");
-      std::filesystem::create_directories(out);
+      // Every scenario is loaded before the first run, so that a bad later file is reported at once. Scenarios with
+      // the same file stem (a/x.toml, b/x.toml) get distinct directories: x, x-2, ...
+      std::vector<Scenario> scenarios;
+      std::vector<std::string> dirs;
+      for (const auto& file : opts->scenarios) {
+        scenarios.push_back(load_scenario(file, opts->overrides));
+        const std::string stem = std::filesystem::path(file).stem().string();
+        std::string name = stem;
+        for (int k = 2; std::find(dirs.begin(), dirs.end(), name) != dirs.end(); ++k) {
+          name = stem + "-" + std::to_string(k);
+        }
+        dirs.push_back(name);
+      }
+      prepare_output_dir(out);
       std::string md =
           table_row({"scenario", "engine", "max position error (m)", "w(0)", "w(T)", "min w", "mean w",
                      "norm theta_dot(0)", "norm theta_dot(T)", "mean iterations", "failures", "wall time (s)"});
@@ -323,9 +367,10 @@ void add_run_commands(CLI::App& app, Action& action) {
           "final_joint_velocity_norm,mean_iterations,failures,wall_time_s\n";
       std::vector<std::string> plot_args = {"--compare"};
       int failures = 0;
-      for (const auto& file : opts->scenarios) {
-        const std::string name = std::filesystem::path(file).stem().string();
-        const Outcome o = run_one(load_scenario(file, opts->overrides), out / name, opts->quiet);
+      bool interrupted = false;
+      for (std::size_t i = 0; i < scenarios.size(); ++i) {
+        const std::filesystem::path dir = out / dirs[i];
+        const Outcome o = run_one(std::move(scenarios[i]), dir, opts->quiet);
         failures += o.run.failures;
         const RunSummary& s = o.summary;
         const std::vector<std::string> cells = {s.name,
@@ -340,14 +385,26 @@ void add_run_commands(CLI::App& app, Action& action) {
                                                 num(s.solver.mean_iterations, 4),
                                                 std::to_string(s.solver.failures),
                                                 num(s.wall_time_s, 3)};
-        md += table_row(cells);
-        for (std::size_t c = 0; c < cells.size(); ++c) csv += (c ? "," : "") + cells[c];
+        std::vector<std::string> md_cells = cells;
+        for (auto& c : md_cells) {
+          for (std::size_t at = c.find('|'); at != std::string::npos; at = c.find('|', at + 2)) c.replace(at, 1, "\\|");
+        }
+        md += table_row(md_cells);
+        for (std::size_t c = 0; c < cells.size(); ++c) csv += (c ? "," : "") + csv_field(cells[c]);
         csv += "\n";
-        plot_args.push_back((out / name).string());
+        plot_args.push_back(dir.string());
+        if (o.run.interrupted || g_stop_requested.load()) {
+          interrupted = true;  // the runs after it do not start
+          break;
+        }
       }
-      std::ofstream(out / "comparison.md") << md;
-      std::ofstream(out / "comparison.csv") << csv;
+      write_text(out / "comparison.md", md);
+      write_text(out / "comparison.csv", csv);
       if (!opts->quiet) std::cout << "\n" << md << "\nwritten: " << (out / "comparison.md").string() << "\n";
+      if (interrupted) {
+        std::cerr << "compare: interrupted; comparison.md and comparison.csv hold the runs up to there\n";
+        return kExitInterrupted;
+      }
       if (plotter) {
         plot_args.insert(plot_args.end(), {"--out", out.string()});
         render_plots(*plotter, std::move(plot_args), opts->quiet, "the runs and comparison.md in " + out.string());

@@ -15,7 +15,9 @@
 
 #include "commands.hpp"
 #include "progress.hpp"
+#include "redres/run_output.hpp"
 #include "redres/sweep.hpp"
+#include "stop_signals.hpp"
 
 namespace redres::cli {
 namespace {
@@ -61,17 +63,22 @@ int run(const SweepOptions& o) {
   SweepSpec with_runs = spec;
   with_runs.write_runs = spec.write_runs || o.runs;
   const SweepShard shard = shard_of(o);
-  std::filesystem::create_directories(o.out);
+  prepare_output_dir(o.out);
   const auto start = std::chrono::steady_clock::now();
   SweepTable table;
   {
     ProgressBar bar(spec.name, o.quiet);
-    table = run_sweep(with_runs, shard, o.jobs, o.out, [&bar](std::size_t done, std::size_t total) {
-      char where[48];
-      std::snprintf(where, sizeof where, "%zu/%zu runs", done, total);
-      bar.update(static_cast<double>(done) / static_cast<double>(total), where);
-    });
+    const StopOnSignals signals;
+    table = run_sweep(
+        with_runs, shard, o.jobs, o.out,
+        [&bar](std::size_t done, std::size_t total) {
+          char where[48];
+          std::snprintf(where, sizeof where, "%zu/%zu runs", done, total);
+          bar.update(static_cast<double>(done) / static_cast<double>(total), where);
+        },
+        &g_stop_requested);
   }
+  const bool interrupted = g_stop_requested.load();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string name = table_name(shard);
   write_sweep_csv(table, std::filesystem::path(o.out) / (name + ".csv"));
@@ -82,7 +89,14 @@ int run(const SweepOptions& o) {
               {"variations", spec.size()},
               {"shard", std::to_string(shard.shard) + "/" + std::to_string(shard.count)},
               {"rows", table.rows.size()},
-              {"failed", table.failed()}});
+              {"failed", table.failed()},
+              {"interrupted", interrupted}});
+  if (interrupted) {
+    std::cerr << spec.name << ": interrupted after " << table.rows.size() << " of " << spec.size() << " variations; "
+              << (std::filesystem::path(o.out) / (name + ".csv")).string()
+              << " holds those (a run cut short has status \"interrupted\")\n";
+    return kExitInterrupted;
+  }
   if (!o.quiet) {
     std::cout << spec.name << ": " << table.rows.size() << " of " << spec.size() << " variations in " << seconds
               << " s, " << table.failed() << " not ok -> " << (std::filesystem::path(o.out) / (name + ".csv")).string()

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
@@ -122,12 +123,86 @@ void Controller::solve(double t, StepOutput& out) {
     out.info.residual = 0.0;
     out.info.engine = engine_->name();
     out.info.diagnosis = e.what();
+    // A velocity-limit law that gave NaN or inf is named with where it was configured (the QP's own check saw only
+    // the merged bounds).
+    for (int j = 0; j < robot_->dof(); ++j) {
+      if (std::isfinite(vlo_(j)) && std::isfinite(vhi_(j))) continue;
+      const JointSpec& joint = robot_->joint(j);
+      std::ostringstream s;
+      s << "joint " << j + 1 << " ('" << joint.name << "') velocity limit " << joint.velocity_limit->describe();
+      if (!joint.velocity_limit_source.empty()) s << " (" << joint.velocity_limit_source << ")";
+      const auto show = [&s](double v) -> std::ostream& { return std::isnan(v) ? s << "nan" : s << v; };
+      s << " gave lower ";
+      show(vlo_(j)) << ", upper ";
+      show(vhi_(j)) << " at theta = " << kin_.theta(j) << ": not finite";
+      out.info.diagnosis = s.str();
+      break;
+    }
+    out.task_row_error = 0.0;
     engine_->reset();  // the next step starts cold
     return;
   }
   engine_->solve_valid(qp_, result_);  // build() checked every entry it wrote
-  out.theta_dot = result_.x;
   out.info = result_.info;
+  out.task_row_error = 0.0;
+  if (result_.info.status == SolverStatus::kSolved) {
+    out.theta_dot = result_.x;
+    return;
+  }
+  out.theta_dot.setZero();  // hold: an unconverged iterate is never integrated
+  if (relax_engine_) relax(out);
+}
+
+void Controller::set_relaxation(double weight) {
+  REDRES_REQUIRE(std::isfinite(weight) && weight >= 0.0, "Controller::set_relaxation", "weight >= 0 and finite");
+  relax_weight_ = weight;
+  if (weight == 0.0) {
+    relax_engine_.reset();
+    return;
+  }
+  if (!relax_engine_) {
+    relax_engine_ = make_engine(std::string(engine_->name()), engine_->settings());
+    relaxed_.resize(qp_.n(), 0, qp_.m_in());
+    relaxed_.source_names = qp_.source_names;
+    relaxed_.variable_names = qp_.variable_names;
+    relax_engine_->setup(relaxed_.n(), 0, relaxed_.m_in(), relaxed_result_);
+  }
+}
+
+void Controller::relax(StepOutput& out) {
+  // The elastic QP: min x'(W + rho J'J)x/2 + (zeta - rho J'd)'x subject to A x <= b and the bounds.
+  const double rho = relax_weight_;
+  relaxed_.W = qp_.W;
+  relaxed_.W.noalias() += rho * qp_.J.transpose() * qp_.J;
+  relaxed_.w_diagonal = qp_.m_eq() == 0 && qp_.w_diagonal;
+  relaxed_.zeta = qp_.zeta;
+  relaxed_.zeta.noalias() -= rho * qp_.J.transpose() * qp_.d;
+  relaxed_.A = qp_.A;
+  relaxed_.b = qp_.b;
+  relaxed_.lo = qp_.lo;
+  relaxed_.hi = qp_.hi;
+  relaxed_.lo_source = qp_.lo_source;
+  relaxed_.hi_source = qp_.hi_source;
+  relaxed_.in_source = qp_.in_source;
+  relaxed_.in_row_description = qp_.in_row_description;
+  relax_engine_->solve_valid(relaxed_, relaxed_result_);
+  const SolverInfo& r = relaxed_result_.info;
+  std::ostringstream s;
+  s.precision(6);
+  if (r.status != SolverStatus::kSolved) {
+    s << "; the elastic QP (rows relaxed with weight " << rho << ") failed too: " << to_string(r.status) << ": "
+      << r.diagnosis;
+    out.info.diagnosis += s.str();
+    return;
+  }
+  out.theta_dot = relaxed_result_.x;
+  out.task_row_error = qp_.m_eq() > 0 ? (qp_.J * out.theta_dot - qp_.d).cwiseAbs().maxCoeff() : 0.0;
+  s << "rows relaxed (weight " << rho << "), missed by " << out.task_row_error << " at most, after "
+    << to_string(out.info.status) << ": " << out.info.diagnosis;
+  out.info.status = SolverStatus::kRelaxed;
+  out.info.iterations += r.iterations;
+  out.info.residual = r.residual;
+  out.info.diagnosis = s.str();
 }
 
 }  // namespace redres

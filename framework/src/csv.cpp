@@ -88,4 +88,14 @@ CsvTable read_csv(const std::filesystem::path& path, const std::vector<std::stri
   return table;
 }
 
+std::string csv_field(const std::string& cell) {
+  if (cell.find_first_of(",\"\n\r") == std::string::npos) return cell;
+  std::string out = "\"";
+  for (const char c : cell) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
 }  // namespace redres

@@ -170,7 +170,8 @@ struct KinematicsKernels {
     REDRES_REQUIRE(data.J.cols() == n && data.J.rows() == model.task_dim() && data.theta.size() == n,
                    "compute_kinematics", "data was sized for this model (KinematicsData(model))");
     data.theta = theta;
-    REDRES_REQUIRE(finite_probe(theta.data(), n) == 0.0, "compute_kinematics", "theta is finite (it contains NaN or Inf)");
+    REDRES_REQUIRE(finite_probe(theta.data(), n) == 0.0, "compute_kinematics",
+                   "theta is finite (it contains NaN or Inf)");
   }
 
   // General path: joint frames, end-effector pose and f by 3-D frame products.

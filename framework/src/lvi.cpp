@@ -4,6 +4,9 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/QR>
+#include <Eigen/SVD>
+
 namespace redres {
 
 const char* to_string(SolverStatus status) {
@@ -14,6 +17,7 @@ const char* to_string(SolverStatus status) {
     case SolverStatus::kNumericalError: return "numerical_error";
     case SolverStatus::kNotRun: return "not_run";
     case SolverStatus::kInvalidProblem: return "invalid_problem";
+    case SolverStatus::kRelaxed: return "relaxed";
   }
   return "unknown";
 }
@@ -48,24 +52,168 @@ std::string joint_label(const QpProblem& qp, int i) {
   return s;
 }
 
-// Why the rows cannot be met: the box-constrained least-squares residual min |J x - d| (and the inequality
-// violation), found by projected gradient, and the joints held at a bound there. Runs only after a failure.
+// min 1/2 |C x - e|^2 over lo <= x <= hi (bounds may be infinite), from a feasible x: an active-set method in the
+// manner of Stark and Parker's BVLS. Each pass solves the least-squares problem over the free variables (minimum
+// norm, so that rank-deficient rows are fine), walks from x towards that solution until a bound stops it, and
+// once the free variables' solution lies inside the box frees the bound variable whose gradient most wants it
+// inside. Every pass decreases the objective; it ends at a KKT point, or at the pass cap (a feasible x either way).
+void bounded_least_squares(const Eigen::MatrixXd& C, const Eigen::VectorXd& e, const Eigen::VectorXd& lo,
+                           const Eigen::VectorXd& hi, Eigen::VectorXd& x) {
+  const int n = static_cast<int>(C.cols());
+  enum : char { kFree, kAtLower, kAtUpper };
+  std::vector<char> state(static_cast<std::size_t>(n), kFree);
+  for (int i = 0; i < n; ++i) {
+    if (x(i) <= lo(i)) state[static_cast<std::size_t>(i)] = kAtLower;
+    if (x(i) >= hi(i)) state[static_cast<std::size_t>(i)] = kAtUpper;
+  }
+  const double scale = std::max(1.0, C.cwiseAbs().maxCoeff() * (e.cwiseAbs().maxCoeff() + 1.0));
+  std::vector<int> free;
+  std::vector<int> releases(static_cast<std::size_t>(n), 0);  // a variable freed again and again is degenerate
+  for (int pass = 0; pass < 20 * n + 100; ++pass) {
+    free.clear();
+    for (int i = 0; i < n; ++i) {
+      if (state[static_cast<std::size_t>(i)] == kFree) free.push_back(i);
+    }
+    if (!free.empty()) {
+      Eigen::VectorXd r = e;
+      Eigen::MatrixXd CF(C.rows(), static_cast<Eigen::Index>(free.size()));
+      for (int i = 0; i < n; ++i) {
+        if (state[static_cast<std::size_t>(i)] != kFree) r -= C.col(i) * x(i);
+      }
+      for (std::size_t j = 0; j < free.size(); ++j) CF.col(static_cast<Eigen::Index>(j)) = C.col(free[j]);
+      const Eigen::VectorXd z = CF.completeOrthogonalDecomposition().solve(r);
+      double alpha = 1.0;
+      int blocking = -1;
+      for (std::size_t j = 0; j < free.size(); ++j) {
+        const int i = free[j];
+        const double to = z(static_cast<Eigen::Index>(j)), from = x(i);
+        double a = 1.0;
+        if (to < lo(i)) a = (lo(i) - from) / (to - from);
+        if (to > hi(i)) a = (hi(i) - from) / (to - from);
+        if (a < alpha) {
+          alpha = std::max(0.0, a);
+          blocking = i;
+        }
+      }
+      for (std::size_t j = 0; j < free.size(); ++j) {
+        const int i = free[j];
+        x(i) = std::clamp(x(i) + alpha * (z(static_cast<Eigen::Index>(j)) - x(i)), lo(i), hi(i));
+      }
+      if (blocking >= 0) {
+        const bool lower =
+            z(static_cast<Eigen::Index>(std::find(free.begin(), free.end(), blocking) - free.begin())) < lo(blocking);
+        x(blocking) = lower ? lo(blocking) : hi(blocking);
+        state[static_cast<std::size_t>(blocking)] = lower ? kAtLower : kAtUpper;
+        continue;
+      }
+    }
+    // The free variables are optimal: free the bound variable that most wants to move inside, if any does.
+    const Eigen::VectorXd g = C.transpose() * (C * x - e);
+    int release = -1;
+    double worst = 1e-13 * scale;
+    for (int i = 0; i < n; ++i) {
+      const char st = state[static_cast<std::size_t>(i)];
+      const double want = st == kAtLower ? -g(i) : st == kAtUpper ? g(i) : 0.0;
+      if (want > worst && releases[static_cast<std::size_t>(i)] < 3) {
+        worst = want;
+        release = i;
+      }
+    }
+    if (release < 0) return;
+    state[static_cast<std::size_t>(release)] = kFree;
+    ++releases[static_cast<std::size_t>(release)];
+  }
+}
+
+}  // namespace
+
+RowFit best_row_fit(const QpProblem& qp) {
+  const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
+  RowFit fit;
+  fit.x = Eigen::VectorXd::Zero(n).cwiseMax(qp.lo).cwiseMin(qp.hi);
+  const auto measure = [&qp](const Eigen::VectorXd& x, double& eq, double& in) {
+    eq = qp.m_eq() > 0 ? (qp.J * x - qp.d).cwiseAbs().maxCoeff() : 0.0;
+    in = qp.m_in() > 0 ? std::max(0.0, (qp.A * x - qp.b).maxCoeff()) : 0.0;
+  };
+  // The inequality rows that x violates are taken as rows to meet with equality, x is fitted again by bounded least
+  // squares, and the best point on the segment from the old x to the new one is kept: a semismooth Newton method
+  // on |J x - d|^2 + |(A x - b)+|^2 with a line search, exact for equality rows alone (one pass). Projected
+  // gradient steps then polish the fit with inequality rows.
+  const auto value = [&qp, mi](const Eigen::VectorXd& x) {
+    return (qp.J * x - qp.d).squaredNorm() + (mi > 0 ? (qp.A * x - qp.b).cwiseMax(0.0).squaredNorm() : 0.0);
+  };
+  double best_value = value(fit.x);
+  for (int outer = 0; outer < (mi > 0 ? 4 * mi + 20 : 1); ++outer) {
+    std::vector<int> active;
+    for (int r = 0; r < mi; ++r) {
+      if (qp.A.row(r).dot(fit.x) > qp.b(r)) active.push_back(r);
+    }
+    const int rows = me + static_cast<int>(active.size());
+    if (rows == 0) break;
+    Eigen::MatrixXd C(rows, n);
+    Eigen::VectorXd e(rows);
+    C.topRows(me) = qp.J;
+    e.head(me) = qp.d;
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      C.row(me + static_cast<Eigen::Index>(k)) = qp.A.row(active[k]);
+      e(me + static_cast<Eigen::Index>(k)) = qp.b(active[k]);
+    }
+    Eigen::VectorXd target = fit.x;
+    bounded_least_squares(C, e, qp.lo, qp.hi, target);
+    // The segment's best point among a few (the objective is convex and piecewise quadratic along it).
+    Eigen::VectorXd best = fit.x;
+    double best_here = best_value;
+    for (const double a : {1.0, 0.5, 0.25, 0.125, 0.0625}) {
+      const Eigen::VectorXd x = fit.x + a * (target - fit.x);
+      const double v = value(x);
+      if (v < best_here) {
+        best_here = v;
+        best = x;
+      }
+    }
+    const bool improved = best_here < best_value * (1.0 - 1e-12);
+    fit.x = best;
+    best_value = best_here;
+    if (!improved) break;
+  }
+  if (mi > 0) {
+    // Step 1 / L with L the largest eigenvalue of [J; A]'[J; A], which bounds the gradient's Lipschitz constant.
+    Eigen::MatrixXd stacked(me + mi, n);
+    stacked << qp.J, qp.A;
+    const double lipschitz = std::max(Eigen::JacobiSVD<Eigen::MatrixXd>(stacked).singularValues()(0), 1e-150);
+    Eigen::VectorXd x = fit.x;
+    for (int k = 0; k < 20000; ++k) {
+      const Eigen::VectorXd viol = (qp.A * x - qp.b).cwiseMax(0.0);
+      const Eigen::VectorXd grad = qp.J.transpose() * (qp.J * x - qp.d) + qp.A.transpose() * viol;
+      const Eigen::VectorXd next = (x - grad / (lipschitz * lipschitz)).cwiseMax(qp.lo).cwiseMin(qp.hi);
+      const double moved = (next - x).cwiseAbs().maxCoeff();
+      x = next;
+      if (moved <= 1e-16 * (1.0 + x.cwiseAbs().maxCoeff())) break;
+    }
+    if (value(x) < best_value) fit.x = x;
+  }
+  measure(fit.x, fit.equality_miss, fit.inequality_excess);
+  return fit;
+}
+
+namespace {
+
+// Why the rows cannot be met: the best fit of the rows inside the bounds (best_row_fit), and the joints held at a
+// bound there. Runs only after a failure. *infeasible: the rows miss by more than 10 tolerances at best.
 std::string diagnose_rows(const QpProblem& qp, double tolerance, bool* infeasible) {
   const int n = qp.n();
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(n).cwiseMax(qp.lo).cwiseMin(qp.hi);
-  const double lipschitz = qp.J.squaredNorm() + qp.A.squaredNorm() + 1e-300;
-  for (int k = 0; k < 5000; ++k) {
-    const Eigen::VectorXd viol = (qp.A * x - qp.b).cwiseMax(0.0);
-    const Eigen::VectorXd grad = qp.J.transpose() * (qp.J * x - qp.d) + qp.A.transpose() * viol;
-    x = (x - grad / lipschitz).cwiseMax(qp.lo).cwiseMin(qp.hi);
-  }
+  const RowFit fit = best_row_fit(qp);
+  const Eigen::VectorXd& x = fit.x;
   const Eigen::VectorXd eq = qp.J * x - qp.d;
   const Eigen::VectorXd in = (qp.A * x - qp.b).cwiseMax(0.0);
-  const double worst = std::max(eq.size() ? eq.cwiseAbs().maxCoeff() : 0.0, in.size() ? in.maxCoeff() : 0.0);
+  const double worst = std::max(fit.equality_miss, fit.inequality_excess);
   *infeasible = worst > 10.0 * tolerance;
   std::ostringstream s;
   s.precision(6);
-  if (!*infeasible) return "the rows can be met inside the bounds (best residual " + std::to_string(worst) + ")";
+  if (!*infeasible) {
+    s << "the rows can be met inside the bounds (best residual " << worst << ")";
+    return s.str();
+  }
   s << "the constraint rows cannot be met inside the bounds:";
   for (Eigen::Index r = 0; r < eq.size(); ++r) {
     if (std::abs(eq(r)) > 10.0 * tolerance) {
@@ -102,7 +250,64 @@ std::string diagnose_rows(const QpProblem& qp, double tolerance, bool* infeasibl
   return out;
 }
 
+// What the equality rows' singular values say, when they say something: "" for well-conditioned rows.
+std::string singular_rows(const QpProblem& qp) {
+  if (qp.m_eq() == 0) return {};
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(qp.J).singularValues();
+  const double largest = sv.size() > 0 ? sv(0) : 0.0;
+  int rank = 0;
+  for (Eigen::Index k = 0; k < sv.size(); ++k) rank += sv(k) > 1e-9 * largest && sv(k) > 0.0;
+  const double smallest = qp.m_eq() > qp.n() ? 0.0 : sv(sv.size() - 1);
+  std::ostringstream s;
+  s.precision(3);
+  if (rank < qp.m_eq()) {
+    s << "the " << qp.m_eq() << " equality rows have rank " << rank << " here (a singular configuration: smallest "
+      << "singular value " << smallest << ", largest " << largest << ")";
+  } else if (smallest < 1e-4 * largest) {
+    s << "the equality rows are nearly singular here (smallest singular value " << smallest << ", largest " << largest
+      << ")";
+  }
+  return s.str();
+}
+
 }  // namespace
+
+void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info) const {
+  // One decision gives both the status and the text: the rows are infeasible exactly when the best fit of the rows
+  // inside the bounds misses them (best_row_fit); otherwise the engine failed on a QP that has a solution, and the
+  // text says how, with the residual compared to the tolerance only in the direction it holds.
+  bool unmeetable = false;
+  const std::string rows = diagnose_rows(qp, settings_.tolerance, &unmeetable);
+  const std::string singular = singular_rows(qp);
+  std::ostringstream s;
+  s.precision(6);
+  if (unmeetable) {
+    info.status = SolverStatus::kInfeasible;
+    s << rows;
+  } else {
+    const SolverStatus reported = info.status;
+    if (capped || reported == SolverStatus::kInfeasible || reported == SolverStatus::kSolved) {
+      info.status = SolverStatus::kNumericalError;
+      s << info.engine << ": the duals of the rows reached varpi = " << settings_.varpi << " although " << rows
+        << ": this step's multipliers are larger than varpi (raise [solver] varpi, or keep the arm away "
+        << "from this configuration)";
+    } else {
+      s << info.engine;
+      if (reported == SolverStatus::kMaxIterations) {
+        s << " reached max_iterations = " << settings_.max_iterations;
+      } else {
+        s << " failed";
+      }
+      if (!info.diagnosis.empty()) s << " (" << info.diagnosis << ")";
+      s << " with residual " << info.residual
+        << (info.residual > settings_.tolerance ? " > tolerance " : " (within tolerance ") << settings_.tolerance
+        << (info.residual > settings_.tolerance ? "" : ", but the engine did not accept it)") << " after "
+        << info.iterations << (info.iterations == 1 ? " iteration; " : " iterations; ") << rows;
+    }
+  }
+  if (!singular.empty()) s << "; " << singular;
+  info.diagnosis = s.str();
+}
 
 void LviEngine::setup(int n, int m_e, int m_i, SolverResult& result) {
   REDRES_REQUIRE(n > 0 && m_e >= 0 && m_i >= 0, "LviEngine::setup", "n > 0, m_e >= 0, m_i >= 0");
@@ -170,17 +375,7 @@ void LviEngine::run(const QpProblem& qp, SolverResult& result) {
   for (int r = 0; r < m_e_; ++r) capped |= std::abs(result.y(r)) >= cap;
   for (int r = 0; r < m_i_; ++r) capped |= result.z(r) >= cap;
   if (info.status != SolverStatus::kSolved || capped) {
-    bool infeasible = false;
-    const std::string rows = diagnose_rows(qp, settings_.tolerance, &infeasible);
-    if (infeasible || capped) {
-      info.status = SolverStatus::kInfeasible;
-      info.diagnosis = rows;
-    } else if (info.diagnosis.empty()) {
-      std::ostringstream s;
-      s << info.engine << " stopped with residual " << info.residual << " > tolerance " << settings_.tolerance
-        << " after " << info.iterations << " iterations; " << rows;
-      info.diagnosis = s.str();
-    }
+    diagnose_failure(qp, capped, info);
     warm_ = false;
     result.y.setZero();
     result.z.setZero();

@@ -38,12 +38,13 @@ void Objective::write_common(toml::table& out) const {
 
 namespace {
 
-[[noreturn]] void bad_output(const char* kind, const std::string& name, const std::string& what) {
-  throw std::invalid_argument(std::string(kind) + " '" + name + "' produced an invalid QP: " + what);
+[[noreturn]] void bad_output(const char* kind, const Plugin& plugin, const std::string& what) {
+  const std::string at = plugin.source().empty() ? "" : " (" + plugin.source() + ")";
+  throw std::invalid_argument(std::string(kind) + " '" + plugin.name() + "'" + at + " produced an invalid QP: " + what);
 }
 
 template <class M>
-void check_finite(const M& m, const char* kind, const std::string& name, const char* what) {
+void check_finite(const M& m, const char* kind, const Plugin& name, const char* what) {
   for (Eigen::Index c = 0; c < m.cols(); ++c) {
     for (Eigen::Index r = 0; r < m.rows(); ++r) {
       if (!std::isfinite(m(r, c))) {
@@ -67,7 +68,7 @@ double rows_probe(const Eigen::MatrixXd& M, const Eigen::VectorXd& v, int offset
 }
 
 // The full check with the names of the culprits; runs only when the fast scan below finds a non-finite entry.
-[[gnu::cold]] [[gnu::noinline]] void name_culprit(const QpBuilder& builder, const char* kind, const std::string& name) {
+[[gnu::cold]] [[gnu::noinline]] void name_culprit(const QpBuilder& builder, const char* kind, const Plugin& name) {
   const QpProblem& qp = builder.problem();
   if (builder.wrote_zeta()) check_finite(qp.zeta, kind, name, "zeta");
   if (builder.written_w() != QpBuilder::WrittenW::kNone) check_finite(qp.W, kind, name, "W");
@@ -78,7 +79,7 @@ double rows_probe(const Eigen::MatrixXd& M, const Eigen::VectorXd& v, int offset
   check_finite(qp.b.segment(builder.in_offset(), builder.in_rows()), kind, name, "its b");
 }
 
-void check_contribution(const QpBuilder& builder, const char* kind, const std::string& name) {
+void check_contribution(const QpBuilder& builder, const char* kind, const Plugin& name) {
   const QpProblem& qp = builder.problem();
   const Eigen::Index n = qp.zeta.size();
   double acc = builder.wrote_zeta() ? finite_probe(qp.zeta.data(), n) : 0.0;
@@ -102,13 +103,13 @@ void check_contribution(const QpBuilder& builder, const char* kind, const std::s
 void Objective::contribute(const Context& ctx, QpBuilder& builder) const {
   if (!active()) return;
   add_to(ctx, builder);
-  check_contribution(builder, "objective", name());
+  check_contribution(builder, "objective", *this);
 }
 
 void Constraint::contribute(const Context& ctx, QpBuilder& builder) const {
   if (!active()) return;
   add_to(ctx, builder);
-  check_contribution(builder, "constraint", name());
+  check_contribution(builder, "constraint", *this);
 }
 
 ObjectiveRegistry& objective_registry() {

@@ -282,6 +282,7 @@ void read_velocity_law(const TableReader& r, JointSpec& jt) {
   const TableReader law_table = r.table("velocity_limit");
   const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' velocity_limit");
   jt.velocity_limit = make_velocity_limit(law_reader);
+  jt.velocity_limit_source = r.location("velocity_limit").str();
   law_reader.finish();
   if (auto bad = check_velocity_law(*jt.velocity_limit, jt.lower, jt.upper)) {
     law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() + "' is invalid at theta = " + num(bad->theta) +

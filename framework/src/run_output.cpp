@@ -1,7 +1,10 @@
 #include "redres/run_output.hpp"
 
+#include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -111,8 +114,75 @@ Trajectory joint_frames(const RobotModel& robot, const Trajectory& run, std::siz
   return out;
 }
 
-void write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
-               const std::filesystem::path& dir, const RecordOptions& record) {
+namespace {
+
+bool manifest_name_ok(const std::string& name) {
+  return !name.empty() && name.find('/') == std::string::npos && name[0] != '.';
+}
+
+void write_manifest(const std::filesystem::path& dir, const std::vector<std::string>& names) {
+  const std::filesystem::path file = dir / kOutputManifest, tmp = staging_path(file);
+  {
+    std::ofstream out(tmp);
+    out << "# the files the last redres run wrote into this directory; the next run removes those it does not "
+           "write again\n";
+    for (const auto& n : names) out << n << "\n";
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(tmp, ignored);
+      throw std::runtime_error("cannot write " + file.string());
+    }
+  }
+  std::filesystem::rename(tmp, file);
+}
+
+}  // namespace
+
+std::vector<std::string> read_output_manifest(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  std::ifstream in(dir / kOutputManifest);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (manifest_name_ok(line)) names.push_back(line);
+  }
+  return names;
+}
+
+void add_to_output_manifest(const std::filesystem::path& dir, const std::vector<std::string>& names) {
+  std::vector<std::string> all = read_output_manifest(dir);
+  for (const auto& n : names) {
+    if (manifest_name_ok(n) && std::find(all.begin(), all.end(), n) == all.end()) all.push_back(n);
+  }
+  write_manifest(dir, all);
+}
+
+void prepare_output_dir(const std::filesystem::path& dir, const std::string& what) {
+  const std::string where = what + " " + dir.string() + ": ";
+  std::error_code ec;
+  const auto status = std::filesystem::status(dir, ec);
+  if (std::filesystem::exists(status) && !std::filesystem::is_directory(status)) {
+    throw std::runtime_error(where + "exists and is not a directory");
+  }
+  if (!std::filesystem::exists(status)) {
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw std::runtime_error(where + "cannot create the directory: " + ec.message());
+  }
+  const std::filesystem::path probe = staging_path(dir / "probe");
+  {
+    std::ofstream out(probe);
+    out << "probe\n";
+    out.close();
+    if (!out) {
+      std::filesystem::remove(probe, ec);
+      throw std::runtime_error(where + "cannot write into the directory (" + std::strerror(errno) + ")");
+    }
+  }
+  std::filesystem::remove(probe, ec);
+}
+
+std::vector<std::string> write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
+                                   const std::filesystem::path& dir, const RecordOptions& record) {
   REDRES_REQUIRE(record.every >= 1, "write_run", "record.every >= 1");
   std::filesystem::create_directories(dir);
   // Every file is written to a temporary beside it first, so that a failed write (a full disk, a read-only
@@ -139,11 +209,21 @@ void write_run(const RobotModel& robot, const RunResult& run, const RunSummary& 
     for (const auto& [tmp, file] : staged) std::filesystem::remove(tmp, ignored);
     throw;
   }
+  std::vector<std::string> written;
+  for (const auto& [tmp, file] : staged) written.push_back(file.filename().string());
+  // What an earlier run wrote and this one does not is stale: removed, before this run's files appear. A
+  // directory from before manifests existed may hold tables that would not belong to a summary-only run.
+  std::vector<std::string> stale = read_output_manifest(dir);
+  if (record.none) stale.insert(stale.end(), {"trajectory.csv", "frames.csv"});
   std::filesystem::remove(summary_file);
-  if (record.none) {
-    for (const char* stale : {"trajectory.csv", "frames.csv"}) std::filesystem::remove(dir / stale);
+  for (const auto& name : stale) {
+    if (std::find(written.begin(), written.end(), name) != written.end()) continue;
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(dir / name, ec)) std::filesystem::remove(dir / name, ec);
   }
   for (const auto& [tmp, file] : staged) std::filesystem::rename(tmp, file);  // summary.json last
+  write_manifest(dir, written);
+  return written;
 }
 
 }  // namespace redres

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -16,6 +18,23 @@ const Metric* RunSummary::metric(const std::string& plugin, const std::string& m
   }
   return nullptr;
 }
+
+namespace {
+
+// Every number in `j` is finite; otherwise a std::runtime_error names its path (e.g. "solver.max_residual").
+void require_finite_numbers(const nlohmann::json& j, const std::string& path) {
+  if (j.is_number_float() && !std::isfinite(j.get<double>())) {
+    throw std::runtime_error("summary.json: '" + path + "' is " + std::to_string(j.get<double>()) +
+                             ", not a finite number (JSON has no inf or nan); this is a bug in the figure's source");
+  }
+  if (j.is_object()) {
+    for (const auto& [key, value] : j.items()) require_finite_numbers(value, path.empty() ? key : path + "." + key);
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i) require_finite_numbers(j[i], path + "[" + std::to_string(i) + "]");
+  }
+}
+
+}  // namespace
 
 RunSummary summarise(const Scenario& s, const RunResult& run) {
   const RobotModel& robot = *s.robot;
@@ -87,6 +106,13 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   for (int j = 0; j < n; ++j) out.final_theta.push_back(tr(rows - 1, c_th[static_cast<std::size_t>(j)]));
   out.solver = {run.engine(), it_sum / static_cast<double>(rows), it_max, max_res, run.failures, run.first_failure,
                 run.stopped};
+  out.solver.on_infeasible = s.on_infeasible == OnInfeasible::kStop    ? "stop"
+                             : s.on_infeasible == OnInfeasible::kRelax ? "relax"
+                                                                       : "hold";
+  out.solver.held_steps = run.held_steps;
+  out.solver.relaxed_steps = run.relaxed_steps;
+  out.solver.max_relaxed_task_error = run.max_relaxed_task_error;
+  out.solver.first_relaxed = run.first_relaxed;
   out.wall_time_s = run.wall_time_s;
   out.robot.name = robot.name();
   out.robot.kind = to_string(robot.kind());
@@ -193,7 +219,12 @@ std::string to_json(const RunSummary& s) {
         {"max_residual", s.solver.max_residual},
         {"failures", s.solver.failures},
         {"first_failure", s.solver.first_failure},
-        {"stopped", s.solver.stopped}}},
+        {"stopped", s.solver.stopped},
+        {"on_infeasible", s.solver.on_infeasible},
+        {"held_steps", s.solver.held_steps},
+        {"relaxed_steps", s.solver.relaxed_steps},
+        {"max_relaxed_task_error", s.solver.max_relaxed_task_error},
+        {"first_relaxed", s.solver.first_relaxed}}},
       {"wall_time_s", s.wall_time_s},
       {"robot",
        {{"name", s.robot.name},
@@ -208,6 +239,7 @@ std::string to_json(const RunSummary& s) {
       {"metrics", metrics},
       {"obstacles", obstacles},
   };
+  require_finite_numbers(j, "");
   return j.dump(2);
 }
 

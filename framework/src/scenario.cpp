@@ -105,7 +105,7 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   const TableReader path_table = r.table("path");
   s.path = make_path(TableReader(path_table.file_ptr(), path_table.raw(), "path"), pc);
 
-  s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot));
+  s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot, s.duration, s.tau));
   const std::size_t width = trajectory_width(s);
   if (const double bytes = (s.steps() + 1.0) * static_cast<double>(width) * 8.0; bytes > kMaxTableBytes) {
     std::ostringstream m;
@@ -117,9 +117,22 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   if (r.has("solver")) {
     const TableReader t = r.table("solver");
     const TableReader solver(t.file_ptr(), t.raw(), "solver");
-    s.on_infeasible = solver.choice("on_infeasible", {"continue", "stop"}, "continue") == "continue"
-                          ? OnInfeasible::kContinue
-                          : OnInfeasible::kStop;
+    const std::string policy = solver.choice("on_infeasible", {"hold", "stop", "relax", "continue"}, "hold");
+    s.on_infeasible = policy == "stop"    ? OnInfeasible::kStop
+                      : policy == "relax" ? OnInfeasible::kRelax
+                                          : OnInfeasible::kHold;
+    if (solver.has("relax_weight")) {
+      s.relax_weight = solver.number("relax_weight");
+      if (!(s.relax_weight >= 1.0 && s.relax_weight <= 1e8)) {
+        std::ostringstream m;
+        m << "expected a weight in [1, 1e8], got " << s.relax_weight;
+        solver.fail("relax_weight", m.str());
+      }
+      if (s.on_infeasible != OnInfeasible::kRelax) {
+        solver.fail("relax_weight",
+                    "is used only with on_infeasible = \"relax\" (on_infeasible is \"" + policy + "\")");
+      }
+    }
     s.engine = make_engine(solver);
   } else {
     s.engine = make_engine("projection");

@@ -32,25 +32,33 @@ Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> 
   }
 }
 
-Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot) {
+Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, double duration, double step) {
   std::vector<std::unique_ptr<Objective>> objectives;
   std::vector<std::unique_ptr<Constraint>> constraints;
   std::set<std::string> names;
-  const auto unique = [&](const TableReader& t, const std::string& name) {
-    if (!names.insert(name).second) {
-      t.fail("name", "duplicate plugin name '" + name + "'; give one of them a different `name`");
+  const auto unique = [&](const TableReader& t, Plugin& p) {
+    if (!names.insert(p.name()).second) {
+      t.fail("name", "duplicate plugin name '" + p.name() + "'; give one of them a different `name`");
+    }
+    p.set_source(t.location().str());
+    if (duration > 0.0 && step > 0.0) {
+      try {
+        p.check_run(duration, step);
+      } catch (const FieldError& e) {
+        rethrow_at(t, e);
+      }
     }
   };
   if (root.has("objectives")) {
     for (const TableReader& t : root.tables("objectives")) {
       objectives.push_back(make_objective(t, robot));
-      unique(t, objectives.back()->name());
+      unique(t, *objectives.back());
     }
   }
   if (root.has("constraints")) {
     for (const TableReader& t : root.tables("constraints")) {
       constraints.push_back(make_constraint(t, robot));
-      unique(t, constraints.back()->name());
+      unique(t, *constraints.back());
     }
   }
   if (objectives.empty()) root.fail("expected at least one [[objectives]] entry (e.g. type = \"min_velocity_norm\")");

@@ -110,6 +110,7 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
   Controller ctrl(robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
   ctrl.set_orientation_turn(s.orientation_turn);
   ctrl.set_kinematics_level(KinematicsLevel::kGradient);
+  if (s.on_infeasible == OnInfeasible::kRelax) ctrl.set_relaxation(s.relax_weight);
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
   Eigen::VectorXd theta = s.theta0, theta_pred(n);
   const bool orientation_rows = robot.has_orientation_rows();
@@ -134,7 +135,16 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
       run.engines.push_back(o.info.engine);
     }
     last_engine = o.info.engine;
-    if (o.info.status != SolverStatus::kSolved && run.failures++ == 0) {
+    if (o.info.status == SolverStatus::kRelaxed) {
+      ++run.relaxed_steps;
+      run.max_relaxed_task_error = std::max(run.max_relaxed_task_error, o.task_row_error);
+      if (run.first_relaxed.empty()) {
+        std::ostringstream msg;
+        msg << "t = " << t << " s: " << o.info.diagnosis;
+        run.first_relaxed = msg.str();
+      }
+    }
+    if (!usable(o.info.status) && run.failures++ == 0) {
       std::ostringstream msg;
       msg << "t = " << t << " s: " << to_string(o.info.status) << ": " << o.info.diagnosis;
       run.first_failure = msg.str();
@@ -226,6 +236,10 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
       run.stopped = true;  // the row of the failed step is the last
       break;
     }
+    if (!usable(out.info.status)) {
+      ++run.held_steps;  // theta_dot = 0 (the controller never hands out an unconverged iterate): theta stays
+      continue;
+    }
     if (s.integrator == Integrator::kEuler) {
       theta += s.tau * out.theta_dot;
     } else {
@@ -239,7 +253,11 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
         run.stopped = true;
         break;
       }
-      theta += 0.5 * s.tau * (out.theta_dot + out2.theta_dot);
+      if (usable(out2.info.status)) {
+        theta += 0.5 * s.tau * (out.theta_dot + out2.theta_dot);
+      } else {
+        theta += s.tau * out.theta_dot;  // the second stage failed: Euler's step with the first, which solved
+      }
     }
   }
   run.trajectory.publish();

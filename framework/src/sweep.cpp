@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "redres/csv.hpp"
 #include "redres/error.hpp"
 #include "redres/formula.hpp"
 #include "redres/input_file.hpp"
@@ -144,7 +145,7 @@ void flatten(const nlohmann::json& j, const std::string& key, Cells& out) {
 }
 
 Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesystem::path& out_dir,
-                    std::mutex& load_lock) {
+                    std::mutex& load_lock, const std::atomic<bool>* stop) {
   Cells cells;
   cells.emplace_back("index", std::to_string(v.index));
   for (std::size_t a = 0; a < spec.axes.size(); ++a) cells.emplace_back(spec.axes[a].key, cell_text(v.values[a]));
@@ -162,10 +163,11 @@ Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesy
       const std::lock_guard<std::mutex> guard(load_lock);
       s.emplace(load_scenario(spec.scenario, v.overrides));
     }
-    const RunResult run = simulate(*s);
+    RunResult run;
+    simulate(*s, run, {}, stop);
     const RunSummary summary = summarise(*s, run);
     if (spec.write_runs) write_run(*s->robot, run, summary, out_dir / "runs" / std::to_string(v.index), spec.record);
-    status = run.failures == 0 ? "ok" : "failed_steps";
+    status = run.interrupted ? "interrupted" : run.failures == 0 ? "ok" : "failed_steps";
     diagnosis = run.first_failure;
     nlohmann::json j = nlohmann::json::parse(to_json(summary));
     // (The run's own "status" is the sweep's status column and solver.stopped.)
@@ -194,16 +196,6 @@ SweepTable to_table(const std::vector<Cells>& rows) {
     t.rows.push_back(std::move(cells));
   }
   return t;
-}
-
-std::string quoted(const std::string& cell) {
-  if (cell.find_first_of(",\"\n\r") == std::string::npos) return cell;
-  std::string out = "\"";
-  for (char c : cell) {
-    if (c == '"') out += '"';
-    out += c;
-  }
-  return out + "\"";
 }
 
 }  // namespace
@@ -305,7 +297,8 @@ std::size_t SweepTable::failed() const {
 }
 
 SweepTable run_sweep(const SweepSpec& spec, const SweepShard& shard, unsigned jobs,
-                     const std::filesystem::path& out_dir, const SweepProgress& progress) {
+                     const std::filesystem::path& out_dir, const SweepProgress& progress,
+                     const std::atomic<bool>* stop) {
   REDRES_REQUIRE(shard.count >= 1 && shard.shard < shard.count, "run_sweep", "0 <= shard < count");
   std::vector<std::size_t> mine;
   for (std::size_t i = shard.shard; i < spec.size(); i += shard.count) mine.push_back(i);
@@ -315,7 +308,8 @@ SweepTable run_sweep(const SweepSpec& spec, const SweepShard& shard, unsigned jo
   std::mutex load_lock, progress_lock;
   const auto work = [&] {
     for (std::size_t k = next++; k < mine.size(); k = next++) {
-      rows[k] = run_variation(spec, variation(spec, mine[k]), out_dir, load_lock);
+      if (stop != nullptr && stop->load(std::memory_order_relaxed)) return;  // the rows not started stay empty
+      rows[k] = run_variation(spec, variation(spec, mine[k]), out_dir, load_lock, stop);
       const std::lock_guard<std::mutex> guard(progress_lock);
       ++done;
       if (progress) progress(done, mine.size());
@@ -327,15 +321,16 @@ SweepTable run_sweep(const SweepSpec& spec, const SweepShard& shard, unsigned jo
   for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
   work();
   for (auto& t : pool) t.join();
+  rows.erase(std::remove_if(rows.begin(), rows.end(), [](const Cells& c) { return c.empty(); }), rows.end());
   return to_table(rows);
 }
 
 void write_sweep_csv(const SweepTable& table, const std::filesystem::path& file) {
   std::ofstream out(file);
-  for (std::size_t c = 0; c < table.columns.size(); ++c) out << (c ? "," : "") << quoted(table.columns[c]);
+  for (std::size_t c = 0; c < table.columns.size(); ++c) out << (c ? "," : "") << csv_field(table.columns[c]);
   out << "\n";
   for (const auto& row : table.rows) {
-    for (std::size_t c = 0; c < row.size(); ++c) out << (c ? "," : "") << quoted(row[c]);
+    for (std::size_t c = 0; c < row.size(); ++c) out << (c ? "," : "") << csv_field(row[c]);
     out << "\n";
   }
   out.close();

@@ -41,9 +41,9 @@ void check_shape(std::string_view text, const std::filesystem::path& path) {
   State state = State::kNormal;
   std::uint32_t line = 1;
   std::size_t line_start = 0;
-  int dots = 0;          // dots in the current run of joined tokens
-  bool token = false;    // the last significant character ended a key-like token
-  bool joined = false;   // a dot follows that token
+  int dots = 0;         // dots in the current run of joined tokens
+  bool token = false;   // the last significant character ended a key-like token
+  bool joined = false;  // a dot follows that token
   int depth = 0;
   const auto fail = [&](std::size_t at, const std::string& message) {
     throw ConfigError({path.string(), line, static_cast<std::uint32_t>(at - line_start + 1)}, message);
@@ -99,7 +99,8 @@ void check_shape(std::string_view text, const std::filesystem::path& path) {
         continue;
       case State::kNormal: break;
     }
-    const bool bare = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    const bool bare =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
     if (bare) {
       if (!token || joined) begin_token();
       token = true;
@@ -123,7 +124,8 @@ void check_shape(std::string_view text, const std::filesystem::path& path) {
     if (c == '"' || c == '\'') {
       begin_token();
       const bool triple = starts(i, c == '"' ? "\"\"\"" : "'''");
-      state = c == '"' ? (triple ? State::kMultiBasic : State::kBasic) : (triple ? State::kMultiLiteral : State::kLiteral);
+      state =
+          c == '"' ? (triple ? State::kMultiBasic : State::kBasic) : (triple ? State::kMultiLiteral : State::kLiteral);
       if (triple) i += 2;
       continue;
     }

@@ -119,7 +119,10 @@ class NloptSlsqp final : public LviEngine {
       // tolerance like any other.
       info.status = SolverStatus::kSolved;
     } else if (code > 0 || code == NLOPT_ROUNDOFF_LIMITED) {
-      info.status = SolverStatus::kMaxIterations;  // stopped short of the tolerance; diagnosed by the caller
+      // SLSQP met one of its own stopping tests (or rounding stopped it) short of the tolerance: not the iteration
+      // cap, which is NLOPT_MAXEVAL_REACHED above.
+      info.status = SolverStatus::kNumericalError;
+      info.diagnosis = std::string("SLSQP ended with ") + nlopt_result_to_string(code) + " short of the tolerance";
     } else {
       info.status = SolverStatus::kNumericalError;
       info.diagnosis = "nlopt SLSQP failed with code " + std::to_string(static_cast<int>(code)) + " (" +

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 
 namespace redres {
 
@@ -38,6 +39,21 @@ const Schema<ManipulabilityConfig>& ManipulabilityConfig::schema() {
 
 Manipulability::Manipulability(const Config& config, const RobotModel& /*robot*/) : Configured(kType, config) {
   if (config_.formula) formula_ = std::make_unique<Formula>(*config_.formula, std::vector<std::string>{"t", "T"});
+}
+
+void Manipulability::check_run(double T, double tau) const {
+  if (config_.schedule != Schedule::kExpression) return;
+  const auto steps = static_cast<long>(std::llround(T / tau));
+  for (long k = 0; k <= steps; ++k) {
+    const double t = k == steps ? T : static_cast<double>(k) * tau;
+    const double p = formula_->evaluate({t, T});
+    if (!std::isfinite(p)) {
+      std::ostringstream m;
+      m << "expected p(t) finite at every step time of the run, got " << p << " at t = " << t << " s (step " << k
+        << " of " << steps << ", T = " << T << " s)";
+      throw FieldError("formula", m.str());
+    }
+  }
 }
 
 double Manipulability::coefficient(double t, double T) const {

@@ -87,8 +87,8 @@ TEST(CliScenario, RecordKeepsEveryNthRowOrNoneWhileTheSummaryUsesEveryStep) {
   EXPECT_FALSE(std::filesystem::exists(dir / "frames.csv"));
   EXPECT_EQ(summary_of(), all);
   for (const char* bad : {"every=0", "every=x", "some", "every=3x"}) {
-    const Cli r = redres("run configs/paper_r_mvn.toml --quiet --record " + std::string(bad) + " --out '" +
-                         dir.string() + "'");
+    const Cli r =
+        redres("run configs/paper_r_mvn.toml --quiet --record " + std::string(bad) + " --out '" + dir.string() + "'");
     EXPECT_EQ(r.code, 2) << bad;
     EXPECT_NE(r.out.find("expected \"all\", \"none\" or \"every=N\""), std::string::npos) << r.out;
   }

@@ -168,7 +168,8 @@ std::string file_text(const std::filesystem::path& p) {
 std::vector<std::string> hidden(const std::filesystem::path& dir) {
   std::vector<std::string> out;
   for (const auto& e : std::filesystem::directory_iterator(dir)) {
-    if (e.path().filename().string()[0] == '.') out.push_back(e.path().filename().string());
+    const std::string name = e.path().filename().string();
+    if (name[0] == '.' && name != kOutputManifest) out.push_back(name);  // a temporary left behind
   }
   return out;
 }

@@ -354,9 +354,15 @@ bool within(const T& v, double bound) {
     return within(v.values, bound);
   } else if constexpr (std::is_convertible_v<const T&, std::string_view> || std::is_same_v<T, std::filesystem::path>) {
     return true;
-  } else if constexpr (requires { v.has_value(); *v; }) {
+  } else if constexpr (requires {
+                         v.has_value();
+                         *v;
+                       }) {
     return !v.has_value() || within(*v, bound);
-  } else if constexpr (requires { v.begin(); v.end(); }) {
+  } else if constexpr (requires {
+                         v.begin();
+                         v.end();
+                       }) {
     for (const auto& x : v) {
       if (!within(x, bound)) return false;
     }

@@ -6,6 +6,7 @@
 /// iteration cap).
 
 #include <algorithm>
+#include <memory>
 
 #include <Eigen/Core>
 
@@ -19,8 +20,11 @@ namespace redres {
 /// (e.g. the two stages of Heun's method) never alias. Make one with Controller::make_output() (sized once);
 /// step() then reuses its buffers without allocating (the diagnosis text of a failed step excepted).
 struct StepOutput {
-  Eigen::VectorXd theta_dot;  //!< x = theta_dot (n), inside the merged bounds
-  SolverInfo info;            //!< status, iterations, residual, engine, diagnosis
+  Eigen::VectorXd theta_dot;    //!< x = theta_dot (n), inside the merged bounds; zero when the step failed (the
+                                //!< unconverged iterate is never handed out: Controller::result() keeps it)
+  SolverInfo info;              //!< status, iterations, residual, engine, diagnosis
+  double task_row_error = 0.0;  //!< for a `relaxed` step, max_r |J_r theta_dot - d_r|: how far the equality rows
+                                //!< are missed (0 for every other status)
 };
 
 /// Runs the scheme for one robot. The robot, scheme, engine and path must outlive the controller.
@@ -58,6 +62,13 @@ class Controller {
   [[nodiscard]] const Eigen::Vector3d& orientation_reference() const noexcept { return orientation_; }
   /// Computes at least this much kinematics each step (e.g. kManipulability to record w with any scheme).
   void set_kinematics_level(KinematicsLevel level) { level_ = std::max(level_, level); }
+  /// What a step does when its QP cannot be solved (status not `solved`). By default it holds: theta_dot = 0.
+  /// With a weight > 0 it first solves the elastic QP instead: the same objective plus (weight / 2) |J x - d|^2,
+  /// without the equality rows, and with every bound and inequality row kept, so that the arm yields inside every
+  /// limit. When that solves, the step's status is `relaxed`, theta_dot is its answer and task_row_error says by
+  /// how much the rows are missed; when it does not, the step holds with the first failure's status. weight = 0
+  /// turns relaxation off. Allocates (a second engine of the same type and its QP): call it before the loop.
+  void set_relaxation(double weight);
   /// Forgets the engine's warm start and a captured (not an explicitly set) orientation reference.
   void reset();
 
@@ -74,6 +85,7 @@ class Controller {
 
  private:
   void solve(double t, StepOutput& out);
+  void relax(StepOutput& out);
 
   const RobotModel* robot_;
   const Scheme* scheme_;
@@ -90,6 +102,10 @@ class Controller {
   bool orientation_captured_ = false;               // from the first path-driven step
   KinematicsLevel level_ = KinematicsLevel::kPosition;
   Context ctx_;
+  double relax_weight_ = 0.0;                // set_relaxation(); 0: hold
+  std::unique_ptr<LviEngine> relax_engine_;  // an engine like *engine_ for the elastic QP
+  QpProblem relaxed_;                        // the elastic QP (no equality rows)
+  SolverResult relaxed_result_;
 };
 
 }  // namespace redres

@@ -23,4 +23,8 @@ struct CsvTable {
 /// skipped.
 [[nodiscard]] CsvTable read_csv(const std::filesystem::path& path, const std::vector<std::string>& required = {});
 
+/// One field of a CSV line as RFC 4180 writes it: as is, or in double quotes (with each quote doubled) when it holds
+/// a comma, a quote or a line break.
+[[nodiscard]] std::string csv_field(const std::string& cell);
+
 }  // namespace redres

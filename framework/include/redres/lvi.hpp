@@ -47,9 +47,17 @@ enum class SolverStatus {
   kNotRun,          //!< no solve has run yet (recorded codes 0-3 keep their meaning)
   kInvalidProblem,  //!< the step's QP could not be built: a plugin or a velocity-limit law gave a non-finite value
                     //!< there (Controller; the diagnosis names which); nothing was solved
+  kRelaxed,         //!< the QP failed, and the elastic QP with the equality rows relaxed into a weighted penalty
+                    //!< was solved instead (Controller::set_relaxation); the diagnosis says why and by how much
+                    //!< the rows are missed
 };
 
-/// "solved", "max_iterations", "infeasible", "numerical_error", "not_run", "invalid_problem".
+/// Whether a step with this status has a usable theta_dot: solved, or solved with the rows relaxed.
+[[nodiscard]] constexpr bool usable(SolverStatus status) noexcept {
+  return status == SolverStatus::kSolved || status == SolverStatus::kRelaxed;
+}
+
+/// "solved", "max_iterations", "infeasible", "numerical_error", "not_run", "invalid_problem", "relaxed".
 [[nodiscard]] const char* to_string(SolverStatus status);
 
 /// What a solve reports besides its answer.
@@ -111,11 +119,25 @@ class LviEngine {
   virtual void do_solve(const QpProblem& qp, SolverResult& result) = 0;
   void check_sizes(const QpProblem& qp, const SolverResult& result) const;
   void run(const QpProblem& qp, SolverResult& result);  // solve() after its checks
+  // The status and the diagnosis of a failed solve, from one decision (best_row_fit); runs only after a failure.
+  void diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info) const;
 
   SolverSettings settings_;
   bool warm_ = false;
   int n_ = 0, m_e_ = 0, m_i_ = 0;
 };
+
+/// The best the constraint rows can be met inside the bounds: an x in [lo, hi] that minimises
+/// |J x - d|^2 + |(A x - b)+|^2, found by an active-set bounded least-squares method (exact, up to rounding, for
+/// equality rows alone; for inequality rows an active-set iteration polished by projected gradient steps). The
+/// engines' `infeasible` is this test's verdict: the rows miss by more than 10 tolerances at x.
+struct RowFit {
+  Eigen::VectorXd x;               //!< the fit (n), inside the bounds
+  double equality_miss = 0.0;      //!< max_r |J_r x - d_r|
+  double inequality_excess = 0.0;  //!< max(0, max_r A_r x - b_r)
+};
+/// See RowFit. Allocates; meant for diagnoses and tests, not the per-step path.
+[[nodiscard]] RowFit best_row_fit(const QpProblem& qp);
 
 /// ||e(u)||_2 of the LVI (eq. 14) at u = [x; y; z].
 [[nodiscard]] double lvi_residual(const QpProblem& qp, const SolverResult& u, double varpi);

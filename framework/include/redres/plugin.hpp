@@ -55,6 +55,16 @@ class Plugin {
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
   /// Renames the instance (non-empty).
   void set_name(std::string name);
+  /// Where the plugin was configured ("file:line:col" of its table), for diagnoses; empty for a plugin built in
+  /// code. Scheme::from_toml sets it.
+  [[nodiscard]] const std::string& source() const noexcept { return source_; }
+  void set_source(std::string source) { source_ = std::move(source); }
+  /// Checks what can be checked once the run's duration T and step tau are known, e.g. a formula of t at every
+  /// step time; throws FieldError naming the key. Called at load (Scheme::from_toml with run times). Default: none.
+  virtual void check_run(double T, double tau) const {
+    (void)T;
+    (void)tau;
+  }
   /// Inactive plugins are built but contribute nothing.
   [[nodiscard]] bool active() const noexcept { return active_; }
   void set_active(bool active) noexcept { active_ = active; }
@@ -92,6 +102,7 @@ class Plugin {
 
   std::string type_;
   std::string name_;
+  std::string source_;
   bool active_ = true;
 };
 

@@ -67,6 +67,7 @@ struct JointSpec {
   double lower = 0.0;                                        //!< position limit theta^- (rad or m)
   double upper = 0.0;                                        //!< position limit theta^+ (rad or m)
   std::shared_ptr<const VelocityLimitLaw> velocity_limit;    //!< theta_dot^-(theta), theta_dot^+(theta)
+  std::string velocity_limit_source;  //!< "file:line:col" of the law's table, for diagnoses (empty: built in code)
   /// Collision shapes of the link that joint j moves, in the link frame (the joint's frame after its motion, before
   /// the fixed transform to the next joint). A capsule with neither `length` nor `from`/`to` runs along the link:
   /// from the joint's origin to the next joint's origin (the end effector's, for the last joint).

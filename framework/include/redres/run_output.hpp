@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "redres/record.hpp"
 #include "redres/run_summary.hpp"
@@ -30,7 +31,26 @@ inline constexpr std::size_t kFramesMaxRows = 500;
 /// to this summary). Each file is written to a hidden temporary beside it and renamed into place, summary.json
 /// last: a failed write leaves DIR as it was, and a reader never sees a half-written file or new tables beside an
 /// old summary.
-void write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
-               const std::filesystem::path& dir, const RecordOptions& record = {});
+///
+/// DIR/.redres-outputs (kOutputManifest) lists the files the last run wrote into DIR, one name per line. write_run
+/// removes every file an earlier run listed there and this run does not write (the figures of an earlier `--plots`,
+/// the tables of a run with `record = "all"` before one with `none`), and never touches a file the manifest does not
+/// name: a user's own files in DIR stay. Returns the names it wrote (the manifest's new content), to which a caller
+/// that adds files of its own (figures) appends with add_to_output_manifest().
+std::vector<std::string> write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
+                                   const std::filesystem::path& dir, const RecordOptions& record = {});
+
+/// The name of the manifest in a run's directory.
+inline constexpr const char* kOutputManifest = ".redres-outputs";
+/// The names in DIR's manifest; empty when there is none. Names with a '/' or starting with '.' are skipped (a
+/// manifest never names anything outside DIR or hidden).
+[[nodiscard]] std::vector<std::string> read_output_manifest(const std::filesystem::path& dir);
+/// Adds names to DIR's manifest (written to a temporary and renamed); std::runtime_error on failure.
+void add_to_output_manifest(const std::filesystem::path& dir, const std::vector<std::string>& names);
+
+/// Checks, before a run starts, that `dir` can take its outputs: creates it when missing (with its parents) and
+/// writes and removes a probe file. std::runtime_error "<what> DIR: ..." when DIR is a file, cannot be created, or
+/// cannot be written, so that a long run is not lost to a bad --out at its end.
+void prepare_output_dir(const std::filesystem::path& dir, const std::string& what = "--out");
 
 }  // namespace redres

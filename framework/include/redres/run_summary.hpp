@@ -23,10 +23,15 @@ struct SolverStats {
   std::string engine;            //!< e.g. "projection" or "newton+projection"
   double mean_iterations = 0.0;  //!< per recorded step
   double max_iterations = 0.0;
-  double max_residual = 0.0;  //!< largest ||e(u)||_2
-  int failures = 0;           //!< solves that were not `solved`
-  std::string first_failure;  //!< "t = ...: <status>: <diagnosis>", or empty
-  bool stopped = false;       //!< the run ended at its first failed step ([solver] on_infeasible = "stop")
+  double max_residual = 0.0;            //!< largest ||e(u)||_2
+  int failures = 0;                     //!< solves that were not `solved`
+  std::string first_failure;            //!< "t = ...: <status>: <diagnosis>", or empty
+  bool stopped = false;                 //!< the run ended at its first failed step ([solver] on_infeasible = "stop")
+  std::string on_infeasible;            //!< the policy: "hold", "stop" or "relax"
+  int held_steps = 0;                   //!< failed steps held with theta_dot = 0
+  int relaxed_steps = 0;                //!< steps solved with the rows relaxed ("relax")
+  double max_relaxed_task_error = 0.0;  //!< the largest max_r |J_r theta_dot - d_r| of a relaxed step
+  std::string first_relaxed;            //!< "t = ...: <diagnosis>" of the first relaxed step, or empty
 };
 
 /// A collision shape of a link, in that link's frame (the frames of frames.csv).
@@ -91,7 +96,8 @@ struct RunSummary {
 /// Summarises a run of `scenario`.
 [[nodiscard]] RunSummary summarise(const Scenario& scenario, const RunResult& run);
 
-/// The summary as JSON text (summary.json).
+/// The summary as JSON text (summary.json). Throws std::runtime_error naming the field when a number in it is not
+/// finite (JSON has no inf or nan, and a null in its place would pass silently).
 [[nodiscard]] std::string to_json(const RunSummary& summary);
 
 }  // namespace redres

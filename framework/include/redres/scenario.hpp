@@ -31,8 +31,13 @@ namespace redres {
 
 /// Integration of theta_dot.
 enum class Integrator { kEuler, kHeun };
-/// What a run does after a failed step ([solver] on_infeasible): go on to T (counting failures), or stop there.
-enum class OnInfeasible { kContinue, kStop };
+/// What a run does at a step whose QP cannot be solved ([solver] on_infeasible; docs/scenario_format.md):
+/// - kHold ("hold", the default; "continue" is its older name): theta_dot = 0 for that step, and on to T;
+/// - kStop ("stop"): the run ends there, with every row up to that step;
+/// - kRelax ("relax"): the step solves the elastic QP (Controller::set_relaxation) with [solver] relax_weight; it
+///   holds only when that fails too.
+/// A failed step never integrates the engine's unconverged iterate.
+enum class OnInfeasible { kHold, kStop, kRelax };
 
 /// A loaded scenario. Owns everything a run needs.
 struct Scenario {
@@ -49,10 +54,11 @@ struct Scenario {
   /// [orientation] turn: the rotation (a world-frame rotation vector, rad; planar: its z) the end effector turns
   /// through over the run, from the orientation it has at t = 0 (Controller::set_orientation_turn); zero: hold it.
   Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();
-  OnInfeasible on_infeasible = OnInfeasible::kContinue;  //!< [solver] on_infeasible: "continue" or "stop"
-  RecordOptions record;  //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
-  bool plots = false;    //!< [output] plots
-  bool animate = false;  //!< [output] animate
+  OnInfeasible on_infeasible = OnInfeasible::kHold;  //!< [solver] on_infeasible: "hold", "stop" or "relax"
+  double relax_weight = 1e4;  //!< [solver] relax_weight: rho of the elastic QP under "relax" (1 to 1e8)
+  RecordOptions record;       //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
+  bool plots = false;         //!< [output] plots
+  bool animate = false;       //!< [output] animate
 
   /// Number of control steps N = round(T / tau); the run records N + 1 rows, t = 0 .. T. Throws
   /// std::invalid_argument when T / tau is not in [1, kMaxSteps].

@@ -16,8 +16,10 @@ class Scheme {
   Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
          std::vector<std::unique_ptr<Constraint>> constraints);
 
-  /// Reads `[[objectives]]` and `[[constraints]]` arrays of tables from `root`.
-  static Scheme from_toml(const TableReader& root, const RobotModel& robot);
+  /// Reads `[[objectives]]` and `[[constraints]]` arrays of tables from `root`. Each plugin's source() is its
+  /// table's file:line:col. With `duration` and `step` (> 0), each plugin's check_run(duration, step) runs too, and
+  /// its FieldError is a ConfigError at the key.
+  static Scheme from_toml(const TableReader& root, const RobotModel& robot, double duration = 0.0, double step = 0.0);
 
   /// Sizes `qp` for this scheme (n, m_e, m_i) and names its sources.
   void setup(QpProblem& qp) const;

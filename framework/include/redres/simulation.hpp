@@ -17,12 +17,16 @@ namespace redres {
 /// A finished run: the recorded trajectory and what the loop saw.
 struct RunResult {
   Trajectory trajectory;  //!< one row per step, t = 0 .. T
-  int failures = 0;       //!< steps whose solve was not `solved` (both Heun stages count) or whose state a constraint
-                          //!< found violated (Constraint::violated(), e.g. bodies in collision)
+  int failures = 0;  //!< steps whose solve failed (not `solved` or `relaxed`; both Heun stages count) or whose state a
+                     //!< constraint found violated (Constraint::violated(), e.g. bodies in collision)
   std::string first_failure;              //!< "t = ...: <status>: <diagnosis>" of the first failed solve
   double wall_time_s = 0.0;               //!< time spent in the loop (s)
   std::vector<std::string_view> engines;  //!< engines that ran, in order of first use (a fallback adds one)
   bool stopped = false;                   //!< ended at the first failed step ([solver] on_infeasible = "stop")
+  int held_steps = 0;                     //!< steps whose solve failed, held with theta_dot = 0
+  int relaxed_steps = 0;                  //!< steps solved with the rows relaxed (on_infeasible = "relax")
+  double max_relaxed_task_error = 0.0;    //!< the largest task_row_error of a relaxed step
+  std::string first_relaxed;              //!< "t = ...: <diagnosis>" of the first relaxed step
   bool interrupted = false;               //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
 
   /// "projection", or "newton+projection" when a fallback ran.

@@ -25,6 +25,7 @@
 /// not depend on the number of threads nor on the order in which runs finish: rows are in variation order and
 /// hold no timing.
 
+#include <atomic>
 #include <cstddef>
 #include <filesystem>
 #include <functional>
@@ -96,9 +97,12 @@ using SweepProgress = std::function<void(std::size_t done, std::size_t total)>;
 
 /// Runs the variations of `shard` on `jobs` threads (0: one per core) and returns their table. A variation that
 /// cannot be loaded or fails is a row with its status ("error" or "failed_steps") and diagnosis, never the end of
-/// the sweep. With spec.write_runs, each run's directory is written under out_dir/runs/<index>/.
+/// the sweep. With spec.write_runs, each run's directory is written under out_dir/runs/<index>/. `stop`, when given
+/// and set (by a signal handler), ends the sweep early: the runs under way end after their current step (status
+/// "interrupted"), the variations not yet started are left out of the table.
 [[nodiscard]] SweepTable run_sweep(const SweepSpec& spec, const SweepShard& shard, unsigned jobs,
-                                   const std::filesystem::path& out_dir, const SweepProgress& progress = {});
+                                   const std::filesystem::path& out_dir, const SweepProgress& progress = {},
+                                   const std::atomic<bool>* stop = nullptr);
 
 /// Writes the table as CSV (RFC 4180 quoting) to `file`; std::runtime_error naming it on failure.
 void write_sweep_csv(const SweepTable& table, const std::filesystem::path& file);

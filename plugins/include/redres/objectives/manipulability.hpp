@@ -68,6 +68,9 @@ class Manipulability final : public Configured<Objective, ManipulabilityConfig> 
   [[nodiscard]] double coefficient(double t, double T) const;
   [[nodiscard]] KinematicsLevel kinematics_level() const override;
   [[nodiscard]] std::optional<double> potential(const Context& ctx) const override;
+  /// The expression schedule is finite at every step time of the run (t = k tau and T; Heun's second stage uses
+  /// the same times), so that no step meets a NaN or an infinite p(t).
+  void check_run(double T, double tau) const override;
 
  private:
   void add_to(const Context& ctx, QpBuilder& builder) const override;

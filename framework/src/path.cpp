@@ -193,7 +193,7 @@ const Schema<PathPlacement>& PathPlacement::schema() {
 namespace {
 
 std::unique_ptr<Path> place(const std::string& type, PathGeometry geometry, const PathPlacement& pl,
-                            const PathContext& context) {
+                            const PathContext& context, const char* zero_length_key = "type") {
   const double deg = std::numbers::pi / 180.0;
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   if (pl.origin) {
@@ -235,7 +235,7 @@ std::unique_ptr<Path> place(const std::string& type, PathGeometry geometry, cons
     strokes += stroke.empty() ? 0 : 1;
     for (const auto& seg : stroke) length += seg.length;
   }
-  if (!(length > 0.0)) throw FieldError("type", "the path has zero length");
+  if (!(length > 0.0)) throw FieldError(zero_length_key, "the path has zero length");
   std::ostringstream d;
   d.precision(4);
   d << type << " (" << strokes << (strokes == 1 ? " stroke, " : " strokes, ") << length << " m, "
@@ -253,7 +253,9 @@ std::unique_ptr<Path> make_path(const TableReader& table, const PathContext& con
   std::unique_ptr<PathGeometry> geometry = path_registry().create(table, context);
   table.finish();
   try {
-    return place(table.string("type"), std::move(*geometry), placement, context);
+    // A polyline of zero length is its segments' fault; any other path's, its type's settings.
+    return place(table.string("type"), std::move(*geometry), placement, context,
+                 table.has("segments") ? "segments" : "type");
   } catch (const FieldError& e) {
     rethrow_at(table, e);
   }

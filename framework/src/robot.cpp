@@ -376,6 +376,9 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
     chain = read_urdf_chain(file, base_link, tip_link);
   } catch (const UrdfError& e) {
     r.fail("urdf", e.what());
+  } catch (const ConfigError& e) {
+    if (e.where().line == 0) r.fail("urdf", e.what());  // missing, not a regular file, too large: at the key
+    throw;
   }
   spec.name = r.string("name", chain.robot_name);
   if (spec.name.empty()) r.fail("name", "expected a non-empty robot name (the URDF gives none)");

@@ -39,8 +39,13 @@ Eigen::VectorXd read_theta0(const TableReader& r, const RobotModel& robot) {
                                                        ": expected a number or a formula string, got " +
                                                        describe_type(el));
     }
+    if (!std::isfinite(v)) {
+      std::ostringstream s;
+      s << "key 'theta0': entry " << j + 1 << ": expected a finite number, got " << v;
+      throw ConfigError(location_of(r.file(), el), s.str());
+    }
     const JointSpec& jt = robot.joint(j);
-    if (!std::isfinite(v) || v < jt.lower || v > jt.upper) {
+    if (v < jt.lower || v > jt.upper) {
       std::ostringstream s;
       s.precision(10);
       s << "key 'theta0': joint '" << jt.name << "' = " << v << " is outside its limits [" << jt.lower << ", "
@@ -72,7 +77,15 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   Scenario s;
   s.source = file.string();
   s.name = r.string("name", file.stem().string());
-  s.robot = std::make_unique<RobotModel>(load_robot(r.path("robot")));
+  if (s.name.empty()) r.fail("name", "expected a non-empty name (or leave `name` out: the file's stem)");
+  try {
+    s.robot = std::make_unique<RobotModel>(load_robot(r.path("robot")));
+  } catch (const ConfigError& e) {
+    // A robot file that is missing, a directory or empty is reported at the key that names it; an error inside the
+    // file keeps its own file:line:col.
+    if (e.where().line == 0) r.fail("robot", e.what());
+    throw;
+  }
   if (r.has("task")) {
     // The scenario chooses the task rows (the robot file's `task` is only the default), so that one robot file
     // serves position and pose scenarios alike.
@@ -150,6 +163,12 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
       } else {
         const std::vector<double> w = o.numbers("turn", 3);
         s.orientation_turn = Eigen::Vector3d(w[0], w[1], w[2]);
+      }
+      const double bound = *physical_bound("rad");
+      if (!(s.orientation_turn.cwiseAbs().maxCoeff() <= bound)) {
+        std::ostringstream m;
+        m << "expected |x| <= " << bound << " rad (a physical range), got " << s.orientation_turn.cwiseAbs().maxCoeff();
+        o.fail("turn", m.str());
       }
     }
     o.finish();

@@ -8,7 +8,8 @@ namespace redres {
 const Schema<CircleConfig>& CircleConfig::schema() {
   using C = CircleConfig;
   static const Schema<C> s{{field("radius", &C::radius, "m", "radius", greater(0.0)),
-                            field("turns", &C::turns, "", "number of turns", greater(0.0)),
+                            field("turns", &C::turns, "", "number of turns",
+                                  rule<double>("in (0, 1e6]", [](const double& v) { return v > 0.0 && v <= 1e6; })),
                             field("start_angle_deg", &C::start_angle_deg, "deg", "angle of the origin on the circle"),
                             field("direction", &C::direction, "", "sense of rotation about the normal"),
                             field("normal", &C::normal, "", "plane normal (spatial tasks)")}};

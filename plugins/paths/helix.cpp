@@ -9,7 +9,8 @@ const Schema<HelixConfig>& HelixConfig::schema() {
   using C = HelixConfig;
   static const Schema<C> s{{field("radius", &C::radius, "m", "radius", greater(0.0)),
                             field("pitch", &C::pitch, "m", "advance along the axis per turn"),
-                            field("turns", &C::turns, "", "number of turns", greater(0.0)),
+                            field("turns", &C::turns, "", "number of turns",
+                                  rule<double>("in (0, 1e6]", [](const double& v) { return v > 0.0 && v <= 1e6; })),
                             field("axis", &C::axis, "", "helix axis (non-zero)")}};
   return s;
 }

@@ -17,7 +17,16 @@ namespace {
 std::unique_ptr<PathGeometry> make_waypoints(const WaypointsConfig& c, const PathContext& ctx) {
   std::vector<std::string> cols = {"x", "y"};
   if (ctx.dim == 3) cols.push_back("z");
-  const CsvTable csv = read_csv(c.file, cols);  // a bad file is a ConfigError at its own file:line:col
+  // A file that is missing, not a regular file or empty is reported at the `file` key; an error inside the file
+  // is a ConfigError at its own file:line:col.
+  const CsvTable csv = [&] {
+    try {
+      return read_csv(c.file, cols);
+    } catch (const ConfigError& e) {
+      if (e.where().line == 0) throw FieldError("file", e.what());
+      throw;
+    }
+  }();
   const std::vector<double>& x = csv.column("x");
   const std::vector<double>& y = csv.column("y");
   if (x.size() < 2) throw FieldError("file", "expected at least 2 waypoints in " + csv.path);

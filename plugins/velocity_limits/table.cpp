@@ -48,8 +48,16 @@ const Schema<TableLawConfig>& TableLawConfig::schema() {
 
 TableLaw::TableLaw(const Config& config) : Configured(kType, config) {
   if (config_.file) {
-    // A bad CSV file is a ConfigError at its own file:line:col.
-    const CsvTable csv = read_csv(*config_.file, {"theta", "lower", "upper"});
+    // A file that is missing, not a regular file or empty is reported at the `file` key; an error inside the file
+    // is a ConfigError at its own file:line:col.
+    const CsvTable csv = [&] {
+      try {
+        return read_csv(*config_.file, {"theta", "lower", "upper"});
+      } catch (const ConfigError& e) {
+        if (e.where().line == 0) throw FieldError("file", e.what());
+        throw;
+      }
+    }();
     theta_ = csv.column("theta");
     lower_ = csv.column("lower");
     upper_ = csv.column("upper");

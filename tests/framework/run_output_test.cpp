@@ -212,3 +212,32 @@ TEST(RunOutput, FilesAreReplacedWholeAndAFailedWriteLeavesTheDirectoryAsItWas) {
 
 }  // namespace
 }  // namespace redres
+
+namespace redres {
+namespace {
+
+// JSON has no inf or nan (nlohmann writes null in their place): summary.json refuses them and names the field.
+TEST(SummaryJson, ANonFiniteNumberIsAnErrorNamingItsField) {
+  Scenario s = load_scenario(source_path("configs/paper_r_fast.toml"), {"duration=0.1"});
+  const RunResult run = simulate(s);
+  RunSummary summary = summarise(s, run);
+  EXPECT_NO_THROW((void)to_json(summary));
+  const auto message = [](const RunSummary& bad) {
+    try {
+      (void)to_json(bad);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  RunSummary a = summary;
+  a.solver.max_residual = std::numeric_limits<double>::infinity();
+  EXPECT_NE(message(a).find("summary.json: 'solver.max_residual' is inf, not a finite number"), std::string::npos)
+      << message(a);
+  RunSummary b = summary;
+  b.final_theta[2] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(message(b).find("'final_theta[2]' is nan"), std::string::npos) << message(b);
+}
+
+}  // namespace
+}  // namespace redres

@@ -49,8 +49,13 @@ void Manipulability::check_run(double T, double tau) const {
     const double p = formula_->evaluate({t, T});
     if (!std::isfinite(p)) {
       std::ostringstream m;
-      m << "expected p(t) finite at every step time of the run, got " << p << " at t = " << t << " s (step " << k
-        << " of " << steps << ", T = " << T << " s)";
+      m << "expected p(t) finite at every step time of the run, got ";
+      if (std::isnan(p)) {
+        m << "nan";  // not "-nan": the sign of a NaN means nothing here
+      } else {
+        m << p;
+      }
+      m << " at t = " << t << " s (step " << k << " of " << steps << ", T = " << T << " s)";
       throw FieldError("formula", m.str());
     }
   }

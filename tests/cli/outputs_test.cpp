@@ -216,14 +216,14 @@ TEST(SignalsCli, SigintEndsRunCompareAndSweepWithExitCode130) {
   {
     const int code = interrupt_after({"run", paper, "--out", (dir / "run").string(), "--quiet", "--set", long_run_set(),
                                       "--set", "solver.engine=nlopt"},
-                                     std::chrono::milliseconds(700), dir / "run.log");
+                                     std::chrono::milliseconds(1500), dir / "run.log");
     EXPECT_EQ(code, 130) << slurp(dir / "run.log");
     EXPECT_EQ(nlohmann::json::parse(slurp(dir / "run" / "summary.json"))["status"], "interrupted");
   }
   {
     const int code = interrupt_after({"compare", paper, paper, "--out", (dir / "compare").string(), "--quiet",
                                       "--no-plots", "--set", long_run_set(), "--set", "solver.engine=nlopt"},
-                                     std::chrono::milliseconds(700), dir / "compare.log");
+                                     std::chrono::milliseconds(1500), dir / "compare.log");
     EXPECT_EQ(code, 130) << slurp(dir / "compare.log");
     EXPECT_EQ(nlohmann::json::parse(slurp(dir / "compare" / "paper_r_tvcmm" / "summary.json"))["status"],
               "interrupted");
@@ -236,7 +236,7 @@ TEST(SignalsCli, SigintEndsRunCompareAndSweepWithExitCode130) {
                                       << "[[vary]]\nkey = \"objectives.1.p\"\nvalues = [0.0, 1.0, 2.0, 4.0]\n";
     const int code = interrupt_after(
         {"sweep", (dir / "sweep.toml").string(), "--out", (dir / "sweep").string(), "--quiet", "--jobs", "1"},
-        std::chrono::milliseconds(700), dir / "sweep.log");
+        std::chrono::milliseconds(1500), dir / "sweep.log");
     EXPECT_EQ(code, 130) << slurp(dir / "sweep.log");
     const auto meta = nlohmann::json::parse(slurp(dir / "sweep" / "sweep.json"));
     EXPECT_EQ(meta["interrupted"], true);

@@ -2,7 +2,8 @@
 /// @file
 /// Shared by the libFuzzer targets (docs/fuzzing.md): a per-process scratch directory laid out so that the
 /// relative paths of the repository's robot and scenario files resolve, and writing an input into it, so that every
-/// target goes through the file loaders users hit (read_input_file, the pre-parse scan, TOML++, the strict readers).
+/// target goes through the file loaders users hit (read_input_file, the pre-parse scan, TOML++, the strict readers);
+/// and a brief, bounded run of a scenario that loaded.
 ///
 /// Layout, created once per process under $TMPDIR (default /tmp) and removed at exit; inputs are written into
 /// <scratch>/tests/data/in/, the depth of the repository's tests/data/<corpus>/, so that both the configs'
@@ -13,15 +14,23 @@
 ///   <scratch>/tests/data/in/urdf -> <source>/robots/urdf ("urdf/franka_panda.urdf", as beside robots/)
 ///   <scratch>/tests/data/in/{good,bad}_table.csv, zigzag.csv -> the test data's CSV files
 
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <string_view>
 #include <system_error>
+
+#include "redres/scenario.hpp"
+#include "redres/simulation.hpp"
 
 #ifndef REDRES_SOURCE_DIR
 #error "REDRES_SOURCE_DIR must name the source tree (tests/fuzz/CMakeLists.txt defines it)"
@@ -79,7 +88,7 @@ class Scratch {
     std::ofstream out(p, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
     out.close();
-    if (!out) setup_failed("cannot write " + p.string());
+    if (!out) setup_failed("cannot write " + p.string() + ": " + std::strerror(errno));
     return p;
   }
 
@@ -98,6 +107,34 @@ class Scratch {
 inline const Scratch& scratch() {
   static const Scratch s;
   return s;
+}
+
+/// The most solver iterations per solve in a fuzzed run. A step that fails (the arm starts in collision, the rows
+/// cannot be met) costs the engine's whole iteration cap, 20,000 by default, and under the fuzzing instrumentation
+/// that is most of a second; a cap of 2,000 keeps a run of failing steps to some 0.1 s per step.
+inline constexpr int kMaxSolverIterations = 2000;
+/// The wall-clock time after which a fuzzed run stops (at the end of the current step; the `stop` flag of
+/// simulate(), as SIGINT in the CLI): inputs stay well inside libFuzzer's -timeout unless one step or the loading
+/// alone is slow, which is then the finding. (A failing step also pays for its diagnosis, some 0.1 s here.)
+inline constexpr std::chrono::milliseconds kRunBudget{200};
+
+/// Runs a loaded scenario briefly: at most `max_steps` control steps (its duration cut after loading, so the path,
+/// the scheme and the solver are the ones the file asked for), kMaxSolverIterations per solve, and kRunBudget.
+inline RunResult run_briefly(Scenario& scenario, int max_steps) {
+  scenario.duration = std::min(scenario.duration, max_steps * scenario.tau);
+  SolverSettings settings = scenario.engine->settings();
+  settings.max_iterations = std::min(settings.max_iterations, kMaxSolverIterations);
+  scenario.engine->set_settings(settings);  // before simulate(): the engines set up their fallbacks from it
+  std::atomic<bool> stop{false};
+  const auto start = std::chrono::steady_clock::now();
+  RunResult run;
+  simulate(
+      scenario, run,
+      [&](double, double) {
+        if (std::chrono::steady_clock::now() - start > kRunBudget) stop.store(true);
+      },
+      &stop);
+  return run;
 }
 
 }  // namespace redres::fuzz

@@ -3,13 +3,12 @@
 // The input is a list of overrides, one per line ('\n'; a '\r' stays in its line, as it would in an argument). They
 // are applied, in order, to a fixed valid scenario, configs/paper_r_tvcmm.toml, through load_scenario(file,
 // overrides): the path `redres run --set ...` takes (apply_overrides on the parsed file, then the strict readers).
-// A scenario that loads runs for at most kMaxSteps control steps (its duration cut after loading), so that values
-// the overrides change reach the plugins and the solver.
+// A scenario that loads runs briefly (run_briefly: at most 5 control steps), so that values the overrides change
+// reach the plugins and the solver.
 //
 // Exceptions derived from std::exception are the answers to bad overrides and are expected. Crashes, sanitizer
 // reports, leaks, timeouts and out-of-memory are findings.
 
-#include <algorithm>
 #include <cstdint>
 #include <exception>
 #include <string>
@@ -35,8 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   try {
     redres::Scenario scenario = redres::load_scenario(base, overrides);
-    scenario.duration = std::min(scenario.duration, kMaxSteps * scenario.tau);
-    (void)redres::simulate(scenario);
+    (void)redres::fuzz::run_briefly(scenario, kMaxSteps);
   } catch (const std::exception&) {
     // A malformed override or a value the scenario refuses: a ConfigError, std::invalid_argument, ...
   }

@@ -12,6 +12,14 @@ read -r -a targets <<<"${FUZZ_TARGETS:-robot_loader scenario_loader overrides fo
 jobs="$(nproc 2>/dev/null || echo 2)"
 out=build/fuzz
 
+# One run at a time: runs share the corpus, the logs and the targets' scratch directories.
+mkdir -p "$out"
+exec 9>"$out/fuzz.lock"
+if ! flock -n 9; then
+  echo "fuzz: another scripts/fuzz.sh is running on $out" >&2
+  exit 2
+fi
+
 # clang 14 with libFuzzer's runtime, and llvm-symbolizer for the stack traces.
 bash scripts/install_deps.sh clang-14 libclang-rt-14-dev llvm-14
 
@@ -96,19 +104,31 @@ for t in "${targets[@]}"; do
   [ -n "$secs" ] || secs=$(($(date +%s) - run_start))
   runs="${runs:-0}"
   total_runs=$((total_runs + runs))
-  mapfile -t found < <(find "$artifacts" -type f | sort)
+  # libFuzzer also keeps inputs that ran for 10 s or more as slow-unit-*: a warning, not a failure (a pause of the
+  # machine makes one; a slow input is a failure through -timeout).
+  mapfile -t slow < <(find "$artifacts" -type f -name 'slow-unit-*' | sort)
+  for f in "${slow[@]}"; do
+    echo "fuzz: warning: $t: a slow input (10 s or more once, under the 2 s timeout otherwise) kept at $f"
+  done
+  mapfile -t found < <(find "$artifacts" -type f ! -name 'slow-unit-*' | sort)
   line="fuzz: $t: $runs runs in $secs s, ${#found[@]} crashes"
   if [ "$rc" -ne 0 ] || [ "${#found[@]}" -gt 0 ]; then
     failed+=("$t")
     line="$line (FAILED, exit code $rc)"
     echo "fuzz: $t FAILED (exit code $rc); the report (full log: $log):"
-    # The sanitizer's or libFuzzer's report, from its first line to its summary.
-    sed -n '/==ERROR\|ERROR: libFuzzer\|runtime error:\|ERROR: AddressSanitizer\|ERROR: LeakSanitizer/,/^SUMMARY/p' \
-      "$log" | head -n 120
+    # The sanitizer's or libFuzzer's report, from its first line to its summary (else the end of the log).
+    first='==ERROR\|ERROR: libFuzzer\|runtime error:\|ERROR: AddressSanitizer\|ERROR: LeakSanitizer'
+    report=$(sed -n "/$first/,/^SUMMARY/p" "$log" | head -n 120)
+    if [ -n "$report" ]; then echo "$report"; else tail -n 30 "$log"; fi
     for f in "${found[@]}"; do
       echo "fuzz: input kept at $f ($(stat -c %s "$f") bytes); reproduce with: $bin $f"
       echo "----- begin input -----"
-      if LC_ALL=C grep -q '[^[:print:][:space:]]' "$f"; then od -A d -c "$f" | head -n 60; else head -c 4096 "$f"; echo; fi
+      if LC_ALL=C grep -q '[^[:print:][:space:]]' "$f"; then
+        od -A d -c "$f" | head -n 60  # binary: escaped
+      else
+        head -c 4096 "$f"
+        echo
+      fi
       echo "----- end input -----"
     done
   fi

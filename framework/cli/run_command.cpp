@@ -235,20 +235,6 @@ void record_new_files(const std::filesystem::path& dir, const Listing& before) {
   add_to_output_manifest(dir, added);
 }
 
-// Writes text to a file through a temporary beside it; std::runtime_error naming the file when it fails.
-void write_text(const std::filesystem::path& file, const std::string& text) {
-  const std::filesystem::path tmp = file.parent_path() / ("." + file.filename().string() + ".tmp");
-  std::ofstream out(tmp);
-  out << text;
-  out.close();
-  if (!out) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
-  }
-  std::filesystem::rename(tmp, file);
-}
-
 std::string table_row(const std::vector<std::string>& cells) {
   std::string s = "|";
   for (const auto& c : cells) s += " " + c + " |";
@@ -398,8 +384,8 @@ void add_run_commands(CLI::App& app, Action& action) {
           break;
         }
       }
-      write_text(out / "comparison.md", md);
-      write_text(out / "comparison.csv", csv);
+      write_text_file(out / "comparison.md", md);
+      write_text_file(out / "comparison.csv", csv);
       if (!opts->quiet) std::cout << "\n" << md << "\nwritten: " << (out / "comparison.md").string() << "\n";
       if (interrupted) {
         std::cerr << "compare: interrupted; comparison.md and comparison.csv hold the runs up to there\n";

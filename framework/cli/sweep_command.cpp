@@ -53,9 +53,7 @@ std::string table_name(const SweepShard& s) {
 }
 
 void write_meta(const std::filesystem::path& file, const nlohmann::json& meta) {
-  std::ofstream out(file);
-  out << meta.dump(2) << "\n";
-  if (!out) throw std::runtime_error("cannot write " + file.string());
+  write_text_file(file, meta.dump(2) + "\n");
 }
 
 int run(const SweepOptions& o) {

@@ -83,7 +83,8 @@ void bounded_least_squares(const Eigen::MatrixXd& C, const Eigen::VectorXd& e, c
       for (std::size_t j = 0; j < free.size(); ++j) CF.col(static_cast<Eigen::Index>(j)) = C.col(free[j]);
       const Eigen::VectorXd z = CF.completeOrthogonalDecomposition().solve(r);
       double alpha = 1.0;
-      int blocking = -1;
+      int blocking = -1;  // the variable whose bound stops the step
+      bool blocked_low = false;
       for (std::size_t j = 0; j < free.size(); ++j) {
         const int i = free[j];
         const double to = z(static_cast<Eigen::Index>(j)), from = x(i);
@@ -93,6 +94,7 @@ void bounded_least_squares(const Eigen::MatrixXd& C, const Eigen::VectorXd& e, c
         if (a < alpha) {
           alpha = std::max(0.0, a);
           blocking = i;
+          blocked_low = to < lo(i);
         }
       }
       for (std::size_t j = 0; j < free.size(); ++j) {
@@ -100,10 +102,8 @@ void bounded_least_squares(const Eigen::MatrixXd& C, const Eigen::VectorXd& e, c
         x(i) = std::clamp(x(i) + alpha * (z(static_cast<Eigen::Index>(j)) - x(i)), lo(i), hi(i));
       }
       if (blocking >= 0) {
-        const bool lower =
-            z(static_cast<Eigen::Index>(std::find(free.begin(), free.end(), blocking) - free.begin())) < lo(blocking);
-        x(blocking) = lower ? lo(blocking) : hi(blocking);
-        state[static_cast<std::size_t>(blocking)] = lower ? kAtLower : kAtUpper;
+        x(blocking) = blocked_low ? lo(blocking) : hi(blocking);
+        state[static_cast<std::size_t>(blocking)] = blocked_low ? kAtLower : kAtUpper;
         continue;
       }
     }

@@ -121,23 +121,34 @@ bool manifest_name_ok(const std::string& name) {
 }
 
 void write_manifest(const std::filesystem::path& dir, const std::vector<std::string>& names) {
-  const std::filesystem::path file = dir / kOutputManifest, tmp = staging_path(file);
-  {
-    std::ofstream out(tmp);
-    out << "# the files the last redres run wrote into this directory; the next run removes those it does not "
-           "write again\n";
-    for (const auto& n : names) out << n << "\n";
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);
-      throw std::runtime_error("cannot write " + file.string());
-    }
-  }
-  std::filesystem::rename(tmp, file);
+  std::string text =
+      "# the files the last redres run wrote into this directory; the next run removes those it does not write "
+      "again\n";
+  for (const auto& n : names) text += n + "\n";
+  write_text_file(dir / kOutputManifest, text);
 }
 
 }  // namespace
+
+void write_text_file(const std::filesystem::path& file, const std::string& text) {
+  const std::filesystem::path tmp = staging_path(file);
+  std::ofstream out(tmp);
+  out << text;
+  out.close();
+  if (!out) {
+    const int e = errno;
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(e));
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw std::runtime_error("cannot write " + file.string() + ": " + ec.message());
+  }
+}
 
 std::vector<std::string> read_output_manifest(const std::filesystem::path& dir) {
   std::vector<std::string> names;

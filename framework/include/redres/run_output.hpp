@@ -40,6 +40,10 @@ inline constexpr std::size_t kFramesMaxRows = 500;
 std::vector<std::string> write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
                                    const std::filesystem::path& dir, const RecordOptions& record = {});
 
+/// Writes `text` to `file` through a hidden temporary beside it, renamed into place: a reader never sees half of
+/// it, and a failed write leaves the old file. std::runtime_error naming the file on failure.
+void write_text_file(const std::filesystem::path& file, const std::string& text);
+
 /// The name of the manifest in a run's directory.
 inline constexpr const char* kOutputManifest = ".redres-outputs";
 /// The names in DIR's manifest; empty when there is none. Names with a '/' or starting with '.' are skipped (a

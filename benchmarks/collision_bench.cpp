@@ -8,12 +8,14 @@
 #include <benchmark/benchmark.h>
 
 #include "qp_util.hpp"
-#include "redres/collision.hpp"
+#include "redres/model/collision.hpp"
 #include "redres/constraints/obstacle_avoidance.hpp"
 #include "redres/constraints/self_collision.hpp"
-#include "redres/lvi.hpp"
-#include "redres/scheme.hpp"
-#include "redres/simulation.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/control/scheme.hpp"
+#include "redres/run/simulation.hpp"
+#include "redres/control/engine_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace {

@@ -19,7 +19,7 @@
 
 #include <Eigen/Cholesky>
 
-#include "redres/simulation.hpp"
+#include "redres/run/simulation.hpp"
 
 namespace redres {
 namespace {

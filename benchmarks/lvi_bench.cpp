@@ -14,6 +14,7 @@
 
 #include "qp_util.hpp"
 #include "test_util.hpp"
+#include "redres/control/engine_registry.hpp"
 
 namespace {
 

@@ -14,7 +14,7 @@
 #include "redres/constraints/joint_angle_margin.hpp"
 #include "redres/constraints/task_tracking.hpp"
 #include "redres/objectives/manipulability.hpp"
-#include "redres/scenario.hpp"
+#include "redres/run/scenario.hpp"
 #include "redres/velocity_limits/constant.hpp"
 #include "redres/velocity_limits/push_rod.hpp"
 

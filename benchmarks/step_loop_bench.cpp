@@ -21,7 +21,7 @@
 #include <benchmark/benchmark.h>
 
 #include "paper_baseline_setup.hpp"
-#include "redres/simulation.hpp"
+#include "redres/run/simulation.hpp"
 
 namespace redres {
 namespace {

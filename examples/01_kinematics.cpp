@@ -8,7 +8,8 @@
 #include <iomanip>
 #include <iostream>
 
-#include <redres/kinematics.hpp>
+#include <redres/model/kinematics.hpp>
+#include "redres/parsers/robot_toml.hpp"
 
 int main(int argc, char** argv) {
   try {

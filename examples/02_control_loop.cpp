@@ -14,10 +14,12 @@
 #include <redres/constraints/joint_angle_margin.hpp>
 #include <redres/constraints/joint_velocity_limits.hpp>
 #include <redres/constraints/task_tracking.hpp>
-#include <redres/controller.hpp>
+#include <redres/control/controller.hpp>
 #include <redres/engines/newton.hpp>
 #include <redres/objectives/manipulability.hpp>
 #include <redres/objectives/min_velocity_norm.hpp>
+#include "redres/control/engine_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
 
 int main(int argc, char** argv) {
   using namespace redres;

@@ -2,7 +2,7 @@
 //   x_j <= cap  and  -x_j <= cap.
 // (Bounds would do the same job faster; rows show how a constraint writes A x <= b.)
 
-#include <redres/plugin.hpp>
+#include <redres/control/plugin.hpp>
 
 namespace {
 

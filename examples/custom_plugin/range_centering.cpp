@@ -4,7 +4,7 @@
 // added as zeta += weight * grad P = weight * lambda (theta_j - m_j) / h_j^2. Unlike joint_centering it scales each
 // joint by its own range, so a narrow joint is pulled as hard as a wide one.
 
-#include <redres/plugin.hpp>
+#include <redres/control/plugin.hpp>
 
 namespace {
 

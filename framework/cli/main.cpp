@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "redres/error.hpp"
-#include "redres/plugin_loader.hpp"
+#include "redres/common/error.hpp"
+#include "redres/config/plugin_loader.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"redres: redundancy resolution of redundant manipulators (QP from plugins, solved as an LVI)"};

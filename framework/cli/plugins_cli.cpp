@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "redres/conformance.hpp"
+#include "redres/extend/conformance.hpp"
 
 namespace redres::cli {
 

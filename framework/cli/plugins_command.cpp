@@ -8,10 +8,12 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "redres/lvi.hpp"
-#include "redres/path.hpp"
-#include "redres/plugin.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/control/path.hpp"
+#include "redres/control/plugin.hpp"
+#include "redres/model/velocity_limit.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/control/engine_registry.hpp"
 
 namespace redres::cli {
 

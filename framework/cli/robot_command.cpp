@@ -7,8 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "redres/formula.hpp"
-#include "redres/kinematics.hpp"
+#include "redres/common/formula.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/parsers/robot_toml.hpp"
 
 namespace redres::cli {
 

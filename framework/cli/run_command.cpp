@@ -25,9 +25,9 @@
 
 #include "commands.hpp"
 #include "progress.hpp"
-#include "redres/csv.hpp"
-#include "redres/run_output.hpp"
-#include "redres/scenario.hpp"
+#include "redres/common/csv.hpp"
+#include "redres/run/run_output.hpp"
+#include "redres/run/scenario.hpp"
 #include "stop_signals.hpp"
 
 extern char** environ;  // the environment plot_run.py inherits (POSIX leaves the declaration to the program)

@@ -15,8 +15,8 @@
 
 #include "commands.hpp"
 #include "progress.hpp"
-#include "redres/run_output.hpp"
-#include "redres/sweep.hpp"
+#include "redres/run/run_output.hpp"
+#include "redres/run/sweep.hpp"
 #include "stop_signals.hpp"
 
 namespace redres::cli {

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "redres/trajectory.hpp"
+#include "redres/run/trajectory.hpp"
 
 namespace redres {
 

@@ -1,6 +1,6 @@
 #include "redres/constraints/joint_velocity_limits.hpp"
 
-#include "redres/velocity_limit.hpp"
+#include "redres/model/velocity_limit.hpp"
 
 namespace redres {
 
@@ -19,10 +19,6 @@ void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder) const {
   const Eigen::VectorXd& theta = ctx.theta();
   const double scale = config_.scale;
   if (ctx.velocity_lower != nullptr && ctx.velocity_upper != nullptr) {
-    if (scale == 1.0) {
-      builder.intersect_bounds(*ctx.velocity_lower, *ctx.velocity_upper);
-      return;
-    }
     if (scale == 1.0) {
       builder.intersect_bounds(*ctx.velocity_lower, *ctx.velocity_upper);
       return;

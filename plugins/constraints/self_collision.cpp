@@ -5,7 +5,7 @@
 #include <limits>
 #include <sstream>
 
-#include "redres/trajectory.hpp"
+#include "redres/run/trajectory.hpp"
 
 namespace redres {
 

@@ -5,7 +5,7 @@
 
 #include <Eigen/Geometry>
 
-#include "redres/trajectory.hpp"
+#include "redres/run/trajectory.hpp"
 
 namespace redres {
 

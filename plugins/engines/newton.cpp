@@ -32,6 +32,7 @@
 #include <Eigen/LU>
 
 #include "redres/engines/newton.hpp"
+#include "redres/control/engine_registry.hpp"
 
 namespace redres {
 namespace {

@@ -15,6 +15,7 @@
 #include <Eigen/QR>
 
 #include "redres/engines/nlopt.hpp"
+#include "redres/control/engine_registry.hpp"
 
 namespace redres {
 namespace {

@@ -23,6 +23,7 @@
 #endif
 
 #include "redres/engines/projection.hpp"
+#include "redres/control/engine_registry.hpp"
 
 namespace redres {
 namespace {

@@ -1,6 +1,6 @@
 #include "redres/paths/waypoints.hpp"
 
-#include "redres/csv.hpp"
+#include "redres/common/csv.hpp"
 
 namespace redres {
 

@@ -1,4 +1,5 @@
 #include "redres/velocity_limits/constant.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
 
 #include <sstream>
 

@@ -1,4 +1,5 @@
 #include "redres/velocity_limits/expression.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
 
 namespace redres {
 

@@ -1,4 +1,5 @@
 #include "redres/velocity_limits/push_rod.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
 
 #include <cmath>
 #include <numbers>

@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <sstream>
 
-#include "redres/csv.hpp"
+#include "redres/common/csv.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
 
 namespace redres {
 

@@ -20,9 +20,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.hpp"
-#include "redres/run_output.hpp"
-#include "redres/scenario.hpp"
-#include "redres/simulation.hpp"
+#include "redres/run/run_output.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/simulation.hpp"
 
 namespace redres {
 namespace {

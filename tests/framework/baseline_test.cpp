@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "paper_baseline_setup.hpp"
-#include "redres/simulation.hpp"
+#include "redres/run/simulation.hpp"
 #include "test_util.hpp"
 
 namespace redres {

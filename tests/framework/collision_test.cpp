@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/collision.hpp"
+#include "redres/model/collision.hpp"
 
 namespace redres {
 namespace {

@@ -8,16 +8,19 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/config.hpp"
+#include "redres/config/config.hpp"
 #include "redres/constraints/joint_angle_margin.hpp"
 #include "redres/engines/newton.hpp"
-#include "redres/lvi.hpp"
+#include "redres/qp/lvi.hpp"
 #include "redres/objectives/manipulability.hpp"
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
 #include "redres/paths/letter_r.hpp"
-#include "redres/plugin.hpp"
-#include "redres/scheme.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/control/plugin.hpp"
+#include "redres/control/scheme.hpp"
+#include "redres/model/velocity_limit.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/control/engine_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -5,11 +5,14 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/conformance.hpp"
-#include "redres/lvi.hpp"
-#include "redres/path.hpp"
-#include "redres/plugin.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/extend/conformance.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/control/path.hpp"
+#include "redres/control/plugin.hpp"
+#include "redres/model/velocity_limit.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/control/engine_registry.hpp"
+#include "config/registration_scope.hpp"
 
 namespace redres {
 namespace {

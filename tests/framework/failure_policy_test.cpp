@@ -22,10 +22,11 @@
 
 #include "cli_util.hpp"
 #include "qp_util.hpp"
-#include "redres/lvi.hpp"
-#include "redres/run_summary.hpp"
-#include "redres/scenario.hpp"
-#include "redres/simulation.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/run/run_summary.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/simulation.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "test_util.hpp"
 
 namespace redres {

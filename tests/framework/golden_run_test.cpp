@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "redres/run_summary.hpp"
+#include "redres/run/run_summary.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -4,7 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/kinematics.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

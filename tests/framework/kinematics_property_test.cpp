@@ -12,7 +12,8 @@
 
 #include "alloc_counter.hpp"
 #include "random_chain.hpp"
-#include "redres/kinematics.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -11,6 +11,7 @@
 #include "alloc_counter.hpp"
 #include "qp_util.hpp"
 #include "test_util.hpp"
+#include "redres/control/engine_registry.hpp"
 
 namespace redres {
 namespace {

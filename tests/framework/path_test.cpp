@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -7,8 +7,9 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/plugin.hpp"
-#include "redres/scheme.hpp"
+#include "redres/control/plugin.hpp"
+#include "redres/control/scheme.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

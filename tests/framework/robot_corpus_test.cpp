@@ -9,7 +9,8 @@
 
 #include <Eigen/Geometry>
 
-#include "redres/kinematics.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -16,9 +16,10 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/kinematics.hpp"
-#include "redres/run_output.hpp"
-#include "redres/run_summary.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/run/run_output.hpp"
+#include "redres/run/run_summary.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

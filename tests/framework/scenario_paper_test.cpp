@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/simulation.hpp"
+#include "redres/run/simulation.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -8,7 +8,7 @@
 
 #include <Eigen/Geometry>
 
-#include "redres/run_summary.hpp"
+#include "redres/run/run_summary.hpp"
 #include "run_checks.hpp"
 #include "test_util.hpp"
 

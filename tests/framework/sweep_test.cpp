@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/scenario.hpp"
-#include "redres/sweep.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/sweep.hpp"
 #include "test_util.hpp"
 
 namespace redres {

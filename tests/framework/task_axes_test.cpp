@@ -10,8 +10,9 @@
 
 #include <Eigen/Geometry>
 
-#include "redres/run_summary.hpp"
-#include "redres/toml_reader.hpp"
+#include "redres/run/run_summary.hpp"
+#include "redres/config/toml_reader.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "run_checks.hpp"
 #include "test_util.hpp"
 

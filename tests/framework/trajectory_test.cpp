@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/run_summary.hpp"
-#include "redres/simulation.hpp"
+#include "redres/run/run_summary.hpp"
+#include "redres/run/simulation.hpp"
 #include "test_util.hpp"
 
 namespace redres {

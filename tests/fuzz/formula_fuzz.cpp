@@ -21,11 +21,13 @@
 #include <string>
 
 #include "fuzz_util.hpp"
-#include "redres/formula.hpp"
+#include "redres/common/formula.hpp"
 #include "redres/objectives/manipulability.hpp"
-#include "redres/plugin.hpp"
-#include "redres/robot.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/control/plugin.hpp"
+#include "redres/model/robot.hpp"
+#include "redres/model/velocity_limit.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
 
 namespace {
 

@@ -29,8 +29,8 @@
 #include <string_view>
 #include <system_error>
 
-#include "redres/scenario.hpp"
-#include "redres/simulation.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/simulation.hpp"
 
 #ifndef REDRES_SOURCE_DIR
 #error "REDRES_SOURCE_DIR must name the source tree (tests/fuzz/CMakeLists.txt defines it)"

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "fuzz_util.hpp"
-#include "redres/scenario.hpp"
-#include "redres/simulation.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/simulation.hpp"
 
 namespace {
 constexpr int kMaxSteps = 5;

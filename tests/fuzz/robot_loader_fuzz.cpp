@@ -18,9 +18,10 @@
 #include <vector>
 
 #include "fuzz_util.hpp"
-#include "redres/collision.hpp"
-#include "redres/kinematics.hpp"
-#include "redres/robot.hpp"
+#include "redres/model/collision.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/model/robot.hpp"
+#include "redres/parsers/robot_toml.hpp"
 
 namespace {
 

@@ -13,9 +13,9 @@
 #include <exception>
 
 #include "fuzz_util.hpp"
-#include "redres/run_summary.hpp"
-#include "redres/scenario.hpp"
-#include "redres/simulation.hpp"
+#include "redres/run/run_summary.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/simulation.hpp"
 
 namespace {
 constexpr int kMaxSteps = 20;

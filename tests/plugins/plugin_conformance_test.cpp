@@ -10,7 +10,10 @@
 #include <gtest/gtest.h>
 
 #include "qp_util.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/model/velocity_limit.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/control/engine_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -5,6 +5,7 @@
 #include <Eigen/QR>
 
 #include "test_util.hpp"
+#include "redres/parsers/robot_toml.hpp"
 
 namespace redres::testing {
 

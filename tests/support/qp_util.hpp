@@ -6,8 +6,8 @@
 #include <random>
 #include <string>
 
-#include "redres/lvi.hpp"
-#include "redres/scheme.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/control/scheme.hpp"
 
 namespace redres::testing {
 

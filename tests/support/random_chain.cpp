@@ -1,6 +1,7 @@
 #include "random_chain.hpp"
 
-#include "redres/toml_reader.hpp"
+#include "redres/config/toml_reader.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
 
 namespace redres::testing {
 

@@ -6,7 +6,7 @@
 
 #include <rapidcheck.h>
 
-#include "redres/robot.hpp"
+#include "redres/model/robot.hpp"
 
 namespace redres::testing {
 

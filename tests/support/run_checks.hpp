@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/run_summary.hpp"
+#include "redres/run/run_summary.hpp"
 
 namespace redres {
 

@@ -1,7 +1,7 @@
 // A plugin library for the loader tests: loaded at run time with dlopen, it registers one objective and one
 // constraint exactly as a user's library would (tests/framework/plugin_loader_test.cpp, tests/cli/).
 
-#include <redres/plugin.hpp>
+#include <redres/control/plugin.hpp>
 
 namespace {
 

@@ -1,7 +1,7 @@
 // A plugin library that registers a name the built-ins already have: loading it must fail with a clear error that
 // names the library, and leave the built-in plugin in place.
 
-#include <redres/plugin.hpp>
+#include <redres/control/plugin.hpp>
 
 namespace {
 

@@ -12,8 +12,8 @@
 
 #include <Eigen/Core>
 
-#include "redres/robot.hpp"
-#include "redres/trajectory.hpp"
+#include "redres/model/robot.hpp"
+#include "redres/run/trajectory.hpp"
 
 namespace redres {
 

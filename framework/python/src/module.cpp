@@ -14,15 +14,18 @@
 #include <pybind11/stl/filesystem.h>
 
 #include "python_plugins.hpp"
-#include "redres/kinematics.hpp"
-#include "redres/lvi.hpp"
-#include "redres/path.hpp"
-#include "redres/run_output.hpp"
-#include "redres/run_summary.hpp"
-#include "redres/scenario.hpp"
-#include "redres/simulation.hpp"
-#include "redres/sweep.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/control/path.hpp"
+#include "redres/run/run_output.hpp"
+#include "redres/run/run_summary.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/simulation.hpp"
+#include "redres/run/sweep.hpp"
+#include "redres/model/velocity_limit.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/control/engine_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "types.hpp"
 
 namespace redres::python {

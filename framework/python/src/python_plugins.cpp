@@ -8,9 +8,10 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
-#include "redres/conformance.hpp"
-#include "redres/lvi.hpp"
-#include "redres/path.hpp"
+#include "redres/extend/conformance.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/control/path.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "types.hpp"
 
 namespace redres::python {

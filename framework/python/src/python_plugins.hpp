@@ -8,7 +8,7 @@
 
 #include <pybind11/pybind11.h>
 
-#include "redres/plugin.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres::python {
 

@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-#include "redres/robot.hpp"
+#include "redres/model/robot.hpp"
 
 namespace redres::python {
 

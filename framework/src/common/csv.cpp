@@ -1,12 +1,12 @@
-#include "redres/csv.hpp"
+#include "redres/common/csv.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
-#include "redres/error.hpp"
-#include "redres/input_file.hpp"
+#include "redres/common/error.hpp"
+#include "common/input_file.hpp"
 
 namespace redres {
 

@@ -1,4 +1,4 @@
-#include "redres/error.hpp"
+#include "redres/common/error.hpp"
 
 namespace redres {
 

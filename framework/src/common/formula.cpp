@@ -1,4 +1,4 @@
-#include "redres/formula.hpp"
+#include "redres/common/formula.hpp"
 
 #include <array>
 #include <limits>

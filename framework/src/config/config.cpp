@@ -1,4 +1,4 @@
-#include "redres/config.hpp"
+#include "redres/config/config.hpp"
 
 #include <sstream>
 

@@ -1,9 +1,9 @@
-#include "redres/overrides.hpp"
+#include "config/overrides.hpp"
 
 #include <charconv>
 #include <sstream>
 
-#include "redres/error.hpp"
+#include "redres/common/error.hpp"
 
 namespace redres {
 

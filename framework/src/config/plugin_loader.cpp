@@ -1,11 +1,12 @@
-#include "redres/plugin_loader.hpp"
+#include "redres/config/plugin_loader.hpp"
 
 #include <dlfcn.h>
 
 #include <algorithm>
 #include <cstdlib>
 
-#include "redres/registry.hpp"
+#include "redres/config/registry.hpp"
+#include "config/registration_scope.hpp"
 
 namespace redres {
 

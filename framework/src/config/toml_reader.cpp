@@ -1,11 +1,11 @@
-#include "redres/toml_reader.hpp"
+#include "redres/config/toml_reader.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <sstream>
 
-#include "redres/formula.hpp"
-#include "redres/input_file.hpp"
+#include "redres/common/formula.hpp"
+#include "common/input_file.hpp"
 
 namespace redres {
 

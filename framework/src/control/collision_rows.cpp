@@ -1,12 +1,12 @@
-#include "redres/collision_rows.hpp"
+#include "redres/control/collision_rows.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "redres/config.hpp"
-#include "redres/plugin.hpp"
-#include "redres/trajectory.hpp"
+#include "redres/config/config.hpp"
+#include "redres/control/plugin.hpp"
+#include "redres/run/trajectory.hpp"
 
 namespace redres {
 

@@ -1,4 +1,4 @@
-#include "redres/controller.hpp"
+#include "redres/control/controller.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,8 @@
 
 #include <Eigen/Geometry>
 
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
+#include "redres/control/engine_registry.hpp"
 
 namespace redres {
 

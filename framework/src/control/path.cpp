@@ -1,4 +1,4 @@
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
 
 #include <algorithm>
 #include <cmath>

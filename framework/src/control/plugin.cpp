@@ -1,4 +1,4 @@
-#include "redres/plugin.hpp"
+#include "redres/control/plugin.hpp"
 
 #include <cmath>
 #include <sstream>

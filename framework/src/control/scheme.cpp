@@ -1,4 +1,4 @@
-#include "redres/scheme.hpp"
+#include "redres/control/scheme.hpp"
 
 #include <algorithm>
 #include <set>

@@ -1,15 +1,17 @@
-#include "redres/conformance.hpp"
+#include "redres/extend/conformance.hpp"
 
 #include <cmath>
 #include <set>
 #include <sstream>
 
-#include "redres/lvi.hpp"
-#include "redres/path.hpp"
-#include "redres/plugin.hpp"
-#include "redres/robot.hpp"
-#include "redres/scheme.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/control/path.hpp"
+#include "redres/control/plugin.hpp"
+#include "redres/model/robot.hpp"
+#include "redres/control/scheme.hpp"
+#include "redres/model/velocity_limit.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/control/engine_registry.hpp"
 
 namespace redres {
 

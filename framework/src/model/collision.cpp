@@ -1,6 +1,6 @@
 // The only translation unit that includes FCL (its headers cost seconds and hundreds of MB to compile).
 
-#include "redres/collision.hpp"
+#include "redres/model/collision.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "redres/kinematics.hpp"
+#include "redres/model/kinematics.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,26 +1,15 @@
-#include "redres/velocity_limit.hpp"
+#include "redres/model/velocity_limit.hpp"
 
 #include <cmath>
 #include <sstream>
 
 namespace redres {
 
-VelocityLimitRegistry& velocity_limit_registry() {
-  static VelocityLimitRegistry registry("velocity-limit law");
-  return registry;
-}
-
 toml::table VelocityLimitLaw::config() const {
   toml::table out;
   out.insert("type", type_);
   write_config(out);
   return out;
-}
-
-std::unique_ptr<VelocityLimitLaw> make_velocity_limit(const TableReader& table) {
-  auto law = velocity_limit_registry().create(table);
-  table.finish();
-  return law;
 }
 
 std::optional<UndefinedAt> check_velocity_law(const VelocityLimitLaw& law, double lo, double hi) {

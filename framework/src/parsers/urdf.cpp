@@ -1,6 +1,6 @@
 // The only translation unit that includes urdfdom.
 
-#include "redres/urdf.hpp"
+#include "parsers/urdf.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,8 +10,8 @@
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
-#include "redres/error.hpp"
-#include "redres/input_file.hpp"
+#include "redres/common/error.hpp"
+#include "common/input_file.hpp"
 
 namespace redres {
 

@@ -1,9 +1,9 @@
-#include "redres/qp.hpp"
+#include "redres/qp/qp.hpp"
 
 #include <cmath>
 #include <sstream>
 
-#include "redres/error.hpp"
+#include "redres/common/error.hpp"
 
 namespace redres {
 

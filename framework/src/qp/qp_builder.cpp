@@ -1,9 +1,9 @@
-#include "redres/qp_builder.hpp"
+#include "redres/qp/qp_builder.hpp"
 
 #include <cmath>
 #include <string>
 
-#include "redres/error.hpp"
+#include "redres/common/error.hpp"
 
 namespace redres {
 

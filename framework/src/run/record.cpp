@@ -1,4 +1,4 @@
-#include "redres/record.hpp"
+#include "redres/run/record.hpp"
 
 #include <charconv>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "redres/run_output.hpp"
+#include "redres/run/run_output.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -13,8 +13,8 @@
 
 #include <unistd.h>
 
-#include "redres/error.hpp"
-#include "redres/kinematics.hpp"
+#include "redres/common/error.hpp"
+#include "redres/model/kinematics.hpp"
 
 namespace redres {
 

@@ -1,4 +1,4 @@
-#include "redres/run_summary.hpp"
+#include "redres/run/run_summary.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,12 +1,14 @@
-#include "redres/scenario.hpp"
+#include "redres/run/scenario.hpp"
 
 #include <cmath>
 #include <sstream>
 
-#include "redres/formula.hpp"
-#include "redres/overrides.hpp"
-#include "redres/plugin_loader.hpp"
-#include "redres/simulation.hpp"
+#include "redres/common/formula.hpp"
+#include "config/overrides.hpp"
+#include "redres/config/plugin_loader.hpp"
+#include "redres/run/simulation.hpp"
+#include "redres/control/engine_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
 
 namespace redres {
 

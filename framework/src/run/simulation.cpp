@@ -1,4 +1,4 @@
-#include "redres/simulation.hpp"
+#include "redres/run/simulation.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "redres/sweep.hpp"
+#include "redres/run/sweep.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -13,13 +13,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "redres/csv.hpp"
-#include "redres/error.hpp"
-#include "redres/formula.hpp"
-#include "redres/input_file.hpp"
-#include "redres/run_summary.hpp"
-#include "redres/scenario.hpp"
-#include "redres/toml_reader.hpp"
+#include "redres/common/csv.hpp"
+#include "redres/common/error.hpp"
+#include "redres/common/formula.hpp"
+#include "common/input_file.hpp"
+#include "redres/run/run_summary.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/config/toml_reader.hpp"
 
 namespace redres {
 

@@ -1,4 +1,4 @@
-#include "redres/trajectory.hpp"
+#include "redres/run/trajectory.hpp"
 
 #include <cstdint>
 #include <cstring>

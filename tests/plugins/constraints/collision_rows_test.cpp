@@ -11,8 +11,10 @@
 #include "alloc_counter.hpp"
 #include "redres/constraints/obstacle_avoidance.hpp"
 #include "redres/constraints/self_collision.hpp"
-#include "redres/lvi.hpp"
-#include "redres/scheme.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/control/scheme.hpp"
+#include "redres/control/engine_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "redres/constraints/obstacle_avoidance.hpp"
-#include "redres/run_summary.hpp"
+#include "redres/run/run_summary.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -7,10 +7,11 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/kinematics.hpp"
-#include "redres/path.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/control/path.hpp"
 #include "redres/paths/letter_r.hpp"
-#include "redres/robot.hpp"
+#include "redres/model/robot.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

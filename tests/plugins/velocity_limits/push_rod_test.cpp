@@ -9,7 +9,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "redres/robot.hpp"
+#include "redres/model/robot.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -41,7 +41,7 @@
 
 #include <Eigen/Core>
 
-#include "redres/toml_reader.hpp"
+#include "redres/config/toml_reader.hpp"
 
 namespace redres {
 

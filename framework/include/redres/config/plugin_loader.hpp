@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "redres/error.hpp"
-#include "redres/toml_reader.hpp"
+#include "redres/common/error.hpp"
+#include "redres/config/toml_reader.hpp"
 
 namespace redres {
 

@@ -18,20 +18,21 @@
 #include <typeinfo>
 #include <vector>
 
-#include "redres/config.hpp"
-#include "redres/toml_reader.hpp"
+#include "redres/config/config.hpp"
+#include "redres/config/toml_reader.hpp"
 
 namespace redres {
 
-/// While a plugin library is being loaded: its path and the registration errors it caused.
-struct RegistrationScope {
-  std::string library;              //!< the library being loaded
-  std::vector<std::string> errors;  //!< e.g. duplicate names
-  int added = 0;                    //!< plugins it registered
-};
-
-/// The scope of the library being loaded, or nullptr (built-in registration).
-RegistrationScope*& current_registration_scope();
+/// Where registrations come from (a plugin library being loaded, or the built-in plugins), as the registries see it.
+namespace registration {
+/// "built-in", or the path of the library being loaded.
+[[nodiscard]] std::string origin();
+/// A registration refused (e.g. a duplicate name): a std::logic_error for a built-in plugin, else recorded as a load
+/// error of the library being loaded.
+void refuse(const std::string& why);
+/// Counts a plugin that the library being loaded registered.
+void added() noexcept;
+}  // namespace registration
 
 /// What every registry offers to the plugin loader and `redres plugins`, independent of the plugin kind.
 class RegistryBase {
@@ -82,8 +83,7 @@ class Registry : public RegistryBase {
     Entry e;
     e.type = std::move(type);
     e.summary = std::move(summary);
-    RegistrationScope* scope = current_registration_scope();
-    e.origin = scope != nullptr ? scope->library : "built-in";
+    e.origin = registration::origin();
     e.keys = describe_keys<C>(C::schema());
     e.groups = C::schema().groups;
     e.config_type = &typeid(C);
@@ -103,13 +103,12 @@ class Registry : public RegistryBase {
     if (const auto it = entries_.find(e.type); it != entries_.end()) {
       const std::string why =
           "duplicate " + kind() + " type '" + e.type + "': already registered by " + it->second.origin;
-      if (scope == nullptr) throw std::logic_error(why);
-      scope->errors.push_back(why);
+      registration::refuse(why);
       return false;
     }
     const std::string name = e.type;
     entries_.emplace(name, std::move(e));
-    if (scope != nullptr) ++scope->added;
+    registration::added();
     return true;
   }
 

@@ -16,7 +16,7 @@
 
 #include <toml++/toml.h>
 
-#include "redres/error.hpp"
+#include "redres/common/error.hpp"
 
 namespace redres {
 

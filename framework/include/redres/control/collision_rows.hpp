@@ -19,9 +19,9 @@
 
 #include <Eigen/Core>
 
-#include "redres/collision.hpp"
-#include "redres/kinematics.hpp"
-#include "redres/plugin.hpp"
+#include "redres/model/collision.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres {
 

@@ -4,7 +4,7 @@
 
 #include <Eigen/Core>
 
-#include "redres/kinematics.hpp"
+#include "redres/model/kinematics.hpp"
 
 namespace redres {
 

@@ -10,9 +10,9 @@
 
 #include <Eigen/Core>
 
-#include "redres/lvi.hpp"
-#include "redres/path.hpp"
-#include "redres/scheme.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/control/path.hpp"
+#include "redres/control/scheme.hpp"
 
 namespace redres {
 

@@ -26,8 +26,8 @@
 
 #include <Eigen/Core>
 
-#include "redres/config.hpp"
-#include "redres/registry.hpp"
+#include "redres/config/config.hpp"
+#include "redres/config/registry.hpp"
 
 namespace redres {
 

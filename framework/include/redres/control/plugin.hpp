@@ -23,11 +23,11 @@
 
 #include <Eigen/Core>
 
-#include "redres/config.hpp"
-#include "redres/context.hpp"
-#include "redres/kinematics.hpp"
-#include "redres/qp_builder.hpp"
-#include "redres/registry.hpp"
+#include "redres/config/config.hpp"
+#include "redres/control/context.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/qp/qp_builder.hpp"
+#include "redres/config/registry.hpp"
 
 namespace redres {
 

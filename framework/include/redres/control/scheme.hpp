@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include "redres/plugin.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres {
 

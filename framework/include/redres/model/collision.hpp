@@ -24,7 +24,7 @@
 
 #include <Eigen/Geometry>
 
-#include "redres/config.hpp"
+#include "redres/config/config.hpp"
 
 namespace redres {
 

@@ -20,7 +20,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
-#include "redres/robot.hpp"
+#include "redres/model/robot.hpp"
 
 namespace redres {
 

@@ -38,9 +38,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "redres/collision.hpp"
-#include "redres/toml_reader.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/model/collision.hpp"
+#include "redres/config/toml_reader.hpp"
+#include "redres/model/velocity_limit.hpp"
 
 namespace redres {
 
@@ -196,15 +196,9 @@ class RobotModel {
   std::vector<LinkShape> link_shapes_;
 };
 
-/// Loads a robot TOML file. Every problem is a ConfigError starting "file:line:col:".
-[[nodiscard]] RobotModel load_robot(const std::filesystem::path& file);
-
-/// Loads a robot from a table (the root of a robot file, or a table embedded in another file).
-[[nodiscard]] RobotModel load_robot(const TableReader& table);
-
-/// Reads the key `task` of a robot or scenario table into spec.task and spec.task_axes: "position", "pose", or an
-/// array naming a subset of the pose's rows in order (e.g. ["x", "y", "z", "wz"]). spec.kind must be set.
-void read_task(const TableReader& table, RobotSpec& spec);
+/// The rows of a pose task, in order ("x", "y", "phi" planar; "x", "y", "z", "wx", "wy", "wz" spatial); a position
+/// task has the first two (planar) or three (spatial).
+[[nodiscard]] const std::vector<std::string>& pose_row_names(ChainKind kind);
 
 /// Text name of an enum value ("planar", "revolute", "dh", "position", ...).
 [[nodiscard]] const char* to_string(ChainKind kind);

@@ -9,8 +9,8 @@
 #include <string>
 #include <utility>
 
-#include "redres/registry.hpp"
-#include "redres/toml_reader.hpp"
+#include "redres/config/config.hpp"
+#include "redres/config/toml_reader.hpp"
 
 namespace redres {
 
@@ -28,7 +28,7 @@ struct UndefinedAt {
 
 /// A velocity-limit law. Immutable after construction; bounds() is allocation-free. A law is a plugin with a typed
 /// Config (config.hpp): derive from Configured<VelocityLimitLaw, MyConfig> and register with
-/// velocity_limit_registry().add_plugin<MyLaw>("summary").
+/// velocity_limit_registry().add_plugin<MyLaw>("summary") (parsers/velocity_limit_registry.hpp).
 class VelocityLimitLaw {
  public:
   VelocityLimitLaw(const VelocityLimitLaw&) = delete;
@@ -57,15 +57,6 @@ class VelocityLimitLaw {
   virtual void write_config(toml::table& out) const = 0;
   std::string type_;
 };
-
-/// The registry of velocity-limit laws.
-using VelocityLimitRegistry = Registry<VelocityLimitLaw>;
-
-/// The process-wide registry of velocity-limit laws (function-local static).
-VelocityLimitRegistry& velocity_limit_registry();
-
-/// Builds a law from a [joints.velocity_limit] table (`type` and the law's keys); strict (unknown keys rejected).
-[[nodiscard]] std::unique_ptr<VelocityLimitLaw> make_velocity_limit(const TableReader& table);
 
 /// Number of positions (including both ends) at which a law is sampled at load.
 inline constexpr int kVelocityLawSamples = 2001;

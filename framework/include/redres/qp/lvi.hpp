@@ -23,8 +23,9 @@
 
 #include <Eigen/Core>
 
-#include "redres/qp.hpp"
-#include "redres/registry.hpp"
+#include "redres/config/config.hpp"
+#include "redres/config/toml_reader.hpp"
+#include "redres/qp/qp.hpp"
 
 namespace redres {
 
@@ -141,21 +142,5 @@ struct RowFit {
 
 /// ||e(u)||_2 of the LVI (eq. 14) at u = [x; y; z].
 [[nodiscard]] double lvi_residual(const QpProblem& qp, const SolverResult& u, double varpi);
-
-/// The registry of engines. An engine is a plugin with its own Config (engine-specific keys in the [solver]
-/// table; the built-in engines have none) and receives the common SolverSettings.
-using EngineRegistry = Registry<LviEngine, const SolverSettings&>;
-/// The process-wide engine registry.
-EngineRegistry& engine_registry();
-
-/// Reads the [solver] table's common keys (`engine`, `tolerance`, `varpi`, `max_iterations`, `warm_start`) and
-/// builds the engine; unknown keys are ConfigErrors.
-[[nodiscard]] std::unique_ptr<LviEngine> make_engine(const TableReader& solver);
-
-/// Builds an engine by name with the given settings and its default Config (for code that does not read TOML).
-[[nodiscard]] std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSettings& settings = {});
-
-/// The [solver] table's `engine` key and the common settings, for the listing.
-[[nodiscard]] const std::vector<KeyInfo>& solver_common_keys();
 
 }  // namespace redres

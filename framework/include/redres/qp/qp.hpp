@@ -17,7 +17,7 @@
 
 #include <Eigen/Core>
 
-#include "redres/error.hpp"
+#include "redres/common/error.hpp"
 
 namespace redres {
 

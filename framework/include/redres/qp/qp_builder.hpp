@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-#include "redres/qp.hpp"
+#include "redres/qp/qp.hpp"
 
 namespace redres {
 

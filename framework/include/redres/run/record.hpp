@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "redres/toml_reader.hpp"
+#include "redres/config/toml_reader.hpp"
 
 namespace redres {
 

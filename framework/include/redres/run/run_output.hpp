@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "redres/record.hpp"
-#include "redres/run_summary.hpp"
+#include "redres/run/record.hpp"
+#include "redres/run/run_summary.hpp"
 
 namespace redres {
 

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "redres/collision.hpp"
-#include "redres/plugin.hpp"
-#include "redres/simulation.hpp"
+#include "redres/model/collision.hpp"
+#include "redres/control/plugin.hpp"
+#include "redres/run/simulation.hpp"
 
 namespace redres {
 

@@ -24,8 +24,8 @@
 #include <string>
 #include <vector>
 
-#include "redres/controller.hpp"
-#include "redres/record.hpp"
+#include "redres/control/controller.hpp"
+#include "redres/run/record.hpp"
 
 namespace redres {
 

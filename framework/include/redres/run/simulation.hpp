@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "redres/scenario.hpp"
-#include "redres/trajectory.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/trajectory.hpp"
 
 namespace redres {
 

@@ -35,7 +35,7 @@
 
 #include <Eigen/Core>
 
-#include "redres/run_output.hpp"
+#include "redres/run/run_output.hpp"
 
 namespace redres {
 

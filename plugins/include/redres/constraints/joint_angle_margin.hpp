@@ -6,7 +6,7 @@
 /// Reports to the run summary: `max_safety_region_entry` (the deepest entry of any joint into its safety region,
 /// rad or m) and `safety_margin` (the margin per joint).
 
-#include "redres/plugin.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres {
 

@@ -3,7 +3,7 @@
 /// `joint_velocity_limits`: the robot's per-joint velocity-limit laws as bounds (eq. 8, VJVL),
 ///   scale theta_dot^-(theta) <= x <= scale theta_dot^+(theta).
 
-#include "redres/plugin.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres {
 

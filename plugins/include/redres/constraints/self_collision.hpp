@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "redres/collision.hpp"
-#include "redres/collision_rows.hpp"
-#include "redres/plugin.hpp"
+#include "redres/model/collision.hpp"
+#include "redres/control/collision_rows.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres {
 

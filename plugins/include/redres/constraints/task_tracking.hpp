@@ -9,7 +9,7 @@
 /// orientation error over the run (the angle between the desired and the actual orientation; for a subset, the norm
 /// of the rotation-vector error's task rows).
 
-#include "redres/plugin.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres {
 

@@ -4,7 +4,7 @@
 /// on the whole LVI (globalised by the method of multipliers) with inequality rows or a dense W; an infeasible step
 /// falls back to projection. Build it with engine_registry().create("newton", NewtonConfig{}, settings).
 
-#include "redres/lvi.hpp"
+#include "redres/qp/lvi.hpp"
 
 namespace redres {
 

@@ -3,7 +3,7 @@
 /// `nlopt`: NLopt's SLSQP on the QP itself, an independent cross-check (NLopt allocates its work array in every
 /// solve). Build it with engine_registry().create("nlopt", NloptConfig{}, settings).
 
-#include "redres/lvi.hpp"
+#include "redres/qp/lvi.hpp"
 
 namespace redres {
 

@@ -4,7 +4,7 @@
 /// convergence; the reference for fidelity). Build it with
 ///   engine_registry().create("projection", ProjectionConfig{}, SolverSettings{.tolerance = 1e-6});
 
-#include "redres/lvi.hpp"
+#include "redres/qp/lvi.hpp"
 
 namespace redres {
 

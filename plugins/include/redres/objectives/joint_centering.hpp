@@ -5,7 +5,7 @@
 
 #include <optional>
 
-#include "redres/plugin.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres {
 

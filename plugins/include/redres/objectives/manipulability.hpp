@@ -20,8 +20,8 @@
 #include <optional>
 #include <string>
 
-#include "redres/formula.hpp"
-#include "redres/plugin.hpp"
+#include "redres/common/formula.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres {
 

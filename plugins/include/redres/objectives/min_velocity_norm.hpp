@@ -3,7 +3,7 @@
 /// `min_velocity_norm`: the minimum-velocity-norm term x'x/2 (MVN; with no other objective this is the paper's
 /// p = 0 scheme). Adds W += weight * I. No keys of its own.
 
-#include "redres/plugin.hpp"
+#include "redres/control/plugin.hpp"
 
 namespace redres {
 

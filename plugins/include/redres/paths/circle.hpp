@@ -7,7 +7,7 @@
 #include <array>
 #include <optional>
 
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
 
 namespace redres {
 

@@ -5,7 +5,7 @@
 
 #include <array>
 
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
 
 namespace redres {
 

@@ -9,7 +9,7 @@
 /// The shape prefers a rotation of 180 degrees (upright, the R leaves the arm's workspace) and per-stroke timing,
 /// so r_d_dot is continuous at every corner.
 
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
 
 namespace redres {
 

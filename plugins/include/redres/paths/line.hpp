@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
 
 namespace redres {
 

@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
 
 namespace redres {
 

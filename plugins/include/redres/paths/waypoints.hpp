@@ -6,7 +6,7 @@
 
 #include <filesystem>
 
-#include "redres/path.hpp"
+#include "redres/control/path.hpp"
 
 namespace redres {
 

@@ -6,8 +6,8 @@
 
 #include <string>
 
-#include "redres/formula.hpp"
-#include "redres/velocity_limit.hpp"
+#include "redres/common/formula.hpp"
+#include "redres/model/velocity_limit.hpp"
 
 namespace redres {
 

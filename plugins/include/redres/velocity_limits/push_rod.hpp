@@ -8,7 +8,7 @@
 
 #include <limits>
 
-#include "redres/velocity_limit.hpp"
+#include "redres/model/velocity_limit.hpp"
 
 namespace redres {
 

@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-#include "redres/velocity_limit.hpp"
+#include "redres/model/velocity_limit.hpp"
 
 namespace redres {
 

@@ -13,7 +13,7 @@
 
 #include <Eigen/Geometry>
 
-#include "redres/collision.hpp"
+#include "redres/model/collision.hpp"
 
 namespace redres {
 

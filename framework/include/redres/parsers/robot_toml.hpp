@@ -1,0 +1,23 @@
+#pragma once
+/// @file
+/// The robot file (TOML) parser: fills a RobotSpec from a robot file or table, joining in a URDF chain where the
+/// file names one (`urdf = "..."`), and builds the RobotModel. Keys: docs/robot_format.md.
+
+#include <filesystem>
+
+#include "redres/config/toml_reader.hpp"
+#include "redres/model/robot.hpp"
+
+namespace redres {
+
+/// Loads a robot TOML file. Every problem is a ConfigError starting "file:line:col:".
+[[nodiscard]] RobotModel load_robot(const std::filesystem::path& file);
+
+/// Loads a robot from a table (the root of a robot file, or a table embedded in another file).
+[[nodiscard]] RobotModel load_robot(const TableReader& table);
+
+/// Reads the key `task` of a robot or scenario table into spec.task and spec.task_axes: "position", "pose", or an
+/// array naming a subset of the pose's rows in order (e.g. ["x", "y", "z", "wz"]). spec.kind must be set.
+void read_task(const TableReader& table, RobotSpec& spec);
+
+}  // namespace redres

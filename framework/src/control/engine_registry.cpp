@@ -1,0 +1,63 @@
+#include "redres/control/engine_registry.hpp"
+
+#include <string>
+
+namespace redres {
+
+namespace {
+// `engine` itself, so that the listing and the reading share one definition.
+struct EngineChoice {
+  std::string engine = "projection";
+  static const Schema<EngineChoice>& schema() {
+    static const Schema<EngineChoice> s{{field("engine", &EngineChoice::engine, "", "the LVI engine (see below)")}};
+    return s;
+  }
+};
+}  // namespace
+
+EngineRegistry& engine_registry() {
+  static EngineRegistry registry("LVI engine");
+  return registry;
+}
+
+const std::vector<KeyInfo>& solver_common_keys() {
+  static const std::vector<KeyInfo> keys = [] {
+    std::vector<KeyInfo> k = describe_keys(EngineChoice::schema());
+    for (auto& x : describe_keys(SolverSettings::schema())) k.push_back(std::move(x));
+    return k;
+  }();
+  return keys;
+}
+
+std::unique_ptr<LviEngine> make_engine(const TableReader& solver) {
+  EngineChoice choice;
+  read_config(solver, EngineChoice::schema(), choice);
+  const EngineRegistry& reg = engine_registry();
+  const auto* entry = reg.find(choice.engine);
+  if (entry == nullptr) {
+    std::string names;
+    for (const auto* e : reg.entries()) names += (names.empty() ? "'" : ", '") + e->type + "'";
+    solver.fail("engine", "expected one of " + names + ", got '" + choice.engine + "'");
+  }
+  SolverSettings s;
+  read_config(solver, SolverSettings::schema(), s);
+  const std::any config = entry->read(solver);
+  solver.finish();
+  try {
+    return entry->make(config, s);
+  } catch (const FieldError& e) {
+    rethrow_at(solver, e);
+  }
+}
+
+std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSettings& settings) {
+  const auto* e = engine_registry().find(name);
+  if (e == nullptr) {
+    throw std::invalid_argument("make_engine: unknown engine '" + name +
+                                "'; known engines: " + engine_registry().names());
+  }
+  require_valid(settings, SolverSettings::schema(), "make_engine(" + name + ")");
+  return e->make(e->defaults, settings);
+}
+
+}  // namespace redres

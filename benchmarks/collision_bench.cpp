@@ -8,14 +8,14 @@
 #include <benchmark/benchmark.h>
 
 #include "qp_util.hpp"
-#include "redres/model/collision.hpp"
 #include "redres/constraints/obstacle_avoidance.hpp"
 #include "redres/constraints/self_collision.hpp"
-#include "redres/qp/lvi.hpp"
-#include "redres/control/scheme.hpp"
-#include "redres/run/simulation.hpp"
 #include "redres/control/engine_registry.hpp"
+#include "redres/control/scheme.hpp"
+#include "redres/model/collision.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/run/simulation.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -63,13 +63,14 @@ void BM_CollisionStep(benchmark::State& state) {
       std::make_unique<redres::SelfCollision>(redres::SelfCollision::Config{.influence_distance = 2.0}, robot));
   const redres::Scheme scheme(robot, {}, std::move(constraints));
   redres::QpProblem qp;
-  scheme.setup(qp);
+  redres::SchemeData scheme_data = scheme.make_data();
+  scheme.setup(qp, scheme_data);
   redres::KinematicsData kin(robot);
   Eigen::VectorXd theta = robot.home();
   redres::compute_kinematics(robot, theta, kin, redres::KinematicsLevel::kJacobian);
   redres::Context ctx{0.0, 10.0, 0.01, &robot, &kin, nullptr, nullptr};
   for (auto _ : state) {
-    scheme.build(ctx, qp);
+    scheme.build(ctx, qp, scheme_data);
     benchmark::DoNotOptimize(qp.b.data());
   }
   state.counters["pairs"] = qp.m_in();
@@ -102,14 +103,15 @@ void BM_ClutterStep(benchmark::State& state) {
       robot));
   const redres::Scheme scheme(robot, {}, std::move(constraints));
   redres::QpProblem qp;
-  scheme.setup(qp);
+  redres::SchemeData scheme_data = scheme.make_data();
+  scheme.setup(qp, scheme_data);
   redres::KinematicsData kin(robot);
   Eigen::VectorXd theta = robot.home();
   redres::Context ctx{0.0, 10.0, 0.01, &robot, &kin, nullptr, nullptr};
   for (auto _ : state) {
     theta(0) += 1e-4;
     redres::compute_kinematics(robot, theta, kin, redres::KinematicsLevel::kJacobian);
-    scheme.build(ctx, qp);
+    scheme.build(ctx, qp, scheme_data);
     benchmark::DoNotOptimize(qp.b.data());
   }
   state.counters["pairs"] = qp.m_in();

@@ -13,8 +13,8 @@
 #include <benchmark/benchmark.h>
 
 #include "qp_util.hpp"
-#include "test_util.hpp"
 #include "redres/control/engine_registry.hpp"
+#include "test_util.hpp"
 
 namespace {
 

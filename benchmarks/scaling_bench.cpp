@@ -13,9 +13,9 @@
 #include "redres/constraints/joint_velocity_limits.hpp"
 #include "redres/constraints/task_tracking.hpp"
 #include "redres/control/controller.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "redres/objectives/manipulability.hpp"
 #include "redres/objectives/min_velocity_norm.hpp"
-#include "redres/control/engine_registry.hpp"
 
 namespace redres {
 namespace {

@@ -1,18 +1,25 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds everything, and runs every test: first in the optimised release build, then in
 # the debug build with AddressSanitizer and UndefinedBehaviorSanitizer, then the fuzz targets. This is the command CI
-# runs.
+# runs. Each stage prints how long it took, and the last line sums them up.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install_deps.sh
 jobs="$(nproc 2>/dev/null || echo 2)"
+times=()
+stage() {  # stage NAME COMMAND...: runs the command and records its wall time
+  local name="$1" start=$SECONDS
+  shift
+  echo "==> [$name]"
+  "$@"
+  times+=("$name $((SECONDS - start)) s")
+  echo "==> [$name] took $((SECONDS - start)) s"
+}
+stage install bash scripts/install_deps.sh
 for preset in release debug-asan; do
-  echo "==> [$preset] build"
-  bash scripts/build.sh "$preset"
-  echo "==> [$preset] test"
-  ctest --preset "$preset" -j "$jobs"
+  stage "$preset build" bash scripts/build.sh "$preset"
+  stage "$preset test" ctest --preset "$preset" -j "$jobs"
 done
 # Then the libFuzzer targets (docs/fuzzing.md): the `fuzz` preset (clang, ASan + UBSan), each target fuzzed for 60 s
 # from the repository's seed corpus; a crash, leak, sanitizer report, timeout or out-of-memory fails the run.
-echo "==> [fuzz] build and run"
-bash scripts/fuzz.sh 60
+stage fuzz bash scripts/fuzz.sh 60
+echo "test.sh: stage times: $(IFS=';'; echo "${times[*]}"); total $SECONDS s"

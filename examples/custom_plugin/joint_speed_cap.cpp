@@ -37,7 +37,7 @@ class JointSpeedCap final : public redres::Configured<redres::Constraint, JointS
   }
 
  private:
-  void add_to(const redres::Context& /*ctx*/, redres::QpBuilder& builder) const override {
+  void add_to(const redres::Context& /*ctx*/, redres::QpBuilder& builder, redres::PluginData* /*data*/) const override {
     auto A = builder.inequality_matrix();
     A.setZero();
     for (std::size_t k = 0; k < config_.joints.size(); ++k) {

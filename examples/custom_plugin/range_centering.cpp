@@ -33,7 +33,7 @@ class RangeCentering final : public redres::Configured<redres::Objective, RangeC
   }
 
  private:
-  void add_to(const redres::Context& ctx, redres::QpBuilder& builder) const override {
+  void add_to(const redres::Context& ctx, redres::QpBuilder& builder, redres::PluginData* /*data*/) const override {
     Eigen::VectorXd& z = builder.scratch();  // workspace: no allocation on the per-step path
     z = config_.lambda * (ctx.theta() - mid_).cwiseProduct(inv_half_sq_);
     builder.add_linear(z);

@@ -8,12 +8,12 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "redres/qp/lvi.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/plugin.hpp"
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
-#include "redres/control/engine_registry.hpp"
+#include "redres/qp/lvi.hpp"
 
 namespace redres::cli {
 

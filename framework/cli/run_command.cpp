@@ -26,6 +26,7 @@
 #include "commands.hpp"
 #include "progress.hpp"
 #include "redres/common/csv.hpp"
+#include "redres/run/comparison.hpp"
 #include "redres/run/run_output.hpp"
 #include "redres/run/scenario.hpp"
 #include "stop_signals.hpp"
@@ -235,18 +236,6 @@ void record_new_files(const std::filesystem::path& dir, const Listing& before) {
   add_to_output_manifest(dir, added);
 }
 
-std::string table_row(const std::vector<std::string>& cells) {
-  std::string s = "|";
-  for (const auto& c : cells) s += " " + c + " |";
-  return s + "\n";
-}
-
-std::string num(double v, int precision = 6) {
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
-}
-
 }  // namespace
 
 void add_run_commands(CLI::App& app, Action& action) {
@@ -344,13 +333,8 @@ void add_run_commands(CLI::App& app, Action& action) {
         dirs.push_back(name);
       }
       prepare_output_dir(out);
-      std::string md =
-          table_row({"scenario", "engine", "max position error (m)", "w(0)", "w(T)", "min w", "mean w",
-                     "norm theta_dot(0)", "norm theta_dot(T)", "mean iterations", "failures", "wall time (s)"});
-      md += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-      std::string csv =
-          "scenario,engine,max_position_error,w_initial,w_final,w_min,w_mean,initial_joint_velocity_norm,"
-          "final_joint_velocity_norm,mean_iterations,failures,wall_time_s\n";
+      std::string md = comparison_markdown_heading();
+      std::string csv = comparison_csv_heading();
       std::vector<std::string> plot_args = {"--compare"};
       int failures = 0;
       bool interrupted = false;
@@ -358,26 +342,8 @@ void add_run_commands(CLI::App& app, Action& action) {
         const std::filesystem::path dir = out / dirs[i];
         const Outcome o = run_one(std::move(scenarios[i]), dir, opts->quiet);
         failures += o.run.failures;
-        const RunSummary& s = o.summary;
-        const std::vector<std::string> cells = {s.name,
-                                                s.solver.engine,
-                                                num(s.max_position_error, 4),
-                                                num(s.manipulability.initial),
-                                                num(s.manipulability.final),
-                                                num(s.manipulability.min),
-                                                num(s.manipulability.mean),
-                                                num(s.initial_joint_velocity_norm, 4),
-                                                num(s.final_joint_velocity_norm, 4),
-                                                num(s.solver.mean_iterations, 4),
-                                                std::to_string(s.solver.failures),
-                                                num(s.wall_time_s, 3)};
-        std::vector<std::string> md_cells = cells;
-        for (auto& c : md_cells) {
-          for (std::size_t at = c.find('|'); at != std::string::npos; at = c.find('|', at + 2)) c.replace(at, 1, "\\|");
-        }
-        md += table_row(md_cells);
-        for (std::size_t c = 0; c < cells.size(); ++c) csv += (c ? "," : "") + csv_field(cells[c]);
-        csv += "\n";
+        md += comparison_markdown_row(o.summary);
+        csv += comparison_csv_row(o.summary);
         plot_args.push_back(dir.string());
         if (o.run.interrupted || g_stop_requested.load()) {
           interrupted = true;  // the runs after it do not start

@@ -25,7 +25,7 @@ JointAngleMargin::JointAngleMargin(const Config& config, const RobotModel& robot
   }
 }
 
-void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder) const {
+void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
   const double kappa = config_.kappa;
@@ -34,7 +34,8 @@ void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder) const {
   builder.intersect_bounds(builder.scratch(), builder.scratch2());
 }
 
-void JointAngleMargin::summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const {
+void JointAngleMargin::summarise(const RobotModel& robot, const Trajectory& run, const PluginData* /*data*/,
+                                 std::vector<Metric>& out) const {
   double entry = 0.0;
   for (int j = 0; j < robot.dof(); ++j) {
     const std::size_t c = run.column("theta_" + std::to_string(j + 1));

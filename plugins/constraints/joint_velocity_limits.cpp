@@ -14,7 +14,7 @@ const Schema<JointVelocityLimitsConfig>& JointVelocityLimitsConfig::schema() {
 JointVelocityLimits::JointVelocityLimits(const Config& config, const RobotModel& /*robot*/)
     : Configured(kType, config) {}
 
-void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder) const {
+void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
   const double scale = config_.scale;

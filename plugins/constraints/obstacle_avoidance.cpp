@@ -5,9 +5,20 @@
 #include <limits>
 #include <sstream>
 
-#include "redres/run/trajectory.hpp"
-
 namespace redres {
+
+// One controller's data: the query (and its tree), the distances, and a step's scratch: the witness point's
+// Jacobian, whether the tree holds the obstacles' poses yet, the obstacles' poses this step, and the candidates
+// near() returns for one link shape.
+struct ObstacleAvoidance::Data : PairData {
+  Data(const std::vector<ShapeSpec>& shapes, int pairs, Damper damper, int dof) : PairData(shapes, pairs, damper) {
+    jacobian.setZero(3, dof);
+  }
+  Eigen::Matrix3Xd jacobian;
+  bool placed = false;
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<int> candidates;
+};
 
 const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
   using C = ObstacleAvoidanceConfig;
@@ -33,7 +44,9 @@ const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
 }
 
 ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& robot)
-    : PairConstraint(kType, config), robot_(&robot) {
+    : PairConstraint(kType, config),
+      PairOutput(*this, "min_obstacle_distance", "obstacle_rows_active"),
+      robot_(&robot) {
   const auto& links = robot.link_shapes();
   if (links.empty()) {
     throw FieldError(
@@ -41,7 +54,7 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
         "robot '" + robot.name() + "' has no collision shapes: give its joints `collision` shapes (docs/collision.md)");
   }
   const bool planar = robot.kind() == ChainKind::kPlanar;
-  std::vector<ShapeSpec> shapes;
+  std::vector<ShapeSpec>& shapes = shapes_;
   for (const auto& l : links) shapes.push_back(l.spec);
   for (std::size_t k = 0; k < config_.obstacles.size(); ++k) {
     const ShapeSpec& o = config_.obstacles[k];
@@ -54,10 +67,7 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
   }
   links_ = static_cast<int>(links.size());
   obstacles_ = static_cast<int>(config_.obstacles.size());
-  query_ = std::make_unique<DistanceQuery>(shapes);
-  jacobian_.setZero(3, robot.dof());
-  distances_ = PairDistances(links_ * obstacles_, {config.influence_distance, config.safety_distance, config.xi},
-                             "min_obstacle_distance", "obstacle_rows_active");
+  (void)DistanceQuery(shapes);  // checks the shapes' sizes now, naming the shape, rather than at the first run
   using B = Config::Broadphase;
   broadphase_ =
       config_.broadphase == B::kAlways || (config_.broadphase == B::kAuto && links_ * obstacles_ > kBroadphasePairs);
@@ -67,14 +77,21 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
     velocities_.push_back(o.velocity ? Eigen::Vector3d(o.velocity->data()) : Eigen::Vector3d::Zero());
     moving_ = moving_ || o.velocity.has_value();
   }
-  if (broadphase_) {
-    query_->build_broadphase(links_, obstacles_);
-    poses_.resize(static_cast<std::size_t>(obstacles_));
-    candidates_.resize(static_cast<std::size_t>(obstacles_));
-  }
 }
 
 ObstacleAvoidance::~ObstacleAvoidance() = default;
+
+std::unique_ptr<PluginData> ObstacleAvoidance::make_data() const {
+  auto data =
+      std::make_unique<Data>(shapes_, links_ * obstacles_,
+                             Damper{config_.influence_distance, config_.safety_distance, config_.xi}, robot_->dof());
+  if (broadphase_) {
+    data->query.build_broadphase(links_, obstacles_);
+    data->poses.resize(static_cast<std::size_t>(obstacles_));
+    data->candidates.resize(static_cast<std::size_t>(obstacles_));
+  }
+  return data;
+}
 
 int ObstacleAvoidance::inequality_rows(const RobotModel& /*robot*/) const { return links_ * obstacles_; }
 
@@ -84,49 +101,50 @@ Eigen::Isometry3d ObstacleAvoidance::obstacle_pose(int k, double t) const {
   return T;
 }
 
-void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder) const {
+void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder, PluginData* plugin_data) const {
+  Data& data = pair_data<Data>(plugin_data);
   const KinematicsData& kin = *ctx.kinematics;
   auto A = builder.inequality_matrix();
   auto b = builder.inequality_rhs();
   const auto& links = robot_->link_shapes();
   if (broadphase_) {
-    add_near_pairs(ctx, builder);
+    add_near_pairs(data, ctx, builder);
     return;
   }
   for (int o = 0; o < obstacles_; ++o) {
     const Eigen::Isometry3d To = obstacle_pose(o, ctx.t);
     for (int l = 0; l < links_; ++l) {
       const auto& shape = links[static_cast<std::size_t>(l)];
-      pair_row(kin, l, kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose, o, To, A, b);
+      pair_row(data, kin, l, kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose, o, To, A, b);
     }
   }
 }
 
-void ObstacleAvoidance::pair_row(const KinematicsData& kin, int l, const Eigen::Isometry3d& Tl, int o,
+void ObstacleAvoidance::pair_row(Data& data, const KinematicsData& kin, int l, const Eigen::Isometry3d& Tl, int o,
                                  const Eigen::Isometry3d& To, Eigen::Block<Eigen::MatrixXd>& A,
                                  Eigen::VectorBlock<Eigen::VectorXd>& b) const {
   const int row = o * links_ + l;
-  const ShapeDistance d = query_->distance(l, Tl, links_ + o, To);
+  const ShapeDistance d = data.query.distance(l, Tl, links_ + o, To);
   Eigen::Vector3d n;
-  if (!distances_.take(row, d, planar_, Tl.translation() - To.translation(), n)) {
+  if (!data.distances.take(row, d, planar_, Tl.translation() - To.translation(), n)) {
     slack_row(A.row(row), b(row));
     return;
   }
-  point_jacobian(*robot_, kin, robot_->link_shapes()[static_cast<std::size_t>(l)].link, d.point_a, jacobian_);
-  damper_row(distances_.damper(), d.distance, n, jacobian_, velocities_[static_cast<std::size_t>(o)], A.row(row),
-             b(row));
+  point_jacobian(*robot_, kin, robot_->link_shapes()[static_cast<std::size_t>(l)].link, d.point_a, data.jacobian);
+  damper_row(data.distances.damper(), d.distance, n, data.jacobian, velocities_[static_cast<std::size_t>(o)],
+             A.row(row), b(row));
 }
 
-void ObstacleAvoidance::add_near_pairs(const Context& ctx, QpBuilder& builder) const {
+void ObstacleAvoidance::add_near_pairs(Data& data, const Context& ctx, QpBuilder& builder) const {
   const KinematicsData& kin = *ctx.kinematics;
   auto A = builder.inequality_matrix();
   auto b = builder.inequality_rhs();
   const auto& links = robot_->link_shapes();
   // The tree holds the obstacles' boxes: static ones are placed once, moving ones moved and refitted every step.
-  if (moving_ || !placed_) {
-    for (int o = 0; o < obstacles_; ++o) poses_[static_cast<std::size_t>(o)] = obstacle_pose(o, ctx.t);
-    query_->move_group(poses_.data());
-    placed_ = true;
+  if (moving_ || !data.placed) {
+    for (int o = 0; o < obstacles_; ++o) data.poses[static_cast<std::size_t>(o)] = obstacle_pose(o, ctx.t);
+    data.query.move_group(data.poses.data());
+    data.placed = true;
   }
   for (int l = 0; l < links_; ++l) {
     const auto& shape = links[static_cast<std::size_t>(l)];
@@ -134,25 +152,26 @@ void ObstacleAvoidance::add_near_pairs(const Context& ctx, QpBuilder& builder) c
     // Every pair of this link shape is beyond d_i unless the tree says otherwise.
     for (int o = 0; o < obstacles_; ++o) {
       const int row = o * links_ + l;
-      distances_.beyond(row);
+      data.distances.beyond(row);
       slack_row(A.row(row), b(row));
     }
-    const int count = query_->near(l, Tl, distances_.damper().influence_distance, candidates_.data());
+    const int count = data.query.near(l, Tl, data.distances.damper().influence_distance, data.candidates.data());
     for (int k = 0; k < count; ++k) {
-      const int o = candidates_[static_cast<std::size_t>(k)] - links_;
-      pair_row(kin, l, Tl, o, poses_[static_cast<std::size_t>(o)], A, b);
+      const int o = data.candidates[static_cast<std::size_t>(k)] - links_;
+      pair_row(data, kin, l, Tl, o, data.poses[static_cast<std::size_t>(o)], A, b);
     }
   }
 }
 
-std::string ObstacleAvoidance::describe_inequality_row(int row) const {
-  if (row < 0 || row >= links_ * obstacles_) return {};
+std::string ObstacleAvoidance::describe_inequality_row(const PluginData* data, int row) const {
+  if (row < 0 || row >= links_ * obstacles_ || data == nullptr) return {};
   const int o = row / links_, l = row % links_;
   const auto& shape = robot_->link_shapes()[static_cast<std::size_t>(l)];
   std::ostringstream s;
   s.precision(4);
   s << "link '" << robot_->joint(shape.link).name << "' " << shape.spec.describe() << " vs obstacle " << o + 1 << " "
-    << config_.obstacles[static_cast<std::size_t>(o)].describe() << " at distance " << distances_[row] << " m";
+    << config_.obstacles[static_cast<std::size_t>(o)].describe() << " at distance " << pair_data(data).distances[row]
+    << " m";
   return s.str();
 }
 

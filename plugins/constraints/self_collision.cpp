@@ -5,9 +5,16 @@
 #include <limits>
 #include <sstream>
 
-#include "redres/run/trajectory.hpp"
-
 namespace redres {
+
+// One controller's data: the query, the distances, and the Jacobians of the two witness points.
+struct SelfCollision::Data : PairData {
+  Data(const std::vector<ShapeSpec>& shapes, int pairs, Damper damper, int dof) : PairData(shapes, pairs, damper) {
+    ja.setZero(3, dof);
+    jb.setZero(3, dof);
+  }
+  Eigen::Matrix3Xd ja, jb;
+};
 
 const Schema<SelfCollisionConfig>& SelfCollisionConfig::schema() {
   using C = SelfCollisionConfig;
@@ -21,14 +28,13 @@ const Schema<SelfCollisionConfig>& SelfCollisionConfig::schema() {
 }
 
 SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
-    : PairConstraint(kType, config), robot_(&robot) {
+    : PairConstraint(kType, config), PairOutput(*this, "min_self_distance", "self_rows_active"), robot_(&robot) {
   const auto& links = robot.link_shapes();
   if (links.empty()) {
     throw FieldError("", "robot '" + robot.name() +
                              "' has no collision shapes: give its joints `collision` shapes (docs/collision.md)");
   }
-  std::vector<ShapeSpec> shapes;
-  for (const auto& l : links) shapes.push_back(l.spec);
+  for (const auto& l : links) shapes_.push_back(l.spec);
   for (std::size_t i = 0; i < links.size(); ++i) {
     for (std::size_t j = i + 1; j < links.size(); ++j) {
       if (robot.self_collision_pair(links[i].link, links[j].link)) {
@@ -36,19 +42,20 @@ SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
       }
     }
   }
-  query_ = std::make_unique<DistanceQuery>(shapes);
-  ja_.setZero(3, robot.dof());
-  jb_.setZero(3, robot.dof());
-  distances_ =
-      PairDistances(static_cast<int>(pairs_.size()), {config.influence_distance, config.safety_distance, config.xi},
-                    "min_self_distance", "self_rows_active");
+  (void)DistanceQuery(shapes_);  // checks the shapes' sizes now, naming the shape, rather than at the first run
 }
 
 SelfCollision::~SelfCollision() = default;
 
+std::unique_ptr<PluginData> SelfCollision::make_data() const {
+  return std::make_unique<Data>(shapes_, static_cast<int>(pairs_.size()),
+                                Damper{config_.influence_distance, config_.safety_distance, config_.xi}, robot_->dof());
+}
+
 int SelfCollision::inequality_rows(const RobotModel& /*robot*/) const { return static_cast<int>(pairs_.size()); }
 
-void SelfCollision::add_to(const Context& ctx, QpBuilder& builder) const {
+void SelfCollision::add_to(const Context& ctx, QpBuilder& builder, PluginData* plugin_data) const {
+  Data& data = pair_data<Data>(plugin_data);
   const KinematicsData& kin = *ctx.kinematics;
   const bool planar = robot_->kind() == ChainKind::kPlanar;
   auto A = builder.inequality_matrix();
@@ -59,29 +66,30 @@ void SelfCollision::add_to(const Context& ctx, QpBuilder& builder) const {
     const auto& sb = links[static_cast<std::size_t>(pairs_[row].second)];
     const Eigen::Isometry3d Ta = kin.link_frames[static_cast<std::size_t>(sa.link)] * sa.pose;
     const Eigen::Isometry3d Tb = kin.link_frames[static_cast<std::size_t>(sb.link)] * sb.pose;
-    const ShapeDistance d = query_->distance(pairs_[row].first, Ta, pairs_[row].second, Tb);
+    const ShapeDistance d = data.query.distance(pairs_[row].first, Ta, pairs_[row].second, Tb);
     const auto r = static_cast<Eigen::Index>(row);
     Eigen::Vector3d n;
-    if (!distances_.take(static_cast<int>(row), d, planar, Ta.translation() - Tb.translation(), n)) {
+    if (!data.distances.take(static_cast<int>(row), d, planar, Ta.translation() - Tb.translation(), n)) {
       slack_row(A.row(r), b(r));
       continue;
     }
-    point_jacobian(*robot_, kin, sa.link, d.point_a, ja_);
-    point_jacobian(*robot_, kin, sb.link, d.point_b, jb_);
-    ja_ -= jb_;
-    damper_row(distances_.damper(), d.distance, n, ja_, Eigen::Vector3d::Zero(), A.row(r), b(r));
+    point_jacobian(*robot_, kin, sa.link, d.point_a, data.ja);
+    point_jacobian(*robot_, kin, sb.link, d.point_b, data.jb);
+    data.ja -= data.jb;
+    damper_row(data.distances.damper(), d.distance, n, data.ja, Eigen::Vector3d::Zero(), A.row(r), b(r));
   }
 }
 
-std::string SelfCollision::describe_inequality_row(int row) const {
-  if (row < 0 || row >= static_cast<int>(pairs_.size())) return {};
+std::string SelfCollision::describe_inequality_row(const PluginData* data, int row) const {
+  if (row < 0 || row >= static_cast<int>(pairs_.size()) || data == nullptr) return {};
   const auto& links = robot_->link_shapes();
   const auto& sa = links[static_cast<std::size_t>(pairs_[static_cast<std::size_t>(row)].first)];
   const auto& sb = links[static_cast<std::size_t>(pairs_[static_cast<std::size_t>(row)].second)];
   std::ostringstream s;
   s.precision(4);
   s << "link '" << robot_->joint(sa.link).name << "' " << sa.spec.describe() << " vs link '"
-    << robot_->joint(sb.link).name << "' " << sb.spec.describe() << " at distance " << distances_[row] << " m";
+    << robot_->joint(sb.link).name << "' " << sb.spec.describe() << " at distance " << pair_data(data).distances[row]
+    << " m";
   return s.str();
 }
 

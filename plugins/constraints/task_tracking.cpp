@@ -19,7 +19,7 @@ const Schema<TaskTrackingConfig>& TaskTrackingConfig::schema() {
 TaskTracking::TaskTracking(const Config& config, const RobotModel& robot)
     : Configured(kType, config), gain_(config_.gain.resolve(robot.task_dim(), "gain", "task row")) {}
 
-void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
+void TaskTracking::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
   REDRES_REQUIRE(ctx.r_d != nullptr && ctx.r_d_dot != nullptr, "task_tracking",
                  "the context carries the desired r_d and r_d_dot");
   const RobotModel& robot = *ctx.robot;
@@ -61,7 +61,8 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder) const {
   }
 }
 
-void TaskTracking::summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const {
+void TaskTracking::summarise(const RobotModel& robot, const Trajectory& run, const PluginData* /*data*/,
+                             std::vector<Metric>& out) const {
   if (!robot.has_orientation_rows()) return;
   // The run records the angle between the desired and the actual orientation at every step.
   const std::size_t c = run.column("orientation_error");

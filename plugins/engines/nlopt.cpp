@@ -14,8 +14,8 @@
 
 #include <Eigen/QR>
 
-#include "redres/engines/nlopt.hpp"
 #include "redres/control/engine_registry.hpp"
+#include "redres/engines/nlopt.hpp"
 
 namespace redres {
 namespace {

@@ -22,8 +22,8 @@
 #include <emmintrin.h>
 #endif
 
-#include "redres/engines/projection.hpp"
 #include "redres/control/engine_registry.hpp"
+#include "redres/engines/projection.hpp"
 
 namespace redres {
 namespace {

@@ -18,7 +18,7 @@ std::optional<double> JointCentering::potential(const Context& ctx) const {
   return 0.5 * config_.lambda * (ctx.theta() - theta_ref_).squaredNorm();
 }
 
-void JointCentering::add_to(const Context& ctx, QpBuilder& builder) const {
+void JointCentering::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
   Eigen::VectorXd& z = builder.scratch();
   z = config_.lambda * (ctx.theta() - theta_ref_);
   builder.add_linear(z);

@@ -97,7 +97,7 @@ std::optional<double> Manipulability::potential(const Context& ctx) const {
   return -coefficient(ctx.t, ctx.T) * value;
 }
 
-void Manipulability::add_to(const Context& ctx, QpBuilder& builder) const {
+void Manipulability::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
   const double p = coefficient(ctx.t, ctx.T);
   const KinematicsData& k = *ctx.kinematics;
   switch (config_.measure) {

@@ -12,7 +12,9 @@ MinVelocityNorm::MinVelocityNorm(const Config& config, const RobotModel& /*robot
 // W = I has no linear term: zeta stays zero, the gradient of a constant potential.
 std::optional<double> MinVelocityNorm::potential(const Context& /*ctx*/) const { return 0.0; }
 
-void MinVelocityNorm::add_to(const Context& /*ctx*/, QpBuilder& builder) const { builder.add_identity(); }
+void MinVelocityNorm::add_to(const Context& /*ctx*/, QpBuilder& builder, PluginData* /*data*/) const {
+  builder.add_identity();
+}
 
 namespace {
 const bool kRegistered =

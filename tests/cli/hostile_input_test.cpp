@@ -15,12 +15,12 @@
 #include <gtest/gtest.h>
 
 #include "cli_util.hpp"
-#include "redres/common/error.hpp"
 #include "common/input_file.hpp"
-#include "redres/run/scenario.hpp"
-#include "redres/run/simulation.hpp"
+#include "redres/common/error.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/model/velocity_limit.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/simulation.hpp"
 
 namespace redres {
 namespace {

@@ -10,17 +10,17 @@
 
 #include "redres/config/config.hpp"
 #include "redres/constraints/joint_angle_margin.hpp"
-#include "redres/engines/newton.hpp"
-#include "redres/qp/lvi.hpp"
-#include "redres/objectives/manipulability.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
-#include "redres/paths/letter_r.hpp"
 #include "redres/control/plugin.hpp"
 #include "redres/control/scheme.hpp"
+#include "redres/engines/newton.hpp"
 #include "redres/model/velocity_limit.hpp"
-#include "redres/parsers/velocity_limit_registry.hpp"
-#include "redres/control/engine_registry.hpp"
+#include "redres/objectives/manipulability.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/paths/letter_r.hpp"
+#include "redres/qp/lvi.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -248,8 +248,9 @@ TEST(Config, APluginBuiltInCppContributesExactlyAsTheSamePluginReadFromToml) {
   EXPECT_EQ(text_of(from_cpp.objectives()[0]->config()), text_of(from_toml.objectives()[0]->config()));
 
   QpProblem a, b;
-  from_toml.setup(a);
-  from_cpp.setup(b);
+  SchemeData data_a = from_toml.make_data(), data_b = from_cpp.make_data();
+  from_toml.setup(a, data_a);
+  from_cpp.setup(b, data_b);
   KinematicsData kin(robot);
   Context ctx{0.0, 40.0, 0.01, &robot, &kin, nullptr, nullptr};
   std::mt19937 rng(3);
@@ -259,8 +260,8 @@ TEST(Config, APluginBuiltInCppContributesExactlyAsTheSamePluginReadFromToml) {
     for (int j = 0; j < 6; ++j) theta(j) += 0.2 * u(rng);
     ctx.t = 40.0 * (u(rng) + 0.5);
     compute_kinematics(robot, theta, kin, KinematicsLevel::kAll);
-    from_toml.build(ctx, a);
-    from_cpp.build(ctx, b);
+    from_toml.build(ctx, a, data_a);
+    from_cpp.build(ctx, b, data_b);
     EXPECT_EQ(a.zeta, b.zeta);
     EXPECT_GT(a.zeta.norm(), 0.0);
   }

@@ -5,14 +5,14 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/extend/conformance.hpp"
-#include "redres/qp/lvi.hpp"
+#include "config/registration_scope.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/plugin.hpp"
+#include "redres/extend/conformance.hpp"
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
-#include "redres/control/engine_registry.hpp"
-#include "config/registration_scope.hpp"
+#include "redres/qp/lvi.hpp"
 
 namespace redres {
 namespace {
@@ -70,7 +70,7 @@ class WrongGradient final : public Configured<Objective, GainConfig> {
   }
 
  private:
-  void add_to(const Context& ctx, QpBuilder& b) const override {
+  void add_to(const Context& ctx, QpBuilder& b, PluginData* /*data*/) const override {
     Eigen::VectorXd& z = b.scratch();
     z = 2.0 * config_.gain * ctx.theta();
     b.add_linear(z);
@@ -84,7 +84,7 @@ class Undocumented final : public Constraint {
   Undocumented(const GainConfig& /*c*/, const RobotModel& /*robot*/) : Constraint(kType) {}
 
  private:
-  void add_to(const Context& /*ctx*/, QpBuilder& b) const override { b.scratch().setZero(); }
+  void add_to(const Context& /*ctx*/, QpBuilder& b, PluginData* /*data*/) const override { b.scratch().setZero(); }
   void write_config(toml::table& out) const override { out.insert("secret", 1.0); }
 };
 

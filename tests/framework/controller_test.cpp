@@ -9,15 +9,15 @@
 #include "redres/constraints/joint_velocity_limits.hpp"
 #include "redres/constraints/task_tracking.hpp"
 #include "redres/control/controller.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "redres/objectives/joint_centering.hpp"
 #include "redres/objectives/manipulability.hpp"
 #include "redres/objectives/min_velocity_norm.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "redres/paths/circle.hpp"
-#include "redres/run/simulation.hpp"
 #include "redres/paths/helix.hpp"
 #include "redres/paths/letter_r.hpp"
-#include "redres/control/engine_registry.hpp"
-#include "redres/parsers/robot_toml.hpp"
+#include "redres/run/simulation.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -22,11 +22,11 @@
 
 #include "cli_util.hpp"
 #include "qp_util.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "redres/qp/lvi.hpp"
 #include "redres/run/run_summary.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
-#include "redres/control/engine_registry.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -353,6 +353,35 @@ TEST(OnInfeasible, RelaxGetsPastASingularStartInsideEveryLimit) {
   Scenario held = load_scenario(file);
   const RunSummary hs = summarise(held, simulate(held));
   EXPECT_GT(hs.max_position_error, 0.05);
+}
+
+TEST(OnInfeasible, AControllerFromTheScenarioRunsWhatSimulateRuns) {
+  // Controller::from_scenario, driven by simulate()'s Euler loop, gives its theta bit for bit, relaxed steps
+  // included (a closed loop that missed set_relaxation would hold at the singular start instead).
+  const auto file = write_scenario("from_scenario", kStretched);
+  Scenario s = load_scenario(file, {"solver.on_infeasible=\"relax\""});
+  const RunResult run = simulate(s);
+  ASSERT_GE(run.relaxed_steps, 1);
+  Scenario again = load_scenario(file, {"solver.on_infeasible=\"relax\""});
+  const std::unique_ptr<Controller> ctrl = Controller::from_scenario(again);
+  StepOutput out = ctrl->make_output();
+  Eigen::VectorXd theta = again.theta0;
+  const Trajectory& tr = run.trajectory;
+  int relaxed = 0;
+  for (int k = 0; k <= again.steps(); ++k) {
+    for (int j = 1; j <= 4; ++j) {
+      ASSERT_EQ(theta(j - 1), tr.at(static_cast<std::size_t>(k), "theta_" + std::to_string(j))) << "row " << k;
+    }
+    ctrl->step(theta, k == again.steps() ? again.duration : k * again.tau, out);
+    ASSERT_EQ(static_cast<double>(static_cast<int>(out.info.status)),
+              tr.at(static_cast<std::size_t>(k), "solver_status"))
+        << "row " << k;
+    relaxed += out.info.status == SolverStatus::kRelaxed ? 1 : 0;
+    if (out.info.status == SolverStatus::kSolved || out.info.status == SolverStatus::kRelaxed) {
+      theta += again.tau * out.theta_dot;
+    }
+  }
+  EXPECT_EQ(relaxed, run.relaxed_steps);
 }
 
 TEST(OnInfeasible, RelaxOnATooFastCircleYieldsInsideTheLimitsAndReportsTheMiss) {

@@ -10,8 +10,8 @@
 
 #include "alloc_counter.hpp"
 #include "qp_util.hpp"
-#include "test_util.hpp"
 #include "redres/control/engine_registry.hpp"
+#include "test_util.hpp"
 
 namespace redres {
 namespace {

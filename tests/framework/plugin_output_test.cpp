@@ -25,7 +25,7 @@ class Writer final : public Objective {
   Writer(Where where, double value) : Objective("writer"), where_(where), value_(value) {}
 
  private:
-  void add_to(const Context& ctx, QpBuilder& b) const override {
+  void add_to(const Context& ctx, QpBuilder& b, PluginData* /*data*/) const override {
     const int n = ctx.robot->dof();
     Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
     Eigen::MatrixXd H = Eigen::MatrixXd::Identity(n, n);
@@ -63,7 +63,7 @@ class RowWriter final : public Constraint {
   int inequality_rows(const RobotModel&) const override { return 1; }
 
  private:
-  void add_to(const Context&, QpBuilder& b) const override {
+  void add_to(const Context&, QpBuilder& b, PluginData* /*data*/) const override {
     b.equality_matrix().setOnes();
     b.equality_rhs().setZero();
     b.inequality_matrix().setOnes();
@@ -87,7 +87,7 @@ class ZetaAndBoundWriter final : public Constraint {
   explicit ZetaAndBoundWriter(Where where) : Constraint("zeta_writer"), where_(where) {}
 
  private:
-  void add_to(const Context& ctx, QpBuilder& b) const override {
+  void add_to(const Context& ctx, QpBuilder& b, PluginData* /*data*/) const override {
     const int n = ctx.robot->dof();
     Eigen::VectorXd lo = Eigen::VectorXd::Constant(n, -1.0), hi = Eigen::VectorXd::Constant(n, 1.0);
     if (where_ == Where::kZeta) {
@@ -109,7 +109,7 @@ class Flaky final : public Objective {
   Flaky() : Objective("flaky") {}
 
  private:
-  void add_to(const Context& ctx, QpBuilder& b) const override {
+  void add_to(const Context& ctx, QpBuilder& b, PluginData* /*data*/) const override {
     Eigen::VectorXd z = Eigen::VectorXd::Zero(ctx.robot->dof());
     if (calls_++ == 0) z(0) = kNaN;
     b.add_linear(z);
@@ -126,13 +126,14 @@ std::string build_error(std::unique_ptr<Objective> objective, std::unique_ptr<Co
   if (constraint) constraints.push_back(std::move(constraint));
   const Scheme scheme(robot, std::move(objectives), std::move(constraints));
   QpProblem qp;
-  scheme.setup(qp);
+  SchemeData scheme_data = scheme.make_data();
+  scheme.setup(qp, scheme_data);
   KinematicsData k(robot);
   compute_kinematics(robot, robot.home(), k, KinematicsLevel::kAll);
   Eigen::VectorXd r_d = k.f, r_d_dot = Eigen::VectorXd::Zero(2);
   const Context ctx{0.0, 1.0, 0.01, &robot, &k, &r_d, &r_d_dot};
   try {
-    scheme.build(ctx, qp);
+    scheme.build(ctx, qp, scheme_data);
   } catch (const std::invalid_argument& e) {
     return e.what();
   }

@@ -142,8 +142,9 @@ TEST(RobotFiles, KinovaGen3MatchesItsPublishedDhTableWithItsBaseRow) {
     T.rotate(Eigen::AngleAxisd(alpha, Eigen::Vector3d::UnitX()));
     return T;
   };
-  const double d[7] = {-(0.1564 + 0.1284), -(0.0054 + 0.0064), -(0.2104 + 0.2104), -(0.0064 + 0.0064),
-                       -(0.2084 + 0.1059), 0.0, -(0.1059 + 0.0615)};
+  const double d[7] = {-(0.1564 + 0.1284), -(0.0054 + 0.0064), -(0.2104 + 0.2104),
+                       -(0.0064 + 0.0064), -(0.2084 + 0.1059), 0.0,
+                       -(0.1059 + 0.0615)};
   const auto table = [&](const Eigen::VectorXd& q) {
     Eigen::Isometry3d T = dh(M_PI, 0.0, 0.0);  // row 0
     for (int i = 0; i < 7; ++i) T = T * dh(i == 6 ? M_PI : M_PI / 2, d[i], q(i) + (i == 0 ? 0.0 : M_PI));
@@ -160,10 +161,10 @@ TEST(RobotFiles, KinovaGen3MatchesItsPublishedDhTableWithItsBaseRow) {
   EXPECT_LT((k.f - Eigen::Vector3d(0.0, -0.0246, 1.1873)).norm(), 1e-12) << "upright at q = 0";
   compute_kinematics(gen3, gen3.home(), k, KinematicsLevel::kPosition);
   EXPECT_LT((k.f - Eigen::Vector3d(0.457, 0.001, 0.434)).cwiseAbs().maxCoeff(), 5e-4) << k.f.transpose();
-  const Eigen::Matrix3d shown = (Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()) *
-                                 Eigen::AngleAxisd(0.0, Eigen::Vector3d::UnitY()) *
-                                 Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()))
-                                    .toRotationMatrix();
+  const Eigen::Matrix3d shown =
+      (Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.0, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   EXPECT_LT(Eigen::AngleAxisd(shown * k.ee_pose.linear().transpose()).angle(), 1e-9) << k.ee_pose.linear();
 }
 

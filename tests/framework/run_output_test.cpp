@@ -17,9 +17,9 @@
 #include <gtest/gtest.h>
 
 #include "redres/model/kinematics.hpp"
+#include "redres/parsers/robot_toml.hpp"
 #include "redres/run/run_output.hpp"
 #include "redres/run/run_summary.hpp"
-#include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 
 namespace redres {

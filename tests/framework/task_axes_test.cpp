@@ -10,9 +10,9 @@
 
 #include <Eigen/Geometry>
 
-#include "redres/run/run_summary.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/run/run_summary.hpp"
 #include "run_checks.hpp"
 #include "test_util.hpp"
 
@@ -128,7 +128,6 @@ TEST(TaskAxes, WrongListsAreConfigErrors) {
   EXPECT_THROW((void)with_axes(planar, {"x", "z"}), std::invalid_argument);
   EXPECT_THROW((void)with_axes(planar, {"phi", "x"}), std::invalid_argument);
 }
-
 
 // configs/kinova_gen3_tool_axis.toml: five task rows (position, tilts about y and z) keep the Gen3's tool axis
 // along the world x axis while the roll about it is free; the log-det manipulability term ends with a higher w than

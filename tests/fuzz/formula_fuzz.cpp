@@ -22,12 +22,12 @@
 
 #include "fuzz_util.hpp"
 #include "redres/common/formula.hpp"
-#include "redres/objectives/manipulability.hpp"
 #include "redres/control/plugin.hpp"
 #include "redres/model/robot.hpp"
 #include "redres/model/velocity_limit.hpp"
-#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/objectives/manipulability.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
 
 namespace {
 

@@ -10,10 +10,10 @@
 #include <gtest/gtest.h>
 
 #include "qp_util.hpp"
-#include "redres/model/velocity_limit.hpp"
-#include "redres/parsers/velocity_limit_registry.hpp"
 #include "redres/control/engine_registry.hpp"
+#include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -114,12 +114,13 @@ TEST(PluginConformance, EveryObjective) {
       QpProblem qp;
       qp.resize(robot->dof(), 0, 0);
       State st(*robot);
+      const std::unique_ptr<PluginData> data = p->make_data();
       for (int rep = 0; rep < 20; ++rep) {
         st.randomise(rng, *robot);
         qp.clear();
         QpBuilder b(qp);
         b.begin(0, p->weight(), 0, 0, 0, 0);
-        p->contribute(st.ctx, b);
+        p->contribute(st.ctx, b, data.get());
         EXPECT_TRUE(qp.W.allFinite() && qp.zeta.allFinite());
         EXPECT_TRUE(qp.W.isApprox(qp.W.transpose()));
         // An analytic gradient, where the objective has a potential: zeta = weight * grad P, against central
@@ -161,12 +162,13 @@ TEST(PluginConformance, EveryConstraint) {
       QpProblem qp;
       qp.resize(robot->dof(), me, mi);
       State st(*robot);
+      const std::unique_ptr<PluginData> data = p->make_data();
       for (int rep = 0; rep < 20; ++rep) {
         st.randomise(rng, *robot);
         qp.clear();
         QpBuilder b(qp);
         b.begin(0, 1.0, 0, me, 0, mi);
-        p->contribute(st.ctx, b);
+        p->contribute(st.ctx, b, data.get());
         EXPECT_TRUE(qp.J.allFinite() && qp.d.allFinite() && qp.A.allFinite() && qp.b.allFinite());
         EXPECT_FALSE(qp.lo.array().isNaN().any() || qp.hi.array().isNaN().any());
         // Constraints touch rows and bounds only, never the objective.

@@ -88,3 +88,57 @@ def test_wrong_sizes_raise_with_the_condition():
         ctrl.step(np.zeros(4), 0.0, np.zeros(2), np.zeros(2))
     with pytest.raises(ValueError, match="per joint|entries|joint"):
         redres.Controller(robot, objectives=[], constraints=[redres.constraints.JointAngleMargin(margin=[0.1, 0.2])])
+
+
+def test_a_controller_from_a_scenario_relaxes_as_the_run_does(tmp_path):
+    # The 4R arm starting stretched: under "relax" the first steps are relaxed, not held. Controller.from_scenario
+    # must carry the policy (a hand-built loop once missed it, and its steps held).
+    scenario = tmp_path / "stretched.toml"
+    scenario.write_text(f"""name = "stretched"
+robot = "{source('robots/planar_4link.toml')}"
+duration = 0.5
+step = 0.01
+theta0 = [0, 0, 0, 0]
+[path]
+type = "circle"
+radius = 0.06
+[[objectives]]
+type = "min_velocity_norm"
+[[constraints]]
+type = "task_tracking"
+gain = 8.0
+[[constraints]]
+type = "joint_velocity_limits"
+[solver]
+engine = "newton"
+on_infeasible = "relax"
+""")
+    s = redres.Scenario.load(str(scenario))
+    ctrl = redres.Controller.from_scenario(s)
+    assert "planar_4link" in repr(ctrl) and "engine 'newton'" in repr(ctrl) and "2 constraints" in repr(ctrl)
+    statuses = []
+    theta = s.theta0.copy()
+    for k in range(s.steps + 1):
+        theta_dot, info = ctrl.step(theta, s.duration if k == s.steps else k * s.step)
+        statuses.append(info.status)
+        if info.status in ("solved", "relaxed") and k < s.steps:
+            theta = theta + s.step * theta_dot
+    run = redres.Scenario.load(str(scenario)).run()
+    assert statuses.count("relaxed") == run.summary["solver"]["relaxed_steps"] >= 1
+    assert theta.tolist() == run.final_theta.tolist()
+
+
+def test_the_column_groups_name_the_result_columns():
+    groups = redres.trajectory_column_groups()
+    assert [g["name"] for g in groups][:3] == ["t", "theta_", "theta_dot_"]
+    result = redres.Scenario.load(source("configs/paper_r_fast.toml"), overrides={"duration": 0.2}).run()
+    names = []
+    for g in groups:
+        if g["count"] == "n":
+            names += [g["name"] + str(j) for j in range(1, 7)]
+        elif g["count"] == "m_ref":
+            names += [g["name"] + r for r in ("x", "y")]
+        elif g["count"] == "1":
+            names.append(g["name"])
+    assert list(result.columns)[: len(names)] == names
+    assert all(g["meaning"] for g in groups)

@@ -107,6 +107,12 @@ def test_compare_runs_every_scenario_and_tabulates_them():
     assert tuple(table[0]) == redres.Comparison.columns
     # The paper's comparison: TVCMM ends with a higher w than MVN.
     assert cmp["paper_r_tvcmm"].summary["manipulability"]["final"] > cmp["paper_r_mvn"].summary["manipulability"]["final"]
-    assert cmp.markdown().count("\n") == 5
+    md = cmp.markdown().splitlines()
+    assert len(md) == 5
+    # The CLI's comparison.md headings, from the one list of columns; the table's numbers are numbers.
+    assert md[0] == "| " + " | ".join(redres.Comparison.headings) + " |"
+    assert "max position error (m)" in md[0] and "mean iterations" in md[0]
+    assert isinstance(table[0]["max_position_error"], float) and isinstance(table[0]["failures"], int)
+    assert table[0]["w_final"] == cmp["paper_r_tvcmm"].summary["manipulability"]["final"]
     with pytest.raises(redres.ConfigError):
         redres.compare([files[0], source("tests/data/robot_corpus/syntax_error.toml")])

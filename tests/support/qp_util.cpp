@@ -4,8 +4,8 @@
 
 #include <Eigen/QR>
 
-#include "test_util.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "test_util.hpp"
 
 namespace redres::testing {
 
@@ -106,7 +106,8 @@ std::unique_ptr<PaperStep> make_paper_step(const std::string& scheme_toml) {
   s->kin = std::make_unique<KinematicsData>(*s->robot);
   s->r_d = Eigen::VectorXd::Zero(2);
   s->r_d_dot = Eigen::VectorXd::Zero(2);
-  s->scheme->setup(s->qp);
+  s->data = s->scheme->make_data();
+  s->scheme->setup(s->qp, s->data);
   s->ctx.robot = s->robot.get();
   s->ctx.kinematics = s->kin.get();
   s->ctx.r_d = &s->r_d;
@@ -138,7 +139,7 @@ void PaperStep::build(const Eigen::VectorXd& theta, double t, const Eigen::Vecto
   ctx.t = t;
   r_d = kin->f + dr;
   r_d_dot = rd_dot;
-  scheme->build(ctx, qp);
+  scheme->build(ctx, qp, data);
 }
 
 }  // namespace redres::testing

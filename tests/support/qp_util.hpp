@@ -6,8 +6,8 @@
 #include <random>
 #include <string>
 
-#include "redres/qp/lvi.hpp"
 #include "redres/control/scheme.hpp"
+#include "redres/qp/lvi.hpp"
 
 namespace redres::testing {
 
@@ -37,6 +37,7 @@ double qp_objective(const QpProblem& qp, const Eigen::VectorXd& x);
 struct PaperStep {
   std::unique_ptr<RobotModel> robot;
   std::unique_ptr<Scheme> scheme;
+  SchemeData data;  // the plugins' data
   std::unique_ptr<KinematicsData> kin;
   Eigen::VectorXd r_d, r_d_dot;
   QpProblem qp;

@@ -22,7 +22,9 @@ class TestDamping final : public redres::Configured<redres::Objective, DampingCo
   std::optional<double> potential(const redres::Context& /*ctx*/) const override { return 0.0; }
 
  private:
-  void add_to(const redres::Context& /*ctx*/, redres::QpBuilder& b) const override { b.add_identity(config_.gain); }
+  void add_to(const redres::Context& /*ctx*/, redres::QpBuilder& b, redres::PluginData* /*data*/) const override {
+    b.add_identity(config_.gain);
+  }
 };
 
 struct CapConfig {
@@ -41,7 +43,7 @@ class TestCap final : public redres::Configured<redres::Constraint, CapConfig> {
   TestCap(const Config& c, const redres::RobotModel& /*robot*/) : Configured(kType, c) {}
 
  private:
-  void add_to(const redres::Context& ctx, redres::QpBuilder& b) const override {
+  void add_to(const redres::Context& ctx, redres::QpBuilder& b, redres::PluginData* /*data*/) const override {
     for (int j = 0; j < ctx.robot->dof(); ++j) b.intersect_bound(j, -config_.cap, config_.cap);
   }
 };

@@ -18,7 +18,7 @@ class Impostor final : public redres::Configured<redres::Objective, NoConfig> {
   Impostor(const Config& c, const redres::RobotModel& /*robot*/) : Configured(kType, c) {}
 
  private:
-  void add_to(const redres::Context& /*ctx*/, redres::QpBuilder& /*b*/) const override {}
+  void add_to(const redres::Context& /*ctx*/, redres::QpBuilder& /*b*/, redres::PluginData* /*data*/) const override {}
 };
 
 struct Fine final : public redres::Configured<redres::Objective, NoConfig> {
@@ -26,7 +26,7 @@ struct Fine final : public redres::Configured<redres::Objective, NoConfig> {
   Fine(const Config& c, const redres::RobotModel& /*robot*/) : Configured(kType, c) {}
 
  private:
-  void add_to(const redres::Context& /*ctx*/, redres::QpBuilder& /*b*/) const override {}
+  void add_to(const redres::Context& /*ctx*/, redres::QpBuilder& /*b*/, redres::PluginData* /*data*/) const override {}
 };
 
 const bool kFine = redres::objective_registry().add_plugin<Fine>("registered before the duplicate; undone with it");

@@ -41,6 +41,7 @@ from ._redres import (  # noqa: F401  (re-exported)
     StepInfo,
     StepQp,
     check_plugins,
+    trajectory_column_groups,
 )
 
 __version__ = "0.1.0"
@@ -309,23 +310,29 @@ class Controller(_redres.Controller):
 
     def __init__(self, robot, objectives=(), constraints=(), engine="newton", path=None, T=1.0, tau=0.01,
                  theta0=None):
+        """Builds the scheme from `objectives` and `constraints` (typed configurations or Python plugin instances)
+        for `robot` (a redres.Robot), the LVI engine (a name or a redres.engines.* configuration), and the optional
+        path (a redres.paths.* configuration, placed at f(theta0)); T is the task duration and tau the control step
+        (s), both visible to the plugins. Everything is sized here: step() allocates nothing."""
         super().__init__(robot, list(objectives), list(constraints), engine, path, T, tau, theta0)
 
     @staticmethod
     def from_scenario(scenario):
-        """A controller for a loaded redres.Scenario (same as scenario.controller())."""
+        """The controller that `redres run` simulates for a loaded redres.Scenario: its scheme, engine and path, its
+        orientation turn, and its [solver] on_infeasible policy (with "relax", the elastic QP). Same as
+        scenario.controller()."""
         return scenario.controller()
 
 
 # --- comparisons ---------------------------------------------------------------------------------------------------
 
 class Comparison:
-    """Several runs side by side: results (redres.Result, in the given order), table() (one dict per run with the
-    columns of `redres compare`'s comparison.csv) and markdown()."""
+    """Several runs side by side: results (redres.Result, in the given order), table() (one dict per run, keyed as
+    the columns of `redres compare`'s comparison.csv, with numbers as numbers) and markdown() (comparison.md's
+    table, with its headings). The columns come from the one list the CLI uses."""
 
-    columns = ("scenario", "engine", "max_position_error", "w_initial", "w_final", "w_min", "w_mean",
-               "initial_joint_velocity_norm", "final_joint_velocity_norm", "mean_iterations", "failures",
-               "wall_time_s")
+    columns = tuple(key for key, _ in _redres._comparison([])[0])  # comparison.csv's heading, in order
+    headings = tuple(heading for _, heading in _redres._comparison([])[0])  # comparison.md's
 
     def __init__(self, results):
         self.results = list(results)
@@ -337,27 +344,12 @@ class Comparison:
         raise KeyError(name)
 
     def table(self):
-        rows = []
-        for r in self.results:
-            s = r.summary
-            w = s["manipulability"]
-            rows.append({
-                "scenario": s["name"], "engine": s["solver"]["engine"],
-                "max_position_error": s["max_position_error"], "w_initial": w["initial"], "w_final": w["final"],
-                "w_min": w["min"], "w_mean": w["mean"],
-                "initial_joint_velocity_norm": s["initial_joint_velocity_norm"],
-                "final_joint_velocity_norm": s["final_joint_velocity_norm"],
-                "mean_iterations": s["solver"]["mean_iterations"], "failures": s["solver"]["failures"],
-                "wall_time_s": s["wall_time_s"],
-            })
-        return rows
+        columns, rows, _ = _redres._comparison(self.results)
+        keys = [key for key, _ in columns]
+        return [dict(zip(keys, row)) for row in rows]
 
     def markdown(self):
-        lines = ["| " + " | ".join(self.columns) + " |", "|" + "---|" * len(self.columns)]
-        for row in self.table():
-            cells = [f"{v:.4g}" if isinstance(v, float) else str(v) for v in row.values()]
-            lines.append("| " + " | ".join(cells) + " |")
-        return "\n".join(lines) + "\n"
+        return _redres._comparison(self.results)[2]
 
     def __repr__(self):
         return f"<redres.Comparison of {len(self.results)} runs>"
@@ -378,7 +370,8 @@ def compare(scenarios, overrides=None, jobs=None):
 def sweep(path, jobs=None, shard=None, out_dir=None):
     """Runs a sweep file (docs/sweeps.md) as `redres sweep` does, on `jobs` threads (default: one per core) with the
     GIL released, and returns its table: a list of dicts, one per variation in variation order, with the axes'
-    values, status, diagnosis and every summary figure (strings, as in sweep.csv). shard="i/N" runs one slice;
+    values, status, diagnosis and every summary figure, as Python values: numbers as int or float, flags as bool,
+    text as str, and None for a figure a failed run has not (sweep.csv holds the same as text). shard="i/N" runs one slice;
     out_dir receives runs/<index>/ when the sweep file asks for each run's directory."""
     columns, rows = _redres._sweep(path, jobs or 0, shard or "", _os.fspath(out_dir) if out_dir else "")
     return [dict(zip(columns, row)) for row in rows]

@@ -1,9 +1,11 @@
 // redres._redres: the C++ side of the Python module. The pure-Python package (redres/__init__.py) builds on it:
 // typed plugin configurations, compare(), and the base classes of Python-defined plugins.
 
+#include <cstdlib>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <pybind11/eigen.h>
@@ -14,18 +16,20 @@
 #include <pybind11/stl/filesystem.h>
 
 #include "python_plugins.hpp"
-#include "redres/model/kinematics.hpp"
-#include "redres/qp/lvi.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/model/velocity_limit.hpp"
+#include "redres/parsers/robot_toml.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
+#include "redres/qp/lvi.hpp"
+#include "redres/run/comparison.hpp"
 #include "redres/run/run_output.hpp"
 #include "redres/run/run_summary.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
 #include "redres/run/sweep.hpp"
-#include "redres/model/velocity_limit.hpp"
-#include "redres/parsers/velocity_limit_registry.hpp"
-#include "redres/control/engine_registry.hpp"
-#include "redres/parsers/robot_toml.hpp"
+#include "redres/run/trajectory_columns.hpp"
 #include "types.hpp"
 
 namespace redres::python {
@@ -119,6 +123,70 @@ std::vector<std::string> override_strings(const std::optional<std::vector<std::p
   return out;
 }
 
+// --- sweeps --------------------------------------------------------------------------------------------------------
+
+// The sweep table's cells as Python values, by what each column holds: the summary's fields keep their types (a
+// vector field's columns <key>_<k> are numbers), plugin metrics and theta0 entries are numbers, an axis value is a
+// number when it reads as one, status and diagnosis are text; an empty cell (a failed run's figures) is None.
+py::list typed_rows(const SweepTable& table, const SweepSpec& spec) {
+  enum class Kind { kText, kNumber, kInteger, kBool, kAxis };
+  std::vector<Kind> kinds;
+  for (const std::string& column : table.columns) {
+    Kind kind = Kind::kText;
+    if (column == "index") {
+      kind = Kind::kInteger;
+    } else if (column.rfind("theta0_", 0) == 0 || column.rfind("metrics.", 0) == 0) {
+      kind = Kind::kNumber;
+    } else {
+      for (const SweepAxis& a : spec.axes) kind = a.key == column ? Kind::kAxis : kind;
+      for (const SummaryField& f : summary_fields()) {
+        const bool whole = column == f.key;
+        const bool entry =
+            column.size() > f.key.size() && column.compare(0, f.key.size(), f.key) == 0 && column[f.key.size()] == '_';
+        if ((!whole && !entry) || f.get == nullptr) continue;
+        const SummaryValue sample = f.get(RunSummary{});
+        if (std::holds_alternative<double>(sample) || std::holds_alternative<std::vector<double>>(sample)) {
+          kind = Kind::kNumber;
+        } else if (std::holds_alternative<long>(sample)) {
+          kind = Kind::kInteger;
+        } else if (std::holds_alternative<bool>(sample)) {
+          kind = Kind::kBool;
+        }
+      }
+    }
+    kinds.push_back(kind);
+  }
+  py::list rows;
+  for (const auto& row : table.rows) {
+    py::list out;
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      const std::string& cell = row[c];
+      if (cell.empty() && kinds[c] != Kind::kText) {
+        out.append(py::none());
+        continue;
+      }
+      char* end = nullptr;
+      switch (kinds[c]) {
+        case Kind::kText: out.append(cell); break;
+        case Kind::kInteger: out.append(std::stol(cell)); break;
+        case Kind::kNumber: out.append(std::stod(cell)); break;
+        case Kind::kBool: out.append(cell == "true"); break;
+        case Kind::kAxis: {
+          const double v = std::strtod(cell.c_str(), &end);
+          if (end == cell.c_str() + cell.size()) {
+            out.append(v);
+          } else {
+            out.append(cell);
+          }
+          break;
+        }
+      }
+    }
+    rows.append(out);
+  }
+  return rows;
+}
+
 // --- controllers -------------------------------------------------------------------------------------------------
 
 // One step's SolverInfo, with the engine's name owned.
@@ -199,9 +267,7 @@ std::unique_ptr<PyController> controller_of(const PyScenario& s) {
   c->scenario = s.scenario;
   Scenario& sc = *s.scenario;
   c->robot = std::shared_ptr<const RobotModel>(s.scenario, sc.robot.get());
-  c->controller = std::make_unique<Controller>(*sc.robot, *sc.scheme, *sc.engine, sc.path.get(), sc.duration, sc.tau);
-  c->controller->set_orientation_turn(sc.orientation_turn);
-  c->controller->set_kinematics_level(KinematicsLevel::kGradient);
+  c->controller = Controller::from_scenario(sc);  // what simulate() runs, the relax policy included
   c->out = c->controller->make_output();
   return c;
 }
@@ -429,7 +495,18 @@ PYBIND11_MODULE(_redres, m) {
   py::class_<PyController>(m, "Controller")
       .def(py::init(&make_controller), py::arg("robot"), py::arg("objectives"), py::arg("constraints"),
            py::arg("engine") = "newton", py::arg("path") = py::none(), py::arg("T") = 1.0, py::arg("tau") = 0.01,
-           py::arg("theta0") = py::none())
+           py::arg("theta0") = py::none(),
+           "Builds the scheme from the objectives and constraints for the robot, the engine (a name or an engine "
+           "configuration) and the optional path (placed at f(theta0)); T and tau in s. Sized here: step() "
+           "allocates nothing.")
+      .def("__repr__",
+           [](const PyController& c) {
+             const Controller& k = *c.controller;
+             return "<redres.Controller robot '" + k.robot().name() + "', " + std::to_string(k.robot().dof()) +
+                    " joints, " + std::to_string(k.scheme().objectives().size()) + " objectives, " +
+                    std::to_string(k.scheme().constraints().size()) + " constraints, engine '" +
+                    std::string(k.engine_name()) + "'>";
+           })
       .def(
           "step",
           [](PyController& c, const Eigen::VectorXd& theta, double t) {
@@ -491,9 +568,48 @@ PYBIND11_MODULE(_redres, m) {
           table = run_sweep(spec, shard.empty() ? SweepShard{} : parse_shard(shard), jobs,
                             out_dir.empty() ? std::filesystem::temp_directory_path() : std::filesystem::path(out_dir));
         }
-        return py::make_tuple(table.columns, table.rows);
+        return py::make_tuple(table.columns, typed_rows(table, spec));
       },
       py::arg("file"), py::arg("jobs") = 0, py::arg("shard") = "", py::arg("out_dir") = "");
+  m.def(
+      "_comparison",
+      [](const std::vector<const PyResult*>& results) {
+        py::list columns, rows;
+        for (const ComparisonColumn& c : comparison_columns()) {
+          columns.append(py::make_tuple(std::string(c.key), std::string(c.heading)));
+        }
+        std::vector<const RunSummary*> summaries;
+        for (const PyResult* r : results) {
+          summaries.push_back(r->summary.get());
+          py::list row;
+          for (const ComparisonColumn& c : comparison_columns()) {
+            row.append(std::visit([](const auto& v) { return py::cast(v); }, summary_value(*r->summary, c.field)));
+          }
+          rows.append(row);
+        }
+        return py::make_tuple(columns, rows, comparison_markdown(summaries));
+      },
+      py::arg("results"));
+  m.def(
+      "trajectory_column_groups",
+      []() {
+        py::list out;
+        for (const TrajectoryColumnGroup& g : trajectory_column_groups()) {
+          const char* count = g.count == ColumnCount::kPerJoint       ? "n"
+                              : g.count == ColumnCount::kPerReference ? "m_ref"
+                              : g.count == ColumnCount::kOne          ? "1"
+                                                                      : "1 (orientation rows)";
+          py::dict d;
+          d["name"] = std::string(g.name);
+          d["count"] = count;
+          d["unit"] = std::string(g.unit);
+          d["meaning"] = std::string(g.meaning);
+          out.append(d);
+        }
+        return out;
+      },
+      "The standard columns of trajectory.csv (and of a Result), group by group: name (or prefix), count ('1', "
+      "'n' per joint, 'm_ref' per reference row), unit and meaning; the same list the C++ run fills its rows from.");
   m.def("_registry", &registry_listing);
   bind_python_plugins(m);
 }

@@ -8,10 +8,10 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include "redres/control/engine_registry.hpp"
+#include "redres/control/path.hpp"
 #include "redres/extend/conformance.hpp"
 #include "redres/qp/lvi.hpp"
-#include "redres/control/path.hpp"
-#include "redres/control/engine_registry.hpp"
 #include "types.hpp"
 
 namespace redres::python {
@@ -230,7 +230,8 @@ class PythonObjective final : public Objective {
   }
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override {
+  // A Python plugin keeps its own state in its instance (the GIL serialises its calls); it makes no PluginData.
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const override {
     call_contribute(*instance_, ctx, builder, ctx.robot->dof(), 0, 0, "python objective '" + name() + "'");
   }
   void write_config(toml::table& out) const override {
@@ -266,7 +267,7 @@ class PythonConstraint final : public Constraint {
   [[nodiscard]] KinematicsLevel kinematics_level() const override { return level_; }
   [[nodiscard]] int equality_rows(const RobotModel&) const override { return eq_; }
   [[nodiscard]] int inequality_rows(const RobotModel&) const override { return in_; }
-  [[nodiscard]] std::string describe_inequality_row(int row) const override {
+  [[nodiscard]] std::string describe_inequality_row(const PluginData* /*data*/, int row) const override {
     if (!describes_) return {};
     py::gil_scoped_acquire gil;
     try {
@@ -275,7 +276,7 @@ class PythonConstraint final : public Constraint {
       return std::string("(describe_inequality_row raised: ") + e.what() + ")";
     }
   }
-  [[nodiscard]] bool violated() const override {
+  [[nodiscard]] bool violated(const PluginData* /*data*/) const override {
     if (!checks_) return false;
     py::gil_scoped_acquire gil;
     try {
@@ -284,14 +285,14 @@ class PythonConstraint final : public Constraint {
       throw std::runtime_error("python constraint '" + name() + "': violated: " + e.what());
     }
   }
-  [[nodiscard]] std::string describe_violation() const override {
+  [[nodiscard]] std::string describe_violation(const PluginData* /*data*/) const override {
     py::gil_scoped_acquire gil;
     if (!py::hasattr(*instance_, "describe_violation")) return "violated";
     return py::str(instance_->attr("describe_violation")()).cast<std::string>();
   }
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override {
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const override {
     call_contribute(*instance_, ctx, builder, ctx.robot->dof(), eq_, in_, "python constraint '" + name() + "'");
   }
   void write_config(toml::table& out) const override {

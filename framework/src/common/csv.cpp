@@ -5,8 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "redres/common/error.hpp"
 #include "common/input_file.hpp"
+#include "redres/common/error.hpp"
 
 namespace redres {
 

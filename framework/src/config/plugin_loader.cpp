@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cstdlib>
 
-#include "redres/config/registry.hpp"
 #include "config/registration_scope.hpp"
+#include "redres/config/registry.hpp"
 
 namespace redres {
 

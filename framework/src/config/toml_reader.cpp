@@ -4,8 +4,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "redres/common/formula.hpp"
 #include "common/input_file.hpp"
+#include "redres/common/formula.hpp"
 
 namespace redres {
 

@@ -6,7 +6,6 @@
 
 #include "redres/config/config.hpp"
 #include "redres/control/plugin.hpp"
-#include "redres/run/trajectory.hpp"
 
 namespace redres {
 
@@ -23,11 +22,8 @@ void point_jacobian(const RobotModel& robot, const KinematicsData& kin, int link
   }
 }
 
-PairDistances::PairDistances(int pairs, Damper damper, std::string minimum, std::string active)
-    : distance_(static_cast<std::size_t>(pairs), std::numeric_limits<double>::infinity()),
-      damper_(damper),
-      minimum_(std::move(minimum)),
-      active_(std::move(active)) {}
+PairDistances::PairDistances(int pairs, Damper damper)
+    : distance_(static_cast<std::size_t>(pairs), std::numeric_limits<double>::infinity()), damper_(damper) {}
 
 bool PairDistances::take(int row, const ShapeDistance& d, bool planar, const Eigen::Vector3d& fallback,
                          Eigen::Vector3d& n) {
@@ -82,21 +78,6 @@ void PairDistances::record(double* values) const {
   }
   values[0] = low;
   values[1] = active;
-}
-
-void PairDistances::summarise(const Trajectory& run, const std::string& plugin, std::vector<Metric>& out) const {
-  const std::size_t cd = own_column(run, plugin, minimum_), ca = own_column(run, plugin, active_);
-  double low = std::numeric_limits<double>::infinity();
-  double steps = 0.0;
-  for (std::size_t r = 0; r < run.size(); ++r) {
-    low = std::min(low, run(r, cd));
-    steps += run(r, ca) > 0.0 ? 1.0 : 0.0;
-  }
-  out.push_back({minimum_, {low}, "m"});
-  out.push_back({"steps_with_active_rows", {steps}, ""});
-  out.push_back({"fcl_failures", {static_cast<double>(failures_)}, ""});
-  out.push_back({"safety_distance", {damper_.safety_distance}, "m"});
-  out.push_back({"influence_distance", {damper_.influence_distance}, "m"});
 }
 
 void damper_row(const Damper& damper, double d, const Eigen::Vector3d& n, const Eigen::Matrix3Xd& D,

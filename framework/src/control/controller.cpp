@@ -7,8 +7,8 @@
 
 #include <Eigen/Geometry>
 
-#include "redres/control/path.hpp"
 #include "redres/control/engine_registry.hpp"
+#include "redres/control/path.hpp"
 
 namespace redres {
 
@@ -16,6 +16,7 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
                        double tau)
     : robot_(&robot),
       scheme_(&scheme),
+      data_(std::make_shared<SchemeData>(scheme.make_data())),
       engine_(&engine),
       path_(path),
       kin_(robot),
@@ -31,7 +32,7 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
                    "the path has one row per task position row (" + std::to_string(position_rows) + ")");
   }
   level_ = scheme.kinematics_level();
-  scheme.setup(qp_);
+  scheme.setup(qp_, *data_);
   engine.setup(qp_.n(), qp_.m_eq(), qp_.m_in(), result_);
   ctx_.T = T;
   ctx_.tau = tau;
@@ -52,7 +53,7 @@ StepOutput Controller::make_output() const {
 
 void Controller::reset() {
   engine_->reset();
-  orientation_captured_ = false;
+  orientation_.forget_captured();
 }
 
 void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out) {
@@ -60,37 +61,7 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, 
   compute_kinematics(*robot_, theta, kin_, level_);
   const int p = path_->dim();
   path_->evaluate(t, r_d_.head(p), r_d_dot_.head(p));
-  if (robot_->reference_dim() > p) {
-    if (!orientation_set_ && !orientation_captured_) {
-      // Hold the orientation the end effector has at the start.
-      orientation_ = robot_->kind() == ChainKind::kPlanar ? Eigen::Vector3d(0.0, 0.0, kin_.f(2))
-                                                          : Eigen::Vector3d(kin_.f.tail<3>());
-      orientation_captured_ = true;
-    }
-    const int rest = robot_->reference_dim() - p;
-    // The turn's progress s(t) in [0, 1] and its rate (zero when the orientation is held).
-    double progress = 0.0, rate = 0.0;
-    const double T = ctx_.T;
-    if (turn_.squaredNorm() > 0.0 && T > 0.0) {
-      double dprogress = 0.0;  // d progress / du, u = t / T
-      timing(TimingLaw::kCycloidal, std::clamp(t / T, 0.0, 1.0), progress, dprogress);
-      rate = dprogress / T;
-    }
-    if (robot_->kind() == ChainKind::kPlanar) {
-      r_d_(2) = orientation_.z() + progress * turn_.z();
-      r_d_dot_(2) = rate * turn_.z();
-    } else {
-      if (progress == 0.0) {
-        r_d_.tail(rest) = orientation_;
-      } else {
-        const double angle = turn_.norm();
-        const Eigen::AngleAxisd R(Eigen::AngleAxisd(progress * angle, turn_ / angle).toRotationMatrix() *
-                                  rotation_from_vector(orientation_));
-        r_d_.tail(rest) = R.angle() * R.axis();
-      }
-      r_d_dot_.tail(rest) = rate * turn_;  // the world angular velocity, as J's angular rows
-    }
-  }
+  if (robot_->reference_dim() > p) orientation_.evaluate(*robot_, kin_, t, ctx_.T, p, r_d_, r_d_dot_);
   solve(t, out);
 }
 
@@ -114,7 +85,7 @@ void Controller::solve(double t, StepOutput& out) {
   ctx_.t = t;
   try {
     robot_->velocity_limits(kin_.theta, vlo_, vhi_);
-    scheme_->build(ctx_, qp_);
+    scheme_->build(ctx_, qp_, *data_);
   } catch (const std::invalid_argument& e) {
     // A plugin or a law gave NaN or inf at this state (a user formula that is NaN in a narrow window): a failed step
     // that moves nothing, not the end of the run. The controller's own calls meet build()'s other conditions.
@@ -163,30 +134,16 @@ void Controller::set_relaxation(double weight) {
   }
   if (!relax_engine_) {
     relax_engine_ = make_engine(std::string(engine_->name()), engine_->settings());
-    relaxed_.resize(qp_.n(), 0, qp_.m_in());
-    relaxed_.source_names = qp_.source_names;
-    relaxed_.variable_names = qp_.variable_names;
-    relax_engine_->setup(relaxed_.n(), 0, relaxed_.m_in(), relaxed_result_);
+    relaxed_.setup(qp_);
+    relax_engine_->setup(qp_.n(), 0, qp_.m_in(), relaxed_result_);
   }
 }
 
 void Controller::relax(StepOutput& out) {
-  // The elastic QP: min x'(W + rho J'J)x/2 + (zeta - rho J'd)'x subject to A x <= b and the bounds.
+  // The elastic QP (qp/elastic.hpp): the rows become a penalty of weight rho; bounds and inequality rows stay.
   const double rho = relax_weight_;
-  relaxed_.W = qp_.W;
-  relaxed_.W.noalias() += rho * qp_.J.transpose() * qp_.J;
-  relaxed_.w_diagonal = qp_.m_eq() == 0 && qp_.w_diagonal;
-  relaxed_.zeta = qp_.zeta;
-  relaxed_.zeta.noalias() -= rho * qp_.J.transpose() * qp_.d;
-  relaxed_.A = qp_.A;
-  relaxed_.b = qp_.b;
-  relaxed_.lo = qp_.lo;
-  relaxed_.hi = qp_.hi;
-  relaxed_.lo_source = qp_.lo_source;
-  relaxed_.hi_source = qp_.hi_source;
-  relaxed_.in_source = qp_.in_source;
-  relaxed_.in_row_description = qp_.in_row_description;
-  relax_engine_->solve_valid(relaxed_, relaxed_result_);
+  relaxed_.build(qp_, rho);
+  relax_engine_->solve_valid(relaxed_.problem(), relaxed_result_);
   const SolverInfo& r = relaxed_result_.info;
   std::ostringstream s;
   s.precision(6);

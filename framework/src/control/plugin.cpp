@@ -100,15 +100,15 @@ void check_contribution(const QpBuilder& builder, const char* kind, const Plugin
 
 }  // namespace
 
-void Objective::contribute(const Context& ctx, QpBuilder& builder) const {
+void Objective::contribute(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   if (!active()) return;
-  add_to(ctx, builder);
+  add_to(ctx, builder, data);
   check_contribution(builder, "objective", *this);
 }
 
-void Constraint::contribute(const Context& ctx, QpBuilder& builder) const {
+void Constraint::contribute(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   if (!active()) return;
-  add_to(ctx, builder);
+  add_to(ctx, builder, data);
   check_contribution(builder, "constraint", *this);
 }
 

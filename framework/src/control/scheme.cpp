@@ -65,7 +65,16 @@ Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, doubl
   return Scheme(robot, std::move(objectives), std::move(constraints));
 }
 
-void Scheme::setup(QpProblem& qp) const {
+SchemeData Scheme::make_data() const {
+  SchemeData data;
+  for (const auto& o : objectives_) data.objectives.push_back(o->make_data());
+  for (const auto& c : constraints_) data.constraints.push_back(c->make_data());
+  return data;
+}
+
+void Scheme::setup(QpProblem& qp, const SchemeData& data) const {
+  REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size(),
+                 "Scheme::setup", "data was made by this scheme's make_data()");
   qp.resize(robot_->dof(), m_eq_, m_in_);
   qp.source_names.clear();
   qp.variable_names.clear();
@@ -73,10 +82,12 @@ void Scheme::setup(QpProblem& qp) const {
   for (const auto& o : objectives_) qp.source_names.push_back(o->name());
   for (const auto& c : constraints_) qp.source_names.push_back(c->name());
   const int base = static_cast<int>(objectives_.size());
-  qp.in_row_description = [this](int row) -> std::string {
+  // The constraints' data, by the vector's storage: it stays where it is when the SchemeData itself is moved.
+  const std::unique_ptr<PluginData>* own = data.constraints.data();
+  qp.in_row_description = [this, own](int row) -> std::string {
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
       if (row >= in_offset_[k] && row < in_offset_[k] + in_rows_[k]) {
-        return constraints_[k]->describe_inequality_row(row - in_offset_[k]);
+        return constraints_[k]->describe_inequality_row(own[k].get(), row - in_offset_[k]);
       }
     }
     return {};
@@ -89,14 +100,16 @@ void Scheme::setup(QpProblem& qp) const {
   }
 }
 
-void Scheme::build(const Context& ctx, QpProblem& qp) const {
+void Scheme::build(const Context& ctx, QpProblem& qp, SchemeData& data) const {
   REDRES_REQUIRE(qp.n() == robot_->dof() && qp.m_eq() == m_eq_ && qp.m_in() == m_in_, "Scheme::build",
                  "qp was sized by setup()");
   REDRES_REQUIRE(ctx.kinematics != nullptr && ctx.robot == robot_, "Scheme::build",
                  "ctx.robot is the scheme's robot and ctx.kinematics is set");
   REDRES_REQUIRE(ctx.kinematics->level >= level_, "Scheme::build",
                  "ctx.kinematics was computed at kinematics_level() or deeper");
-  const bool full_w = contribute_all(ctx, qp, false);
+  REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size(),
+                 "Scheme::build", "data was made by this scheme's make_data()");
+  const bool full_w = contribute_all(ctx, qp, data, false);
   // One scan of everything the plugins can have written (bounds are checked as they are intersected; W off its
   // diagonal keeps clear()'s zeros unless a plugin wrote there).
   const Eigen::Index n = qp.W.rows();
@@ -112,34 +125,37 @@ void Scheme::build(const Context& ctx, QpProblem& qp) const {
          finite_probe(qp.b.data(), qp.b.size());
   if (acc == 0.0 && (!full_w || qp.W.isApprox(qp.W.transpose(), 1e-12))) return;
   // Build again with a check after each plugin, which names the plugin and the entry, and throws.
-  contribute_all(ctx, qp, true);
+  contribute_all(ctx, qp, data, true);
   qp.validate();  // the checked build found nothing (a plugin that gives different values when called again)
   throw_invalid_argument("Scheme::build",
                          "the QP had a non-finite or asymmetric entry that a second build did not "
                          "reproduce (a plugin whose output changes between two calls at one state)");
 }
 
-bool Scheme::contribute_all(const Context& ctx, QpProblem& qp, bool checked) const {
+bool Scheme::contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked) const {
   qp.clear();
   QpBuilder builder(qp);
   bool full_w = false;  // some plugin wrote off the diagonal of W
   int source = 0;
-  for (const auto& o : objectives_) {
-    builder.begin(source++, o->weight(), 0, 0, 0, 0);
+  for (std::size_t k = 0; k < objectives_.size(); ++k) {
+    const Objective& o = *objectives_[k];
+    PluginData* own = data.objectives[k].get();
+    builder.begin(source++, o.weight(), 0, 0, 0, 0);
     if (checked) {
-      o->contribute(ctx, builder);
+      o.contribute(ctx, builder, own);
     } else {
-      o->contribute_unchecked(ctx, builder);
+      o.contribute_unchecked(ctx, builder, own);
     }
     full_w = full_w || builder.written_w() == QpBuilder::WrittenW::kFull;
   }
   for (std::size_t k = 0; k < constraints_.size(); ++k) {
     // Inactive constraints leave their rows empty: 0 x = 0 and 0 x <= 0 are always met.
     builder.begin(source++, 1.0, eq_offset_[k], eq_rows_[k], in_offset_[k], in_rows_[k]);
+    PluginData* own = data.constraints[k].get();
     if (checked) {
-      constraints_[k]->contribute(ctx, builder);
+      constraints_[k]->contribute(ctx, builder, own);
     } else {
-      constraints_[k]->contribute_unchecked(ctx, builder);
+      constraints_[k]->contribute_unchecked(ctx, builder, own);
     }
     full_w = full_w || builder.written_w() == QpBuilder::WrittenW::kFull;
   }

@@ -4,14 +4,14 @@
 #include <set>
 #include <sstream>
 
-#include "redres/qp/lvi.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/plugin.hpp"
-#include "redres/model/robot.hpp"
 #include "redres/control/scheme.hpp"
+#include "redres/model/robot.hpp"
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
-#include "redres/control/engine_registry.hpp"
+#include "redres/qp/lvi.hpp"
 
 namespace redres {
 
@@ -157,7 +157,8 @@ void check_scheme_plugin(const Entry& e, const std::vector<RobotModel>& robots, 
     }
     const Scheme scheme(robot, std::move(objectives), std::move(constraints));
     QpProblem qp;
-    scheme.setup(qp);
+    SchemeData scheme_data = scheme.make_data();
+    scheme.setup(qp, scheme_data);
     KinematicsData kin(robot);
     Eigen::VectorXd r_d = Eigen::VectorXd::Zero(robot.reference_dim()), r_d_dot = r_d;
     Context ctx{0.0, 10.0, 0.01, &robot, &kin, &r_d, &r_d_dot};
@@ -177,7 +178,7 @@ void check_scheme_plugin(const Entry& e, const std::vector<RobotModel>& robots, 
         r_d_dot(r) = lcg.next(-0.05, 0.05);
       }
       try {
-        scheme.build(ctx, qp);
+        scheme.build(ctx, qp, scheme_data);
         if (qp.lo.array().isNaN().any() || qp.hi.array().isNaN().any()) finite_error = "a bound is NaN";
       } catch (const std::exception& ex) {
         finite_error = ex.what();

@@ -209,5 +209,4 @@ bool RobotModel::self_collision_pair(int i, int j) const {
   return true;
 }
 
-
 }  // namespace redres

@@ -10,8 +10,8 @@
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
-#include "redres/common/error.hpp"
 #include "common/input_file.hpp"
+#include "redres/common/error.hpp"
 
 namespace redres {
 

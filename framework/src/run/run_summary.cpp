@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <variant>
 
 #include <nlohmann/json.hpp>
 
@@ -126,17 +128,23 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
     out.robot.link_lengths.push_back(robot.joint(j).length);
   }
   for (const auto& l : robot.link_shapes()) out.robot.link_shapes.push_back({l.link + 1, l.spec});
-  const auto collect = [&](const Plugin& p) {
-    if (!p.active()) return;
+  // Each plugin's figures from the recorded run and its data of the run (none without one: a run made elsewhere).
+  const SchemeData* data = run.plugin_data.get();
+  const auto collect = [&](const Plugin& p, const std::vector<std::unique_ptr<PluginData>>* datas, std::size_t k) {
+    const PluginOutput* output = output_of(p);
+    if (!p.active() || output == nullptr) return;
+    const PluginData* own = datas != nullptr && k < datas->size() ? (*datas)[k].get() : nullptr;
     PluginMetrics pm{p.name(), {}};
-    p.summarise(robot, tr, pm.metrics);
+    output->summarise(robot, tr, own, pm.metrics);
     if (!pm.metrics.empty()) out.metrics.push_back(std::move(pm));
     std::vector<ShapeSpec> shapes;
-    p.scene_obstacles(shapes);
+    output->scene_obstacles(shapes);
     for (auto& shape : shapes) out.obstacles.push_back({p.name(), std::move(shape)});
   };
-  for (const auto& o : s.scheme->objectives()) collect(*o);
-  for (const auto& c : s.scheme->constraints()) collect(*c);
+  const auto& objectives = s.scheme->objectives();
+  const auto& constraints = s.scheme->constraints();
+  for (std::size_t k = 0; k < objectives.size(); ++k) collect(*objectives[k], data ? &data->objectives : nullptr, k);
+  for (std::size_t k = 0; k < constraints.size(); ++k) collect(*constraints[k], data ? &data->constraints : nullptr, k);
   return out;
 }
 
@@ -174,7 +182,155 @@ nlohmann::json obstacle_json(const ObstacleFacts& o) {
 
 }  // namespace
 
+namespace {
+
+using S = RunSummary;
+SummaryValue text(const std::string& v) { return v; }
+SummaryValue count(long v) { return v; }
+
+}  // namespace
+
+const std::vector<SummaryField>& summary_fields() {
+  static const std::vector<SummaryField> fields{
+      {"name", "string", "scenario name", [](const S& s) { return text(s.name); }},
+      {"source", "string", "the scenario file as given on the command line", [](const S& s) { return text(s.source); }},
+      {"status", "string",
+       "`\"complete\"`; `\"stopped\"` (at its first failed step, `on_infeasible = \"stop\"`); or `\"interrupted\"` (by "
+       "SIGINT or SIGTERM: the rows up to the step it was at)",
+       [](const S& s) { return text(s.status); }},
+      {"steps", "integer", "round(T / tau)", [](const S& s) { return count(s.steps); }},
+      {"tau", "number", "step (s)", [](const S& s) { return SummaryValue(s.tau); }},
+      {"duration", "number", "T (s)", [](const S& s) { return SummaryValue(s.duration); }},
+      {"integrator", "string", "`euler` or `heun`", [](const S& s) { return text(s.integrator); }},
+      {"path", "string", "the path's description, e.g. `letter_r (3 strokes, 0.4154 m, cycloidal per stroke)`",
+       [](const S& s) { return text(s.path); }},
+      {"max_position_error", "number", "largest `position_error` (m)",
+       [](const S& s) { return SummaryValue(s.max_position_error); }},
+      {"final_position_error", "number", "`position_error` at t = T (m)",
+       [](const S& s) { return SummaryValue(s.final_position_error); }},
+      {"initial_joint_velocity_norm", "number", "norm of theta_dot at t = 0 (rad/s)",
+       [](const S& s) { return SummaryValue(s.initial_joint_velocity_norm); }},
+      {"final_joint_velocity_norm", "number", "norm of theta_dot at t = T (rad/s)",
+       [](const S& s) { return SummaryValue(s.final_joint_velocity_norm); }},
+      {"manipulability.initial", "number", "w = det(J J') at t = 0",
+       [](const S& s) { return SummaryValue(s.manipulability.initial); }},
+      {"manipulability.final", "number", "w at t = T", [](const S& s) { return SummaryValue(s.manipulability.final); }},
+      {"manipulability.min", "number", "the smallest w of the run",
+       [](const S& s) { return SummaryValue(s.manipulability.min); }},
+      {"manipulability.mean", "number", "the mean of w over the rows",
+       [](const S& s) { return SummaryValue(s.manipulability.mean); }},
+      {"manipulability.max", "number", "the largest w of the run",
+       [](const S& s) { return SummaryValue(s.manipulability.max); }},
+      {"max_joint_angle_violation", "number >= 0",
+       "largest excursion of any theta_i beyond theta_i^- or theta_i^+ (rad)",
+       [](const S& s) { return SummaryValue(s.max_joint_angle_violation); }},
+      {"max_joint_velocity_violation", "number >= 0",
+       "largest excursion of any theta_dot_i beyond its velocity law `vel_lo_i` or `vel_hi_i` (rad/s)",
+       [](const S& s) { return SummaryValue(s.max_joint_velocity_violation); }},
+      {"steps_with_active_bounds", "integer",
+       "rows in which some theta_dot_i is at lo_i or hi_i, to within 1e-9 (1 + abs(bound))",
+       [](const S& s) { return count(s.steps_with_active_bounds); }},
+      {"final_theta", "array of n numbers", "theta at t = T", [](const S& s) { return SummaryValue(s.final_theta); }},
+      {"solver.engine", "string",
+       "the engines that ran, in the order first used, joined by `+` (e.g. `projection`, `newton+projection`)",
+       [](const S& s) { return text(s.solver.engine); }},
+      {"solver.mean_iterations", "number", "mean of `solver_iterations`",
+       [](const S& s) { return SummaryValue(s.solver.mean_iterations); }},
+      {"solver.max_iterations", "number", "largest `solver_iterations` (written as a JSON floating-point number)",
+       [](const S& s) { return SummaryValue(s.solver.max_iterations); }},
+      {"solver.max_residual", "number", "largest `solver_residual`",
+       [](const S& s) { return SummaryValue(s.solver.max_residual); }},
+      {"solver.failures", "integer",
+       "solves whose status is neither `solved` nor `relaxed`: the rows whose `solver_status` is not 0, plus, with "
+       "`heun`, the failed second QPs; plus the solved rows whose state a constraint reports as violated (two bodies "
+       "overlapping, [collision.md](collision.md#when-a-step-fails))",
+       [](const S& s) { return count(s.solver.failures); }},
+      {"solver.first_failure", "string",
+       "`t = <t> s: <status>: <diagnosis>` for the first failed solve (for a Heun second QP, t is the time of its "
+       "prediction, t + tau), or `t = <t> s: constraint '<name>': <what>` for a violated state; empty if none",
+       [](const S& s) { return text(s.solver.first_failure); }},
+      {"solver.stopped", "boolean",
+       "the run ended at its first failed step (`[solver] on_infeasible = \"stop\"`): its last row is that step's, "
+       "before T",
+       [](const S& s) { return SummaryValue(s.solver.stopped); }},
+      {"solver.on_infeasible", "string", "the policy: `\"hold\"`, `\"stop\"` or `\"relax\"`",
+       [](const S& s) { return text(s.solver.on_infeasible); }},
+      {"solver.held_steps", "integer",
+       "failed steps held with theta_dot = 0 (the rows whose `solver_status` is neither 0 nor 6, before T)",
+       [](const S& s) { return count(s.solver.held_steps); }},
+      {"solver.relaxed_steps", "integer",
+       "steps solved with the rows relaxed (`solver_status` 6); they are not failures",
+       [](const S& s) { return count(s.solver.relaxed_steps); }},
+      {"solver.max_relaxed_task_error", "number",
+       "the largest max_r \\|J_r theta_dot - d_r\\| of a relaxed step (the task rows' units per second: m/s, rad/s); 0 "
+       "when none",
+       [](const S& s) { return SummaryValue(s.solver.max_relaxed_task_error); }},
+      {"solver.first_relaxed", "string",
+       "`t = <t> s: rows relaxed (weight ...), missed by ... at most, after <status>: <diagnosis>` for the first "
+       "relaxed step; empty if none",
+       [](const S& s) { return text(s.solver.first_relaxed); }},
+      {"wall_time_s", "number", "wall-clock time of the integration loop (s)",
+       [](const S& s) { return SummaryValue(s.wall_time_s); }},
+      {"robot.name", "string", "robot name", [](const S& s) { return text(s.robot.name); }},
+      {"robot.kind", "string", "`planar` or `spatial`", [](const S& s) { return text(s.robot.kind); }},
+      {"robot.joint_names", "array of n strings", "joint names",
+       [](const S& s) { return SummaryValue(s.robot.joint_names); }},
+      {"robot.task_rows", "array of m strings",
+       "the task's rows, e.g. `[\"x\", \"y\"]` or `[\"x\", \"y\", \"z\", \"wy\", \"wz\"]`",
+       [](const S& s) { return SummaryValue(s.robot.task_rows); }},
+      {"robot.base_position", "array of 3 numbers",
+       "the origin of the robot's `[base]` pose in the world (m); plots draw the base there",
+       [](const S& s) { return SummaryValue(s.robot.base_position); }},
+      {"robot.lower_limits", "array of n numbers", "theta^-",
+       [](const S& s) { return SummaryValue(s.robot.lower_limits); }},
+      {"robot.upper_limits", "array of n numbers", "theta^+",
+       [](const S& s) { return SummaryValue(s.robot.upper_limits); }},
+      {"robot.link_lengths", "array of n numbers", "planar link lengths l_i (the `length` key; 0 where not given)",
+       [](const S& s) { return SummaryValue(s.robot.link_lengths); }},
+      {"robot.link_shapes", "array of objects",
+       "the links' collision shapes (the robot file's `collision`), in joint order: `joint` (1-based, the frame of "
+       "`frames.csv` it moves with) and the shape keys below, its pose in that joint's frame (a capsule along the link "
+       "resolved to its end points). `[]` for a robot without collision shapes",
+       nullptr},
+      {"metrics", "object", "figures reported by plugins, by plugin instance name; see below", nullptr},
+      {"obstacles", "array of objects",
+       "the obstacles of the active plugins that have some (`obstacle_avoidance`), for drawing; see below. `[]` when "
+       "there are none",
+       nullptr},
+  };
+  return fields;
+}
+
+std::string summary_fields_markdown() {
+  std::string md = "| key | type | meaning |\n|---|---|---|\n";
+  for (const SummaryField& f : summary_fields()) {
+    md += "| `" + std::string(f.key) + "` | " + std::string(f.type) + " | " + std::string(f.meaning) + " |\n";
+  }
+  return md;
+}
+
+SummaryValue summary_value(const RunSummary& summary, std::string_view key) {
+  std::string known;
+  for (const SummaryField& f : summary_fields()) {
+    if (f.key == key && f.get != nullptr) return f.get(summary);
+    if (f.get != nullptr) known += (known.empty() ? "" : ", ") + std::string(f.key);
+  }
+  throw std::invalid_argument("summary_value: no summary field '" + std::string(key) + "'; known fields: " + known);
+}
+
 std::string to_json(const RunSummary& s) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const SummaryField& f : summary_fields()) {
+    if (f.get == nullptr) continue;  // a structured part, written below
+    // "a.b" is key b of table a.
+    nlohmann::json* at = &j;
+    std::string_view key = f.key;
+    for (std::size_t dot = key.find('.'); dot != std::string_view::npos; dot = key.find('.')) {
+      at = &(*at)[std::string(key.substr(0, dot))];
+      key.remove_prefix(dot + 1);
+    }
+    std::visit([&](const auto& v) { (*at)[std::string(key)] = v; }, f.get(s));
+  }
   nlohmann::json metrics = nlohmann::json::object();
   for (const auto& pm : s.metrics) {
     nlohmann::json figures = nlohmann::json::object();
@@ -188,57 +344,13 @@ std::string to_json(const RunSummary& s) {
   for (const auto& o : s.obstacles) obstacles.push_back(obstacle_json(o));
   nlohmann::json link_shapes = nlohmann::json::array();
   for (const auto& l : s.robot.link_shapes) {
-    nlohmann::json j = {{"joint", l.joint}};
-    j.update(shape_json(l.shape));
-    link_shapes.push_back(j);
+    nlohmann::json shape = {{"joint", l.joint}};
+    shape.update(shape_json(l.shape));
+    link_shapes.push_back(shape);
   }
-  const ManipulabilityStats& w = s.manipulability;
-  const nlohmann::json j = {
-      {"name", s.name},
-      {"source", s.source},
-      {"status", s.status},
-      {"steps", s.steps},
-      {"tau", s.tau},
-      {"duration", s.duration},
-      {"integrator", s.integrator},
-      {"path", s.path},
-      {"max_position_error", s.max_position_error},
-      {"final_position_error", s.final_position_error},
-      {"initial_joint_velocity_norm", s.initial_joint_velocity_norm},
-      {"final_joint_velocity_norm", s.final_joint_velocity_norm},
-      {"manipulability",
-       {{"initial", w.initial}, {"final", w.final}, {"min", w.min}, {"mean", w.mean}, {"max", w.max}}},
-      {"max_joint_angle_violation", s.max_joint_angle_violation},
-      {"max_joint_velocity_violation", s.max_joint_velocity_violation},
-      {"steps_with_active_bounds", s.steps_with_active_bounds},
-      {"final_theta", s.final_theta},
-      {"solver",
-       {{"engine", s.solver.engine},
-        {"mean_iterations", s.solver.mean_iterations},
-        {"max_iterations", s.solver.max_iterations},
-        {"max_residual", s.solver.max_residual},
-        {"failures", s.solver.failures},
-        {"first_failure", s.solver.first_failure},
-        {"stopped", s.solver.stopped},
-        {"on_infeasible", s.solver.on_infeasible},
-        {"held_steps", s.solver.held_steps},
-        {"relaxed_steps", s.solver.relaxed_steps},
-        {"max_relaxed_task_error", s.solver.max_relaxed_task_error},
-        {"first_relaxed", s.solver.first_relaxed}}},
-      {"wall_time_s", s.wall_time_s},
-      {"robot",
-       {{"name", s.robot.name},
-        {"kind", s.robot.kind},
-        {"joint_names", s.robot.joint_names},
-        {"task_rows", s.robot.task_rows},
-        {"base_position", s.robot.base_position},
-        {"lower_limits", s.robot.lower_limits},
-        {"upper_limits", s.robot.upper_limits},
-        {"link_lengths", s.robot.link_lengths},
-        {"link_shapes", link_shapes}}},
-      {"metrics", metrics},
-      {"obstacles", obstacles},
-  };
+  j["robot"]["link_shapes"] = link_shapes;
+  j["metrics"] = metrics;
+  j["obstacles"] = obstacles;
   require_finite_numbers(j, "");
   return j.dump(2);
 }

@@ -3,12 +3,12 @@
 #include <cmath>
 #include <sstream>
 
-#include "redres/common/formula.hpp"
 #include "config/overrides.hpp"
+#include "redres/common/formula.hpp"
 #include "redres/config/plugin_loader.hpp"
-#include "redres/run/simulation.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/run/simulation.hpp"
 
 namespace redres {
 

@@ -1,5 +1,8 @@
 #include "redres/run/simulation.hpp"
 
+#include "redres/run/plugin_output.hpp"
+#include "redres/run/trajectory_columns.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <numbers>
@@ -26,44 +29,35 @@ Eigen::Vector3d continuous_rotation_vector(const Eigen::Vector3d& w, const Eigen
   return best;
 }
 
-std::vector<std::string> trajectory_columns(const RobotModel& robot) {
-  const int n = robot.dof();
-  std::vector<std::string> cols;
-  cols.emplace_back("t");
-  const auto add = [&cols, n](const std::string& prefix) {
-    for (int j = 1; j <= n; ++j) cols.push_back(prefix + std::to_string(j));
-  };
-  add("theta_");
-  add("theta_dot_");
-  add("lo_");
-  add("hi_");
-  for (const auto& name : robot.reference_names()) cols.push_back("rd_" + name);
-  for (const auto& name : robot.reference_names()) cols.push_back("r_" + name);
-  cols.emplace_back("position_error");
-  if (robot.has_orientation_rows()) cols.emplace_back("orientation_error");
-  for (const char* c : {"manipulability", "solver_iterations", "solver_residual"}) cols.emplace_back(c);
-  add("vel_lo_");
-  add("vel_hi_");
-  cols.emplace_back("solver_status");
-  return cols;
-}
+// A plugin that records columns: its output part, its data in the controller that runs, its first column.
+struct Recorder {
+  const PluginOutput* output = nullptr;
+  const PluginData* data = nullptr;
+  std::size_t first = 0;
+  std::size_t objective = 0, constraint = 0;  // which plugin: objective k (constraint = npos) or constraint k
+};
+constexpr std::size_t kNone = static_cast<std::size_t>(-1);
 
 // The standard columns, then the plugins' own (e.g. collision distances), with where each plugin's start.
-std::vector<std::string> run_columns(const Scenario& s, std::vector<std::pair<const Plugin*, std::size_t>>* recorders) {
-  std::vector<std::string> columns = trajectory_columns(*s.robot);
-  const auto add_recorder = [&](const Plugin& p) {
+std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders) {
+  std::vector<std::string> columns = standard_trajectory_columns(*s.robot);
+  const auto add_recorder = [&](const Plugin& p, std::size_t objective, std::size_t constraint) {
     if (!p.active()) return;
-    const std::vector<std::string> own = p.recorded_columns();
+    const PluginOutput* output = output_of(p);
+    if (output == nullptr) return;
+    const std::vector<std::string> own = output->recorded_columns();
     if (own.empty()) return;
-    if (recorders != nullptr) recorders->emplace_back(&p, columns.size());
+    if (recorders != nullptr) recorders->push_back({output, nullptr, columns.size(), objective, constraint});
     for (const auto& c : own) {
       // Two plugins may record the same quantity (two obstacle sets): the second gets its name as a prefix.
       const bool taken = std::find(columns.begin(), columns.end(), c) != columns.end();
       columns.push_back(taken ? p.name() + "." + c : c);
     }
   };
-  for (const auto& o : s.scheme->objectives()) add_recorder(*o);
-  for (const auto& c : s.scheme->constraints()) add_recorder(*c);
+  const auto& objectives = s.scheme->objectives();
+  const auto& constraints = s.scheme->constraints();
+  for (std::size_t k = 0; k < objectives.size(); ++k) add_recorder(*objectives[k], k, kNone);
+  for (std::size_t k = 0; k < constraints.size(); ++k) add_recorder(*constraints[k], kNone, k);
   return columns;
 }
 
@@ -97,9 +91,9 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
     run = RunResult{};
     run.trajectory = std::move(storage);
   }
-  std::vector<std::pair<const Plugin*, std::size_t>> recorders;  // plugin, first column
+  std::vector<Recorder> recorders;
   std::vector<std::string> columns = run_columns(s, &recorders);
-  const std::size_t standard_columns = recorders.empty() ? columns.size() : recorders.front().second;
+  const std::size_t standard_columns = recorders.empty() ? columns.size() : recorders.front().first;
   REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
                  "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
                      std::to_string(columns.size()) + " columns do not)");
@@ -107,10 +101,13 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
   run.engines.reserve(4);
   std::vector<double> row_buffer(run.trajectory.width());
 
-  Controller ctrl(robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
-  ctrl.set_orientation_turn(s.orientation_turn);
-  ctrl.set_kinematics_level(KinematicsLevel::kGradient);
-  if (s.on_infeasible == OnInfeasible::kRelax) ctrl.set_relaxation(s.relax_weight);
+  const std::unique_ptr<Controller> controller = Controller::from_scenario(s);
+  Controller& ctrl = *controller;
+  const SchemeData& data = ctrl.plugin_data();
+  run.plugin_data = ctrl.shared_plugin_data();
+  for (Recorder& r : recorders) {
+    r.data = r.objective != kNone ? data.objectives[r.objective].get() : data.constraints[r.constraint].get();
+  }
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
   Eigen::VectorXd theta = s.theta0, theta_pred(n);
   const bool orientation_rows = robot.has_orientation_rows();
@@ -126,6 +123,7 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
     return std::sqrt(sum);
   };
   Eigen::Vector3d wd_prev = Eigen::Vector3d::Zero(), w_prev = Eigen::Vector3d::Zero();
+  const std::vector<TrajectoryColumnGroup>& groups = trajectory_column_groups();
   const auto start = std::chrono::steady_clock::now();
   const int report_every = std::max(1, steps / 200);
   std::string_view last_engine;  // the engine of the previous step (the names are static strings)
@@ -151,12 +149,15 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
     }
   };
   // A state a constraint finds violated (e.g. bodies that overlap) is a failed step too, whatever the solver said.
-  const auto check_violations = [&run, &s](double t) {
-    for (const auto& c : s.scheme->constraints()) {
-      if (!c->active() || !c->violated()) continue;
+  const auto check_violations = [&run, &s, &data](double t) {
+    const auto& constraints = s.scheme->constraints();
+    for (std::size_t k = 0; k < constraints.size(); ++k) {
+      const Constraint& c = *constraints[k];
+      const PluginData* own = data.constraints[k].get();
+      if (!c.active() || !c.violated(own)) continue;
       if (run.failures++ == 0) {
         std::ostringstream msg;
-        msg << "t = " << t << " s: constraint '" << c->name() << "': " << c->describe_violation();
+        msg << "t = " << t << " s: constraint '" << c.name() << "': " << c.describe_violation(own);
         run.first_failure = msg.str();
       }
       return;
@@ -179,49 +180,64 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
       std::copy_n(v.data(), n, row + c);
       c += static_cast<std::size_t>(n);
     };
-    row[c++] = t;
-    put(theta);
-    put(out.theta_dot);
-    put(qp.lo);
-    put(qp.hi);
-    if (spatial_orientation) {
-      // Rotation vectors, recorded without 2 pi jumps (the controller itself uses rotations, not these vectors).
-      wd_prev =
-          continuous_rotation_vector(ctrl.r_d().tail<3>(), k == 0 ? Eigen::Vector3d(ctrl.r_d().tail<3>()) : wd_prev);
-      w_prev = continuous_rotation_vector(kin.f.tail<3>(), k == 0 ? Eigen::Vector3d(kin.f.tail<3>()) : w_prev);
-      for (int r = 0; r < 3; ++r) row[c++] = ctrl.r_d()(r);
-      for (int r = 0; r < 3; ++r) row[c++] = wd_prev(r);
-      for (int r = 0; r < 3; ++r) row[c++] = kin.f(r);
-      for (int r = 0; r < 3; ++r) row[c++] = w_prev(r);
-    } else {
-      for (int r = 0; r < m; ++r) row[c++] = ctrl.r_d()(r);
-      for (int r = 0; r < m; ++r) row[c++] = kin.f(r);
-    }
-    if (all_position_rows) {
-      double sum = 0.0;
-      for (int r = 0; r < position_rows; ++r) sum += (ctrl.r_d()(r) - kin.f(r)) * (ctrl.r_d()(r) - kin.f(r));
-      row[c++] = std::sqrt(sum);
-    } else {
-      row[c++] = tracked_norm(ctrl.r_d() - kin.f, 0, position_rows);
-    }
-    if (orientation_rows) {
-      // The angle between the desired and the actual orientation: planar |phi_d - phi|; spatial the angle of
-      // R_d R' (from the rotations themselves). A subset of the orientation rows: the norm of those rows of the
-      // rotation vector of R_d R'.
-      if (spatial_orientation) {
-        const Eigen::AngleAxisd err(rotation_from_vector(ctrl.r_d().tail<3>()) * kin.ee_pose.linear().transpose());
-        row[c++] = all_orientation_rows ? err.angle() : tracked_norm(err.angle() * err.axis(), 3, 3);
-      } else {
-        row[c++] = std::abs(ctrl.r_d()(2) - kin.f(2));
+    // The standard columns, group by group as trajectory_column_groups() lists them.
+    for (const TrajectoryColumnGroup& group : groups) {
+      switch (group.value) {
+        case StepValue::kTime: row[c++] = t; break;
+        case StepValue::kTheta: put(theta); break;
+        case StepValue::kThetaDot: put(out.theta_dot); break;
+        case StepValue::kMergedLower: put(qp.lo); break;
+        case StepValue::kMergedUpper: put(qp.hi); break;
+        case StepValue::kDesired:
+          if (spatial_orientation) {
+            // Rotation vectors, recorded without 2 pi jumps (the controller itself uses rotations, not these).
+            wd_prev = continuous_rotation_vector(ctrl.r_d().tail<3>(),
+                                                 k == 0 ? Eigen::Vector3d(ctrl.r_d().tail<3>()) : wd_prev);
+            for (int r = 0; r < 3; ++r) row[c++] = ctrl.r_d()(r);
+            for (int r = 0; r < 3; ++r) row[c++] = wd_prev(r);
+          } else {
+            for (int r = 0; r < m; ++r) row[c++] = ctrl.r_d()(r);
+          }
+          break;
+        case StepValue::kActual:
+          if (spatial_orientation) {
+            w_prev = continuous_rotation_vector(kin.f.tail<3>(), k == 0 ? Eigen::Vector3d(kin.f.tail<3>()) : w_prev);
+            for (int r = 0; r < 3; ++r) row[c++] = kin.f(r);
+            for (int r = 0; r < 3; ++r) row[c++] = w_prev(r);
+          } else {
+            for (int r = 0; r < m; ++r) row[c++] = kin.f(r);
+          }
+          break;
+        case StepValue::kPositionError:
+          if (all_position_rows) {
+            double sum = 0.0;
+            for (int r = 0; r < position_rows; ++r) sum += (ctrl.r_d()(r) - kin.f(r)) * (ctrl.r_d()(r) - kin.f(r));
+            row[c++] = std::sqrt(sum);
+          } else {
+            row[c++] = tracked_norm(ctrl.r_d() - kin.f, 0, position_rows);
+          }
+          break;
+        case StepValue::kOrientationError:
+          if (!orientation_rows) break;
+          // The angle between the desired and the actual orientation: planar |phi_d - phi|; spatial the angle of
+          // R_d R' (from the rotations themselves). A subset of the orientation rows: the norm of those rows of the
+          // rotation vector of R_d R'.
+          if (spatial_orientation) {
+            const Eigen::AngleAxisd err(rotation_from_vector(ctrl.r_d().tail<3>()) * kin.ee_pose.linear().transpose());
+            row[c++] = all_orientation_rows ? err.angle() : tracked_norm(err.angle() * err.axis(), 3, 3);
+          } else {
+            row[c++] = std::abs(ctrl.r_d()(2) - kin.f(2));
+          }
+          break;
+        case StepValue::kManipulability: row[c++] = kin.w; break;
+        case StepValue::kIterations: row[c++] = out.info.iterations; break;
+        case StepValue::kResidual: row[c++] = out.info.residual; break;
+        case StepValue::kLawLower: put(vlo); break;
+        case StepValue::kLawUpper: put(vhi); break;
+        case StepValue::kStatus: row[c++] = static_cast<double>(static_cast<int>(out.info.status)); break;
       }
     }
-    row[c++] = kin.w;
-    row[c++] = out.info.iterations;
-    row[c++] = out.info.residual;
-    put(vlo);
-    put(vhi);
-    row[c++] = static_cast<double>(static_cast<int>(out.info.status));
-    for (const auto& [plugin, first] : recorders) plugin->record(row + first);
+    for (const Recorder& r : recorders) r.output->record(r.data, row + r.first);
     run.trajectory.append_row(row);
     const int failures_before = run.failures;
     note(out, t);

@@ -13,13 +13,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/input_file.hpp"
 #include "redres/common/csv.hpp"
 #include "redres/common/error.hpp"
 #include "redres/common/formula.hpp"
-#include "common/input_file.hpp"
+#include "redres/config/toml_reader.hpp"
 #include "redres/run/run_summary.hpp"
 #include "redres/run/scenario.hpp"
-#include "redres/config/toml_reader.hpp"
 
 namespace redres {
 

@@ -11,10 +11,10 @@
 #include "alloc_counter.hpp"
 #include "redres/constraints/obstacle_avoidance.hpp"
 #include "redres/constraints/self_collision.hpp"
-#include "redres/qp/lvi.hpp"
-#include "redres/control/scheme.hpp"
 #include "redres/control/engine_registry.hpp"
+#include "redres/control/scheme.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/qp/lvi.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -71,6 +71,7 @@ struct Independent {
 
 struct Built {
   std::unique_ptr<Scheme> scheme;
+  SchemeData data;
   QpProblem qp;
 };
 
@@ -79,7 +80,8 @@ Built build(const RobotModel& robot, std::unique_ptr<Constraint> c) {
   constraints.push_back(std::move(c));
   Built b;
   b.scheme = std::make_unique<Scheme>(robot, std::vector<std::unique_ptr<Objective>>{}, std::move(constraints));
-  b.scheme->setup(b.qp);
+  b.data = b.scheme->make_data();
+  b.scheme->setup(b.qp, b.data);
   return b;
 }
 
@@ -111,7 +113,7 @@ TEST_P(CollisionRows, ObstacleRowsAreTheRateOfTheDistance) {
     const double t = 3.0;
     compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
     Context ctx{t, 10.0, 0.01, &robot, &kin, nullptr, nullptr};
-    b.scheme->build(ctx, b.qp);
+    b.scheme->build(ctx, b.qp, b.data);
     for (int o = 0; o < static_cast<int>(obstacles.size()); ++o) {
       for (int l = 0; l < L; ++l) {
         const int row = o * L + l;
@@ -154,7 +156,7 @@ TEST_P(CollisionRows, SelfCollisionRowsAreTheRateOfTheDistance) {
     for (int j = 0; j < robot.dof(); ++j) x(j) = g(rng);
     compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
     Context ctx{0.0, 10.0, 0.01, &robot, &kin, nullptr, nullptr};
-    b.scheme->build(ctx, b.qp);
+    b.scheme->build(ctx, b.qp, b.data);
     for (std::size_t row = 0; row < pairs.size(); ++row) {
       const double d = ind.link_link(theta, pairs[row].first, pairs[row].second);
       if (d <= 0.002) continue;
@@ -212,7 +214,7 @@ TEST(CollisionRows, PairsBeyondTheInfluenceDistanceGetSlackRowsAndTheDamperBound
   KinematicsData kin(robot);
   compute_kinematics(robot, paper_theta0(), kin, KinematicsLevel::kJacobian);
   Context ctx{0.0, 10.0, 0.01, &robot, &kin, nullptr, nullptr};
-  b.scheme->build(ctx, b.qp);
+  b.scheme->build(ctx, b.qp, b.data);
   const int L = static_cast<int>(robot.link_shapes().size());
   const Independent ind(robot, obstacles);
   for (int l = 0; l < L; ++l) {
@@ -242,7 +244,8 @@ TEST(CollisionRows, ContributionsAllocateNothingWhileNothingPenetrates) {
   objectives.push_back(objective_registry().create_default("min_velocity_norm", robot));
   Scheme scheme(robot, std::move(objectives), std::move(constraints));
   QpProblem qp;
-  scheme.setup(qp);
+  SchemeData scheme_data = scheme.make_data();
+  scheme.setup(qp, scheme_data);
   // newton's general path solves the live rows; its solves allocate nothing either.
   auto engine = make_engine("newton");
   SolverResult result;
@@ -251,7 +254,7 @@ TEST(CollisionRows, ContributionsAllocateNothingWhileNothingPenetrates) {
   Eigen::VectorXd theta = robot.home();
   Context ctx{0.0, 10.0, 0.01, &robot, &kin, nullptr, nullptr};
   compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
-  scheme.build(ctx, qp);
+  scheme.build(ctx, qp, scheme_data);
   engine->solve(qp, result);
   long count = 0;
   int exact = 0;
@@ -260,7 +263,7 @@ TEST(CollisionRows, ContributionsAllocateNothingWhileNothingPenetrates) {
     for (int k = 0; k < 200; ++k) {
       theta(0) += 0.001;
       compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
-      scheme.build(ctx, qp);
+      scheme.build(ctx, qp, scheme_data);
       engine->solve(qp, result);
       exact += result.info.engine == "newton" && result.info.status == SolverStatus::kSolved ? 1 : 0;
     }
@@ -305,8 +308,8 @@ TEST(CollisionRows, TheBroadphaseWritesTheRowsOfBruteForce) {
     compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
     const double t = 0.5 * trial;  // the moving obstacles wander
     Context ctx{t, 20.0, 0.01, &robot, &kin, nullptr, nullptr};
-    tree.scheme->build(ctx, tree.qp);
-    brute.scheme->build(ctx, brute.qp);
+    tree.scheme->build(ctx, tree.qp, tree.data);
+    brute.scheme->build(ctx, brute.qp, brute.data);
     for (int r = 0; r < tree.qp.m_in(); ++r) {
       ASSERT_EQ(tree.qp.b(r), brute.qp.b(r)) << "trial " << trial << " row " << r;
       ASSERT_EQ((tree.qp.A.row(r) - brute.qp.A.row(r)).norm(), 0.0) << "trial " << trial << " row " << r;
@@ -329,14 +332,14 @@ TEST(CollisionRows, TheBroadphaseAllocatesNothingPerStepWithStaticObstacles) {
   Eigen::VectorXd theta = robot.home();
   Context ctx{0.0, 10.0, 0.01, &robot, &kin, nullptr, nullptr};
   compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
-  b.scheme->build(ctx, b.qp);  // places the obstacles in the tree
+  b.scheme->build(ctx, b.qp, b.data);  // places the obstacles in the tree
   long count = 0;
   {
     const testing::AllocationCounter counter;
     for (int k = 0; k < 100; ++k) {
       theta(0) += 0.002;
       compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
-      b.scheme->build(ctx, b.qp);
+      b.scheme->build(ctx, b.qp, b.data);
     }
     count = counter.count();
   }

@@ -7,11 +7,11 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/model/kinematics.hpp"
 #include "redres/control/path.hpp"
-#include "redres/paths/letter_r.hpp"
+#include "redres/model/kinematics.hpp"
 #include "redres/model/robot.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/paths/letter_r.hpp"
 #include "test_util.hpp"
 
 namespace redres {

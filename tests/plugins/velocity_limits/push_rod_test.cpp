@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "redres/model/robot.hpp"
-#include "redres/parsers/velocity_limit_registry.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/parsers/velocity_limit_registry.hpp"
 #include "test_util.hpp"
 
 namespace redres {

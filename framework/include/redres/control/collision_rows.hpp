@@ -19,9 +19,10 @@
 
 #include <Eigen/Core>
 
+#include "redres/common/error.hpp"
+#include "redres/control/plugin.hpp"
 #include "redres/model/collision.hpp"
 #include "redres/model/kinematics.hpp"
-#include "redres/control/plugin.hpp"
 
 namespace redres {
 
@@ -37,15 +38,12 @@ struct Damper {
   }
 };
 
-class Trajectory;
-struct Metric;
-
 /// The distances of a collision constraint's pairs at its last contribution, and what both collision constraints
-/// derive from them: the per-step columns, the violation (a pair that overlaps) and the run summary's figures.
+/// derive from them: the per-step values, the violation (a pair that overlaps) and FCL's failures.
 class PairDistances {
  public:
-  /// `pairs` rows; `minimum` and `active` name the recorded columns (e.g. "min_obstacle_distance").
-  PairDistances(int pairs, Damper damper, std::string minimum, std::string active);
+  /// `pairs` rows held by `damper`.
+  PairDistances(int pairs, Damper damper);
 
   /// Records pair `row`'s query (an FCL failure as NaN, counted) and finds its normal (witness_normal(), with
   /// `fallback`). Returns whether the pair gets a damper row: the query worked, the pair is within d_i and the normal
@@ -64,40 +62,51 @@ class PairDistances {
   [[nodiscard]] std::string describe_violation(const std::function<std::string(int)>& describe_row) const;
   /// The pair with the smallest distance (FCL failures skipped).
   [[nodiscard]] int worst() const;
-  /// The recorded columns: {minimum, active}.
-  [[nodiscard]] std::vector<std::string> columns() const { return {minimum_, active_}; }
-  /// Writes the smallest distance and the number of pairs within d_i.
+  /// Writes the smallest distance and the number of pairs within d_i (two values).
   void record(double* values) const;
-  /// min distance, steps with active rows, FCL failures, d_s and d_i, from plugin `plugin`'s recorded columns.
-  void summarise(const Trajectory& run, const std::string& plugin, std::vector<Metric>& out) const;
+  /// Queries FCL failed on since the data was made.
+  [[nodiscard]] int failures() const noexcept { return failures_; }
 
  private:
   std::vector<double> distance_;
   Damper damper_;
-  std::string minimum_, active_;
   int failures_ = 0;
 };
 
-/// The base of a collision constraint with Config C: its pairs' distances (`distances_`, one per row, filled by the
-/// derived add_to() through PairDistances::take/beyond) and what follows from them: the violation (a pair that
-/// overlaps or could not be measured, described by the derived describe_inequality_row()), the recorded columns and
-/// the run summary's figures.
+/// One controller's data of a collision constraint: its own distance query (FCL's objects move with every query, so
+/// two controllers never share one) and its pairs' distances at the last contribution.
+struct PairData : PluginData {
+  /// A query over `shapes`, and `pairs` distances held by `damper`.
+  PairData(const std::vector<ShapeSpec>& shapes, int pairs, Damper damper) : query(shapes), distances(pairs, damper) {}
+  DistanceQuery query;      //!< the shapes of the constraint's pairs
+  PairDistances distances;  //!< one per row
+};
+
+/// The base of a collision constraint with Config C, whose data derives from PairData (filled by the derived
+/// add_to() through PairDistances::take/beyond): the violation (a pair that overlaps or could not be measured,
+/// described by the derived describe_inequality_row()).
 template <class C>
 class PairConstraint : public Configured<Constraint, C> {
  public:
-  [[nodiscard]] bool violated() const override { return distances_.violated(); }
-  [[nodiscard]] std::string describe_violation() const override {
-    return distances_.describe_violation([this](int row) { return this->describe_inequality_row(row); });
-  }
-  [[nodiscard]] std::vector<std::string> recorded_columns() const override { return distances_.columns(); }
-  void record(double* values) const override { distances_.record(values); }
-  void summarise(const RobotModel& /*robot*/, const Trajectory& run, std::vector<Metric>& out) const override {
-    distances_.summarise(run, this->name(), out);
+  [[nodiscard]] bool violated(const PluginData* data) const override { return pair_data(data).distances.violated(); }
+  [[nodiscard]] std::string describe_violation(const PluginData* data) const override {
+    return pair_data(data).distances.describe_violation(
+        [this, data](int row) { return this->describe_inequality_row(data, row); });
   }
 
  protected:
   using Configured<Constraint, C>::Configured;
-  mutable PairDistances distances_{0, {}, "", ""};  // per row, at the last contribution
+  /// The PairData that make_data() made (std::invalid_argument for none).
+  template <class D = PairData>
+  [[nodiscard]] static const D& pair_data(const PluginData* data) {
+    REDRES_REQUIRE(data != nullptr, "PairConstraint", "the data that make_data() made is given");
+    return static_cast<const D&>(*data);
+  }
+  template <class D = PairData>
+  [[nodiscard]] static D& pair_data(PluginData* data) {
+    REDRES_REQUIRE(data != nullptr, "PairConstraint", "the data that make_data() made is given");
+    return static_cast<D&>(*data);
+  }
 };
 
 /// Checks the damper's keys of a collision constraint's Config: d_s >= 0 and d_i > d_s (FieldError naming the key).

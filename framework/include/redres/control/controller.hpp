@@ -10,9 +10,11 @@
 
 #include <Eigen/Core>
 
-#include "redres/qp/lvi.hpp"
+#include "redres/control/orientation_reference.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/scheme.hpp"
+#include "redres/qp/elastic.hpp"
+#include "redres/qp/lvi.hpp"
 
 namespace redres {
 
@@ -27,12 +29,25 @@ struct StepOutput {
                                 //!< are missed (0 for every other status)
 };
 
+struct Scenario;
+
 /// Runs the scheme for one robot. The robot, scheme, engine and path must outlive the controller.
 class Controller {
  public:
   /// `path` may be null when the caller supplies r_d and r_d_dot itself. T is the task duration (s), tau the
   /// step (s), both visible to plugins through the Context.
+  /// The controller makes its own data of every plugin (Scheme::make_data()), so several controllers can share one
+  /// scheme, each in its own thread.
   Controller(const RobotModel& robot, const Scheme& scheme, LviEngine& engine, const Path* path, double T, double tau);
+  Controller(const Controller&) = delete;
+  Controller& operator=(const Controller&) = delete;
+
+  /// The controller that simulate() runs for `scenario`: its robot, scheme, engine and path, T and tau, its
+  /// orientation turn, the kinematics the recorded run reads (w and its gradient), and, for `on_infeasible =
+  /// "relax"`, the elastic QP with the scenario's relax_weight. It steps with the scenario's own engine (and its warm
+  /// start), so one such controller runs a scenario at a time; the scenario must outlive it. (Defined in run/,
+  /// beside the scenario.)
+  [[nodiscard]] static std::unique_ptr<Controller> from_scenario(Scenario& scenario);
 
   /// An output sized for this controller.
   [[nodiscard]] StepOutput make_output() const;
@@ -48,18 +63,12 @@ class Controller {
 
   /// For tasks with orientation rows: the orientation the path's steps hold (planar: the angle in z; spatial: a
   /// rotation vector).
-  void set_orientation_reference(const Eigen::Vector3d& rotation_vector) {
-    orientation_ = rotation_vector;
-    orientation_set_ = true;
-  }
-  /// Makes the path's steps turn the orientation instead of holding it: from the reference R_0 at t = 0 to
-  /// Rot(turn) R_0 at t = T, by a rotation about the fixed world axis turn / |turn| through |turn| rad (for
-  /// |turn| <= pi the spherical linear interpolation; a larger |turn| goes the long way round, as asked), with the
-  /// cycloidal timing s(t) = t/T - sin(2 pi t/T) / (2 pi), so that the angular velocity
-  /// turn s'(t), fed forward, starts and ends at zero. Planar: only turn.z() is used (an angle about z).
-  void set_orientation_turn(const Eigen::Vector3d& turn) { turn_ = turn; }
+  void set_orientation_reference(const Eigen::Vector3d& rotation_vector) { orientation_.set(rotation_vector); }
+  /// Makes the path's steps turn the orientation instead of holding it (OrientationReference::set_turn: from the
+  /// reference R_0 at t = 0 to Rot(turn) R_0 at t = T, cycloidal timing). Planar: only turn.z() is used.
+  void set_orientation_turn(const Eigen::Vector3d& turn) { orientation_.set_turn(turn); }
   /// The orientation reference (meaningful once set or captured).
-  [[nodiscard]] const Eigen::Vector3d& orientation_reference() const noexcept { return orientation_; }
+  [[nodiscard]] const Eigen::Vector3d& orientation_reference() const noexcept { return orientation_.orientation(); }
   /// Computes at least this much kinematics each step (e.g. kManipulability to record w with any scheme).
   void set_kinematics_level(KinematicsLevel level) { level_ = std::max(level_, level); }
   /// What a step does when its QP cannot be solved (status not `solved`). By default it holds: theta_dot = 0.
@@ -82,6 +91,15 @@ class Controller {
   [[nodiscard]] const Eigen::VectorXd& velocity_upper() const noexcept { return vhi_; }
   [[nodiscard]] const SolverResult& result() const noexcept { return result_; }
   [[nodiscard]] const RobotModel& robot() const noexcept { return *robot_; }
+  /// The name of the engine it solves with.
+  [[nodiscard]] std::string_view engine_name() const { return engine_->name(); }
+  /// The scheme it runs.
+  [[nodiscard]] const Scheme& scheme() const noexcept { return *scheme_; }
+  /// This controller's data of the scheme's plugins, as the last step left it (e.g. the distances of a collision
+  /// constraint): what violated(), the outputs' record() and summarise() read.
+  [[nodiscard]] const SchemeData& plugin_data() const noexcept { return *data_; }
+  /// The same, shared: it stays alive after the controller (a run's summary reads it).
+  [[nodiscard]] std::shared_ptr<const SchemeData> shared_plugin_data() const noexcept { return data_; }
 
  private:
   void solve(double t, StepOutput& out);
@@ -89,22 +107,20 @@ class Controller {
 
   const RobotModel* robot_;
   const Scheme* scheme_;
+  std::shared_ptr<SchemeData> data_;  // the plugins' per-controller data (never null)
   LviEngine* engine_;
   const Path* path_;
   KinematicsData kin_;
   QpProblem qp_;
   SolverResult result_;
   Eigen::VectorXd r_d_, r_d_dot_;
-  Eigen::VectorXd vlo_, vhi_;  // the velocity-limit laws at theta, once per step
-  Eigen::Vector3d orientation_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d turn_ = Eigen::Vector3d::Zero();  // set_orientation_turn(); zero: hold
-  bool orientation_set_ = false;                    // by set_orientation_reference()
-  bool orientation_captured_ = false;               // from the first path-driven step
+  Eigen::VectorXd vlo_, vhi_;         // the velocity-limit laws at theta, once per step
+  OrientationReference orientation_;  // the orientation rows of r_d and r_d_dot under a path
   KinematicsLevel level_ = KinematicsLevel::kPosition;
   Context ctx_;
   double relax_weight_ = 0.0;                // set_relaxation(); 0: hold
   std::unique_ptr<LviEngine> relax_engine_;  // an engine like *engine_ for the elastic QP
-  QpProblem relaxed_;                        // the elastic QP (no equality rows)
+  ElasticQp relaxed_;                        // the elastic QP (no equality rows)
   SolverResult relaxed_result_;
 };
 

@@ -15,6 +15,12 @@
 /// The public, non-virtual contribute() calls the private virtual add_to() and then validates what the plugin
 /// wrote: every entry finite, W symmetric. Bounds are intersected (lo_i = max, hi_i = min) with the plugin as
 /// source, so a conflict lo_i > hi_i names the plugins that caused it; the engine reports it as infeasible.
+///
+/// Model and data. A plugin is immutable once built: everything a step writes (distances, broadphase state, scratch
+/// matrices) lives in the plugin's PluginData, which the plugin makes (make_data()) for each controller and the
+/// controller owns and hands back at every step. One scheme can so serve several controllers, each in its own
+/// thread. What a plugin adds to a run's outputs (trajectory columns, summary figures, obstacles) is not part of
+/// this interface: see run/plugin_output.hpp.
 
 #include <memory>
 #include <optional>
@@ -24,22 +30,21 @@
 #include <Eigen/Core>
 
 #include "redres/config/config.hpp"
+#include "redres/config/registry.hpp"
 #include "redres/control/context.hpp"
 #include "redres/model/kinematics.hpp"
 #include "redres/qp/qp_builder.hpp"
-#include "redres/config/registry.hpp"
 
 namespace redres {
 
-class Trajectory;
-struct ShapeSpec;
-
-/// A named figure that a plugin adds to the run summary (one number, or one per joint).
-struct Metric {
-  std::string name;            //!< e.g. "max_safety_region_entry"
-  std::vector<double> values;  //!< one value, or one per joint
-  std::string unit;            //!< e.g. "rad"
-  bool per_joint = false;      //!< values has one entry per joint (written as an array even for one joint)
+/// One controller's state and scratch of one plugin: derive a plugin's own data from it, and make it in
+/// Plugin::make_data(). The controller owns it and passes it to every call that a step makes.
+class PluginData {
+ public:
+  PluginData() = default;
+  PluginData(const PluginData&) = delete;
+  PluginData& operator=(const PluginData&) = delete;
+  virtual ~PluginData() = default;
 };
 
 /// Base of objectives and constraints: type, instance name, active flag and the configuration round trip.
@@ -72,24 +77,21 @@ class Plugin {
   [[nodiscard]] virtual KinematicsLevel kinematics_level() const { return KinematicsLevel::kPosition; }
   /// The full configuration (type, common keys and the plugin's own), readable by the same registry.
   [[nodiscard]] toml::table config() const;
-  /// Whether the state at the last contribution breaks what this plugin guards (e.g. two bodies overlap). The
-  /// simulation counts such a step as failed, with describe_violation() in its diagnosis. Allocation-free.
-  [[nodiscard]] virtual bool violated() const { return false; }
-  /// What is violated, e.g. "link 'j3' ... vs obstacle 1 overlap by 0.004 m" (called only when violated()).
-  [[nodiscard]] virtual std::string describe_violation() const { return {}; }
-  /// Columns this plugin adds to trajectory.csv (default: none), e.g. "min_obstacle_distance".
-  [[nodiscard]] virtual std::vector<std::string> recorded_columns() const { return {}; }
-  /// Writes this step's values of recorded_columns() (called after each contribution; allocation-free).
-  virtual void record(double* values) const { (void)values; }
-  /// Figures this plugin adds to the run summary, computed from the recorded run (default: none).
-  virtual void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const {
-    (void)robot;
-    (void)run;
-    (void)out;
+  /// Makes this plugin's data for one controller (at setup; may allocate). Default: none (nullptr), for a plugin
+  /// whose steps keep no state and need no scratch.
+  [[nodiscard]] virtual std::unique_ptr<PluginData> make_data() const { return nullptr; }
+  /// Whether the state at the last contribution (recorded in `data`, what make_data() made) breaks what this plugin
+  /// guards (e.g. two bodies overlap). The simulation counts such a step as failed, with describe_violation() in
+  /// its diagnosis. Allocation-free.
+  [[nodiscard]] virtual bool violated(const PluginData* data) const {
+    (void)data;
+    return false;
   }
-  /// Obstacles this plugin keeps the robot away from, for summary.json and the figures: world-frame shapes at
-  /// t = 0, each with its constant velocity if it moves (default: none).
-  virtual void scene_obstacles(std::vector<ShapeSpec>& out) const { (void)out; }
+  /// What is violated, e.g. "link 'j3' ... vs obstacle 1 overlap by 0.004 m" (called only when violated()).
+  [[nodiscard]] virtual std::string describe_violation(const PluginData* data) const {
+    (void)data;
+    return {};
+  }
 
  protected:
   explicit Plugin(std::string type);
@@ -113,12 +115,12 @@ class Objective : public Plugin {
   [[nodiscard]] double weight() const noexcept { return weight_; }
   /// Sets the weight; std::invalid_argument unless finite and >= 0.
   void set_weight(double weight);
-  /// Adds this objective's terms and validates them.
-  void contribute(const Context& ctx, QpBuilder& builder) const;
+  /// Adds this objective's terms and validates them. `data` is what make_data() made for the calling controller.
+  void contribute(const Context& ctx, QpBuilder& builder, PluginData* data) const;
   /// Framework use (Scheme::build): adds the terms without validating them; the caller checks the whole QP after
   /// every plugin has written, and builds it again through contribute() to name a culprit.
-  void contribute_unchecked(const Context& ctx, QpBuilder& builder) const {
-    if (active()) add_to(ctx, builder);
+  void contribute_unchecked(const Context& ctx, QpBuilder& builder, PluginData* data) const {
+    if (active()) add_to(ctx, builder, data);
   }
   /// A scalar P(theta) whose gradient is the zeta this objective adds per unit weight, where one exists; the
   /// conformance checks compare zeta with central differences of it.
@@ -132,7 +134,8 @@ class Objective : public Plugin {
 
  private:
   void write_common(toml::table& out) const override;
-  virtual void add_to(const Context& ctx, QpBuilder& builder) const = 0;
+  /// Adds W and zeta for this step; `data` is this controller's make_data() (nullptr when it makes none).
+  virtual void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const = 0;
 
   double weight_ = 1.0;
 };
@@ -140,11 +143,11 @@ class Objective : public Plugin {
 /// A constraint adds equality rows, inequality rows or bounds.
 class Constraint : public Plugin {
  public:
-  /// Adds this constraint's rows and bounds and validates them.
-  void contribute(const Context& ctx, QpBuilder& builder) const;
+  /// Adds this constraint's rows and bounds and validates them. `data` is what make_data() made for the caller.
+  void contribute(const Context& ctx, QpBuilder& builder, PluginData* data) const;
   /// Framework use (Scheme::build): as Objective::contribute_unchecked.
-  void contribute_unchecked(const Context& ctx, QpBuilder& builder) const {
-    if (active()) add_to(ctx, builder);
+  void contribute_unchecked(const Context& ctx, QpBuilder& builder, PluginData* data) const {
+    if (active()) add_to(ctx, builder, data);
   }
   /// Number of equality rows it writes (fixed at setup).
   [[nodiscard]] virtual int equality_rows(const RobotModel& robot) const {
@@ -156,9 +159,10 @@ class Constraint : public Plugin {
     (void)robot;
     return 0;
   }
-  /// What its inequality row `row` (0-based, its own numbering) stood for at the last contribution, for the
-  /// diagnosis of a failed solve (e.g. the collision pair and its distance). Default: nothing.
-  [[nodiscard]] virtual std::string describe_inequality_row(int row) const {
+  /// What its inequality row `row` (0-based, its own numbering) stood for at the last contribution (in `data`),
+  /// for the diagnosis of a failed solve (e.g. the collision pair and its distance). Default: nothing.
+  [[nodiscard]] virtual std::string describe_inequality_row(const PluginData* data, int row) const {
+    (void)data;
     (void)row;
     return {};
   }
@@ -167,7 +171,8 @@ class Constraint : public Plugin {
   using Plugin::Plugin;
 
  private:
-  virtual void add_to(const Context& ctx, QpBuilder& builder) const = 0;
+  /// Adds rows and bounds for this step; `data` is this controller's make_data() (nullptr when it makes none).
+  virtual void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const = 0;
 };
 
 /// Objective factories receive their Config and the robot.

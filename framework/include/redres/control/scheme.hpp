@@ -9,7 +9,15 @@
 
 namespace redres {
 
-/// Objectives and constraints assembled into one QP. Immutable after construction; build() allocates nothing.
+/// One controller's data for a scheme: each plugin's PluginData (nullptr for a plugin that makes none), in the
+/// scheme's order. Made by Scheme::make_data(); the caller (a Controller) owns it and passes it to every build.
+struct SchemeData {
+  std::vector<std::unique_ptr<PluginData>> objectives;   //!< one per objective
+  std::vector<std::unique_ptr<PluginData>> constraints;  //!< one per constraint
+};
+
+/// Objectives and constraints assembled into one QP. Immutable after construction, so one scheme can serve several
+/// controllers at once (each with its own SchemeData, in its own thread); build() allocates nothing.
 class Scheme {
  public:
   /// Takes ownership of the plugins; sizes follow from the robot and the constraints' row counts.
@@ -21,14 +29,17 @@ class Scheme {
   /// its FieldError is a ConfigError at the key.
   static Scheme from_toml(const TableReader& root, const RobotModel& robot, double duration = 0.0, double step = 0.0);
 
-  /// Sizes `qp` for this scheme (n, m_e, m_i) and names its sources.
-  void setup(QpProblem& qp) const;
+  /// Makes every plugin's data for one controller (allocates; at setup).
+  [[nodiscard]] SchemeData make_data() const;
+  /// Sizes `qp` for this scheme (n, m_e, m_i) and names its sources; the descriptions of its inequality rows read
+  /// the plugins' data in `data` (which may be moved, but must outlive `qp`'s use).
+  void setup(QpProblem& qp, const SchemeData& data) const;
   /// Clears `qp` and lets every active plugin contribute. `ctx.kinematics` must be at kinematics_level().
   /// The plugins write without checks; then one scan checks every entry they can have written (W, zeta, the
   /// rows; bounds are checked as they are intersected). When it finds a non-finite entry (or an asymmetric W), the
   /// QP is built again with a check after each plugin, which throws std::invalid_argument naming the plugin and
   /// the entry. The QP it leaves is therefore valid (QpProblem::validate() would pass).
-  void build(const Context& ctx, QpProblem& qp) const;
+  void build(const Context& ctx, QpProblem& qp, SchemeData& data) const;
 
   /// The deepest kinematics any plugin reads.
   [[nodiscard]] KinematicsLevel kinematics_level() const noexcept { return level_; }
@@ -50,7 +61,7 @@ class Scheme {
   KinematicsLevel level_ = KinematicsLevel::kPosition;
   // Clears qp and lets every plugin write (checked: through contribute(), which throws naming a culprit); returns
   // whether a plugin wrote off W's diagonal.
-  bool contribute_all(const Context& ctx, QpProblem& qp, bool checked) const;
+  bool contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked) const;
 };
 
 }  // namespace redres

@@ -38,8 +38,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "redres/model/collision.hpp"
 #include "redres/config/toml_reader.hpp"
+#include "redres/model/collision.hpp"
 #include "redres/model/velocity_limit.hpp"
 
 namespace redres {

@@ -26,6 +26,7 @@
 #include "redres/config/config.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/qp/qp.hpp"
+#include "redres/qp/row_fit.hpp"  // RowFit, best_row_fit: the test behind `infeasible`
 
 namespace redres {
 
@@ -127,18 +128,6 @@ class LviEngine {
   bool warm_ = false;
   int n_ = 0, m_e_ = 0, m_i_ = 0;
 };
-
-/// The best the constraint rows can be met inside the bounds: an x in [lo, hi] that minimises
-/// |J x - d|^2 + |(A x - b)+|^2, found by an active-set bounded least-squares method (exact, up to rounding, for
-/// equality rows alone; for inequality rows an active-set iteration polished by projected gradient steps). The
-/// engines' `infeasible` is this test's verdict: the rows miss by more than 10 tolerances at x.
-struct RowFit {
-  Eigen::VectorXd x;               //!< the fit (n), inside the bounds
-  double equality_miss = 0.0;      //!< max_r |J_r x - d_r|
-  double inequality_excess = 0.0;  //!< max(0, max_r A_r x - b_r)
-};
-/// See RowFit. Allocates; meant for diagnoses and tests, not the per-step path.
-[[nodiscard]] RowFit best_row_fit(const QpProblem& qp);
 
 /// ||e(u)||_2 of the LVI (eq. 14) at u = [x; y; z].
 [[nodiscard]] double lvi_residual(const QpProblem& qp, const SolverResult& u, double varpi);

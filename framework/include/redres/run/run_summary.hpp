@@ -2,13 +2,16 @@
 /// @file
 /// The summary of a run as a value: the figures the CLI prints, `compare` tabulates, the golden tests check and
 /// summary.json serialises (field by field; docs/output_formats.md). Plugins add their own figures through
-/// Plugin::summarise(), collected under `metrics`, and their obstacles through Plugin::scene_obstacles().
+/// PluginOutput::summarise(), collected under `metrics`, and their obstacles through PluginOutput::scene_obstacles().
 
 #include <string>
+#include <string_view>
+#include <variant>
 #include <vector>
 
-#include "redres/model/collision.hpp"
 #include "redres/control/plugin.hpp"
+#include "redres/model/collision.hpp"
+#include "redres/run/plugin_output.hpp"
 #include "redres/run/simulation.hpp"
 
 namespace redres {
@@ -58,7 +61,7 @@ struct PluginMetrics {
 };
 
 /// One obstacle of the scene, for drawing: a world-frame shape at t = 0 (with its velocity if it moves), and the
-/// plugin that reported it (Plugin::scene_obstacles).
+/// plugin that reported it (PluginOutput::scene_obstacles).
 struct ObstacleFacts {
   std::string plugin;  //!< instance name
   ShapeSpec shape;     //!< as configured
@@ -92,6 +95,30 @@ struct RunSummary {
   /// A plugin's metric by plugin instance name and metric name, or nullptr.
   [[nodiscard]] const Metric* metric(const std::string& plugin, const std::string& metric_name) const;
 };
+
+/// A value of one summary field.
+using SummaryValue = std::variant<long, double, bool, std::string, std::vector<double>, std::vector<std::string>>;
+
+/// One field of the summary: its key in summary.json (nested tables joined by '.', e.g. "solver.max_residual"),
+/// its JSON type and its meaning (with the unit), and its value in a summary. summary_fields() is the one list of
+/// the summary's fields: summary.json, the Python summary dict, the comparison table (comparison.hpp) and the table
+/// in docs/output_formats.md (summary_fields_markdown(), checked by a test) all come from it. The three structured
+/// parts (robot.link_shapes, metrics, obstacles) have no `get`: to_json writes them from the summary's members.
+struct SummaryField {
+  std::string_view key;                              //!< e.g. "manipulability.mean"
+  std::string_view type;                             //!< e.g. "number", "array of n numbers"
+  std::string_view meaning;                          //!< one line, with the unit
+  SummaryValue (*get)(const RunSummary&) = nullptr;  //!< the value; nullptr for a structured part
+};
+
+/// Every field of the summary, in the order docs/output_formats.md lists them.
+[[nodiscard]] const std::vector<SummaryField>& summary_fields();
+
+/// The table of summary_fields() as docs/output_formats.md shows it (key, type, meaning).
+[[nodiscard]] std::string summary_fields_markdown();
+
+/// The value of the field `key` of `summary`; std::invalid_argument listing the keys when there is none.
+[[nodiscard]] SummaryValue summary_value(const RunSummary& summary, std::string_view key);
 
 /// Summarises a run of `scenario`.
 [[nodiscard]] RunSummary summarise(const Scenario& scenario, const RunResult& run);

@@ -28,6 +28,8 @@ struct RunResult {
   double max_relaxed_task_error = 0.0;    //!< the largest task_row_error of a relaxed step
   std::string first_relaxed;              //!< "t = ...: <diagnosis>" of the first relaxed step
   bool interrupted = false;               //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
+  /// The plugins' data as the run's last step left it (what their summaries read, e.g. FCL's failures).
+  std::shared_ptr<const SchemeData> plugin_data;
 
   /// "projection", or "newton+projection" when a fallback ran.
   [[nodiscard]] std::string engine() const;

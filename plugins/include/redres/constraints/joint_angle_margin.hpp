@@ -7,6 +7,7 @@
 /// rad or m) and `safety_margin` (the margin per joint).
 
 #include "redres/control/plugin.hpp"
+#include "redres/run/plugin_output.hpp"
 
 namespace redres {
 
@@ -19,16 +20,17 @@ struct JointAngleMarginConfig {
 };
 
 /// The joint-angle safety-margin constraint.
-class JointAngleMargin final : public Configured<Constraint, JointAngleMarginConfig> {
+class JointAngleMargin final : public Configured<Constraint, JointAngleMarginConfig>, public PluginOutput {
  public:
   static constexpr const char* kType = "joint_angle_margin";
   JointAngleMargin(const Config& config, const RobotModel& robot);
   /// The margin per joint.
   [[nodiscard]] const Eigen::VectorXd& margin() const noexcept { return margin_; }
-  void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const override;
+  void summarise(const RobotModel& robot, const Trajectory& run, const PluginData* data,
+                 std::vector<Metric>& out) const override;
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override;
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
 
   Eigen::VectorXd margin_;
 };

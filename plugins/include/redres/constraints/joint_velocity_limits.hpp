@@ -21,7 +21,7 @@ class JointVelocityLimits final : public Configured<Constraint, JointVelocityLim
   JointVelocityLimits(const Config& config, const RobotModel& robot);
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override;
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
 };
 
 }  // namespace redres

@@ -22,9 +22,10 @@
 #include <utility>
 #include <vector>
 
-#include "redres/model/collision.hpp"
 #include "redres/control/collision_rows.hpp"
 #include "redres/control/plugin.hpp"
+#include "redres/model/collision.hpp"
+#include "redres/run/collision_output.hpp"
 
 namespace redres {
 
@@ -52,14 +53,17 @@ inline auto enum_names(ObstacleAvoidanceConfig::Broadphase) {
 /// Above this many (link shape, obstacle) pairs, `broadphase = "auto"` uses FCL's tree.
 inline constexpr int kBroadphasePairs = 256;
 
-class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig> {
+class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig>, public PairOutput {
  public:
   static constexpr const char* kType = "obstacle_avoidance";
   ObstacleAvoidance(const Config& config, const RobotModel& robot);
   ~ObstacleAvoidance() override;
 
+  /// A distance query over the link shapes and the obstacles (its broadphase tree over the obstacles when it is
+  /// used), the pairs' distances, and the scratch of a step.
+  [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
   [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
-  [[nodiscard]] std::string describe_inequality_row(int row) const override;
+  [[nodiscard]] std::string describe_inequality_row(const PluginData* data, int row) const override;
   /// Its obstacles, as configured (summary.json's `obstacles`).
   void scene_obstacles(std::vector<ShapeSpec>& out) const override;
 
@@ -67,26 +71,23 @@ class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig> {
   [[nodiscard]] Eigen::Isometry3d obstacle_pose(int k, double t) const;
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override;
+  struct Data;
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
   // The row of link shape l (at Tl) against obstacle o (at To): measured, then a damper or a slack row.
-  void pair_row(const KinematicsData& kin, int l, const Eigen::Isometry3d& Tl, int o, const Eigen::Isometry3d& To,
-                Eigen::Block<Eigen::MatrixXd>& A, Eigen::VectorBlock<Eigen::VectorXd>& b) const;
+  void pair_row(Data& data, const KinematicsData& kin, int l, const Eigen::Isometry3d& Tl, int o,
+                const Eigen::Isometry3d& To, Eigen::Block<Eigen::MatrixXd>& A,
+                Eigen::VectorBlock<Eigen::VectorXd>& b) const;
   // The broadphase path of add_to(): only the pairs the tree finds near are measured.
-  void add_near_pairs(const Context& ctx, QpBuilder& builder) const;
+  void add_near_pairs(Data& data, const Context& ctx, QpBuilder& builder) const;
 
   const RobotModel* robot_;
-  std::unique_ptr<DistanceQuery> query_;  // link shapes first, then the obstacles
+  std::vector<ShapeSpec> shapes_;  // the query's shapes: link shapes first, then the obstacles
   int links_ = 0, obstacles_ = 0;
-  mutable Eigen::Matrix3Xd jacobian_;
-  // Broadphase: whether it is used, whether an obstacle moves, whether the tree holds the obstacles' poses yet, the
-  // obstacles' poses this step, and the candidates near() returns for one link shape.
+  // Broadphase: whether it is used; whether an obstacle moves; whether the robot is planar.
   bool broadphase_ = false, moving_ = false, planar_ = false;
   // Each obstacle's pose at t = 0 and its velocity (zero when it stands still).
   std::vector<Eigen::Isometry3d> start_poses_;
   std::vector<Eigen::Vector3d> velocities_;
-  mutable bool placed_ = false;
-  mutable std::vector<Eigen::Isometry3d> poses_;
-  mutable std::vector<int> candidates_;
 };
 
 }  // namespace redres

@@ -11,9 +11,10 @@
 #include <utility>
 #include <vector>
 
-#include "redres/model/collision.hpp"
 #include "redres/control/collision_rows.hpp"
 #include "redres/control/plugin.hpp"
+#include "redres/model/collision.hpp"
+#include "redres/run/collision_output.hpp"
 
 namespace redres {
 
@@ -27,24 +28,26 @@ struct SelfCollisionConfig {
 };
 
 /// The self-collision constraint.
-class SelfCollision final : public PairConstraint<SelfCollisionConfig> {
+class SelfCollision final : public PairConstraint<SelfCollisionConfig>, public PairOutput {
  public:
   static constexpr const char* kType = "self_collision";
   SelfCollision(const Config& config, const RobotModel& robot);
   ~SelfCollision() override;
 
+  /// A distance query over the link shapes, the pairs' distances, and the two witness points' Jacobians.
+  [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
   [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
-  [[nodiscard]] std::string describe_inequality_row(int row) const override;
+  [[nodiscard]] std::string describe_inequality_row(const PluginData* data, int row) const override;
   /// The checked pairs (indices into RobotModel::link_shapes()).
   [[nodiscard]] const std::vector<std::pair<int, int>>& pairs() const noexcept { return pairs_; }
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override;
+  struct Data;
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
 
   const RobotModel* robot_;
-  std::unique_ptr<DistanceQuery> query_;
+  std::vector<ShapeSpec> shapes_;  // the link shapes
   std::vector<std::pair<int, int>> pairs_;
-  mutable Eigen::Matrix3Xd ja_, jb_;
 };
 
 }  // namespace redres

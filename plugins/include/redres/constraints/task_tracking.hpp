@@ -10,6 +10,7 @@
 /// of the rotation-vector error's task rows).
 
 #include "redres/control/plugin.hpp"
+#include "redres/run/plugin_output.hpp"
 
 namespace redres {
 
@@ -21,16 +22,17 @@ struct TaskTrackingConfig {
 };
 
 /// The end-effector task constraint.
-class TaskTracking final : public Configured<Constraint, TaskTrackingConfig> {
+class TaskTracking final : public Configured<Constraint, TaskTrackingConfig>, public PluginOutput {
  public:
   static constexpr const char* kType = "task_tracking";
   TaskTracking(const Config& config, const RobotModel& robot);
   [[nodiscard]] int equality_rows(const RobotModel& robot) const override { return robot.task_dim(); }
   [[nodiscard]] KinematicsLevel kinematics_level() const override { return KinematicsLevel::kJacobian; }
-  void summarise(const RobotModel& robot, const Trajectory& run, std::vector<Metric>& out) const override;
+  void summarise(const RobotModel& robot, const Trajectory& run, const PluginData* data,
+                 std::vector<Metric>& out) const override;
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override;
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
 
   Eigen::VectorXd gain_;
 };

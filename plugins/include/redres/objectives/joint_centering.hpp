@@ -25,7 +25,7 @@ class JointCentering final : public Configured<Objective, JointCenteringConfig> 
   [[nodiscard]] std::optional<double> potential(const Context& ctx) const override;
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override;
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
 
   Eigen::VectorXd theta_ref_;
 };

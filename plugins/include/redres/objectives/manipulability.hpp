@@ -73,7 +73,7 @@ class Manipulability final : public Configured<Objective, ManipulabilityConfig> 
   void check_run(double T, double tau) const override;
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override;
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
 
   std::unique_ptr<Formula> formula_;
 };

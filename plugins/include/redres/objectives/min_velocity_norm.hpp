@@ -20,7 +20,7 @@ class MinVelocityNorm final : public Configured<Objective, MinVelocityNormConfig
   [[nodiscard]] std::optional<double> potential(const Context& ctx) const override;
 
  private:
-  void add_to(const Context& ctx, QpBuilder& builder) const override;
+  void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
 };
 
 }  // namespace redres

@@ -1,0 +1,138 @@
+/// The diagnosis of a failed solve (LviEngine::diagnose_failure): the status and the text, from the row fit
+/// (best_row_fit) and the equality rows' singular values.
+
+#include "redres/qp/lvi.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <sstream>
+#include <string>
+
+#include <Eigen/SVD>
+
+#include "redres/qp/row_fit.hpp"
+
+namespace redres {
+
+namespace {
+
+std::string joint_label(const QpProblem& qp, int i) {
+  std::string s = "joint " + std::to_string(i + 1);
+  if (i < static_cast<int>(qp.variable_names.size()))
+    s += " ('" + qp.variable_names[static_cast<std::size_t>(i)] + "')";
+  return s;
+}
+
+// Why the rows cannot be met: the best fit of the rows inside the bounds (best_row_fit), and the joints held at a
+// bound there. Runs only after a failure. *infeasible: the rows miss by more than 10 tolerances at best.
+std::string diagnose_rows(const QpProblem& qp, double tolerance, bool* infeasible) {
+  const int n = qp.n();
+  const RowFit fit = best_row_fit(qp);
+  const Eigen::VectorXd& x = fit.x;
+  const Eigen::VectorXd eq = qp.J * x - qp.d;
+  const Eigen::VectorXd in = (qp.A * x - qp.b).cwiseMax(0.0);
+  const double worst = std::max(fit.equality_miss, fit.inequality_excess);
+  *infeasible = worst > 10.0 * tolerance;
+  std::ostringstream s;
+  s.precision(6);
+  if (!*infeasible) {
+    s << "the rows can be met inside the bounds (best residual " << worst << ")";
+    return s.str();
+  }
+  s << "the constraint rows cannot be met inside the bounds:";
+  for (Eigen::Index r = 0; r < eq.size(); ++r) {
+    if (std::abs(eq(r)) > 10.0 * tolerance) {
+      s << " equality row " << r + 1 << " (from '" << source_name(qp, qp.eq_source[static_cast<std::size_t>(r)])
+        << "') misses by " << std::abs(eq(r)) << " at best;";
+    }
+  }
+  for (Eigen::Index r = 0; r < in.size(); ++r) {
+    if (in(r) > 10.0 * tolerance) {
+      s << " inequality row " << r + 1 << " (from '" << source_name(qp, qp.in_source[static_cast<std::size_t>(r)])
+        << "'";
+      if (qp.in_row_description) {
+        const std::string what = qp.in_row_description(static_cast<int>(r));
+        if (!what.empty()) s << ": " << what;
+      }
+      s << ") is exceeded by " << in(r) << " at best;";
+    }
+  }
+  s << " joints held at a bound there:";
+  bool any = false;
+  for (int i = 0; i < n; ++i) {
+    const bool at_lo = std::isfinite(qp.lo(i)) && x(i) <= qp.lo(i) + 1e-12;
+    const bool at_hi = std::isfinite(qp.hi(i)) && x(i) >= qp.hi(i) - 1e-12;
+    if (!at_lo && !at_hi) continue;
+    any = true;
+    s << " " << joint_label(qp, i) << " at its " << (at_lo ? "lower" : "upper") << " bound "
+      << (at_lo ? qp.lo(i) : qp.hi(i)) << " (from '"
+      << source_name(qp, at_lo ? qp.lo_source[static_cast<std::size_t>(i)] : qp.hi_source[static_cast<std::size_t>(i)])
+      << "');";
+  }
+  if (!any) s << " none (the rows are inconsistent by themselves);";
+  std::string out = s.str();
+  out.pop_back();
+  return out;
+}
+
+// What the equality rows' singular values say, when they say something: "" for well-conditioned rows.
+std::string singular_rows(const QpProblem& qp) {
+  if (qp.m_eq() == 0) return {};
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(qp.J).singularValues();
+  const double largest = sv.size() > 0 ? sv(0) : 0.0;
+  int rank = 0;
+  for (Eigen::Index k = 0; k < sv.size(); ++k) rank += sv(k) > 1e-9 * largest && sv(k) > 0.0;
+  const double smallest = qp.m_eq() > qp.n() ? 0.0 : sv(sv.size() - 1);
+  std::ostringstream s;
+  s.precision(3);
+  if (rank < qp.m_eq()) {
+    s << "the " << qp.m_eq() << " equality rows have rank " << rank << " here (a singular configuration: smallest "
+      << "singular value " << smallest << ", largest " << largest << ")";
+  } else if (smallest < 1e-4 * largest) {
+    s << "the equality rows are nearly singular here (smallest singular value " << smallest << ", largest " << largest
+      << ")";
+  }
+  return s.str();
+}
+
+}  // namespace
+
+void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info) const {
+  // One decision gives both the status and the text: the rows are infeasible exactly when the best fit of the rows
+  // inside the bounds misses them (best_row_fit); otherwise the engine failed on a QP that has a solution, and the
+  // text says how, with the residual compared to the tolerance only in the direction it holds.
+  bool unmeetable = false;
+  const std::string rows = diagnose_rows(qp, settings_.tolerance, &unmeetable);
+  const std::string singular = singular_rows(qp);
+  std::ostringstream s;
+  s.precision(6);
+  if (unmeetable) {
+    info.status = SolverStatus::kInfeasible;
+    s << rows;
+  } else {
+    const SolverStatus reported = info.status;
+    if (capped || reported == SolverStatus::kInfeasible || reported == SolverStatus::kSolved) {
+      info.status = SolverStatus::kNumericalError;
+      s << info.engine << ": the duals of the rows reached varpi = " << settings_.varpi << " although " << rows
+        << ": this step's multipliers are larger than varpi (raise [solver] varpi, or keep the arm away "
+        << "from this configuration)";
+    } else {
+      s << info.engine;
+      if (reported == SolverStatus::kMaxIterations) {
+        s << " reached max_iterations = " << settings_.max_iterations;
+      } else {
+        s << " failed";
+      }
+      if (!info.diagnosis.empty()) s << " (" << info.diagnosis << ")";
+      s << " with residual " << info.residual
+        << (info.residual > settings_.tolerance ? " > tolerance " : " (within tolerance ") << settings_.tolerance
+        << (info.residual > settings_.tolerance ? "" : ", but the engine did not accept it)") << " after "
+        << info.iterations << (info.iterations == 1 ? " iteration; " : " iterations; ") << rows;
+    }
+  }
+  if (!singular.empty()) s << "; " << singular;
+  info.diagnosis = s.str();
+}
+
+}  // namespace redres

@@ -1,0 +1,17 @@
+// Controller::from_scenario: declared with the controller (control/), defined here, beside the scenario it reads.
+#include "redres/control/controller.hpp"
+#include "redres/run/scenario.hpp"
+
+namespace redres {
+
+std::unique_ptr<Controller> Controller::from_scenario(Scenario& s) {
+  REDRES_REQUIRE(s.robot && s.scheme && s.engine, "Controller::from_scenario",
+                 "the scenario has a robot, a scheme and an engine (as load_scenario makes it)");
+  auto ctrl = std::make_unique<Controller>(*s.robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
+  ctrl->set_orientation_turn(s.orientation_turn);
+  ctrl->set_kinematics_level(KinematicsLevel::kGradient);
+  if (s.on_infeasible == OnInfeasible::kRelax) ctrl->set_relaxation(s.relax_weight);
+  return ctrl;
+}
+
+}  // namespace redres

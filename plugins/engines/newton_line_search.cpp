@@ -1,0 +1,108 @@
+/// `newton`'s exact line search on the reduced path (newton.cpp): the maximiser of the concave, piecewise quadratic
+/// dual function along the Newton step, found by walking the breakpoints where a joint reaches a bound.
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+
+#include "newton_internal.hpp"
+
+namespace redres::newton_internal {
+
+// phi'(s) along y + s delta: -delta . F(y + s delta) = sum_i -(J' delta)_i x_i(s) + delta . d, with
+// x_i(s) = P(v_i + s dv_i); piecewise linear and nonincreasing in s.
+double Newton::slope_at(const QpProblem& qp, double s) const {
+  double out = delta_.dot(qp.d);
+  for (int i = 0; i < qp.n(); ++i) {
+    out -= jtd_(i) * box(v_(i) + s * dv_(i), qp.lo(i), qp.hi(i));
+  }
+  return out;
+}
+
+// The exact maximiser of the concave, piecewise quadratic phi along delta (phi' is piecewise linear between the
+// breakpoints where some v_i crosses a bound). Returns +inf when phi' stays positive for ever: the dual is then
+// unbounded, which proves that J x = d cannot be met inside the bounds.
+template <int kRows>
+double Newton::exact_step(const QpProblem& qp) {
+  const int n = qp.n(), me = rows<kRows>(qp);
+  const double* __restrict J = qp.J.data();
+  const double* __restrict lo = qp.lo.data();
+  const double* __restrict hi = qp.hi.data();
+  const double* __restrict inv_w = inv_w_.data();
+  const double* __restrict delta = delta_.data();
+  const double* __restrict v = v_.data();
+  double* __restrict jtd_out = jtd_.data();
+  double* __restrict dv = dv_.data();
+  double* __restrict v1 = v1_.data();
+  double* __restrict x1 = x1_.data();
+  double* __restrict F1 = F1_.data();
+  // The usual case: no joint changes status between s = 0 and the full Newton step s = 1 (v is linear in s,
+  // so equal status at both ends means no crossing); phi' is then linear on [0, 1] and its root is at s = 1 up
+  // to rounding. Checked without divisions or sorting, in the same pass that computes x, v and F at s = 1, so
+  // that a full step needs no re-evaluation.
+  bool same_status = true;
+  for (int r = 0; r < me; ++r) F1[r] = -qp.d(r);
+  for (int i = 0; i < n; ++i) {
+    const double* Ji = J + static_cast<std::ptrdiff_t>(i) * me;
+    double jtd = 0.0;
+    for (int r = 0; r < me; ++r) jtd += Ji[r] * delta[r];
+    jtd_out[i] = jtd;
+    const double dvi = jtd * inv_w[i];
+    const double v0i = v[i], v1i = v0i + dvi;
+    dv[i] = dvi;
+    v1[i] = v1i;
+    const double x1i = box(v1i, lo[i], hi[i]);
+    x1[i] = x1i;
+    for (int r = 0; r < me; ++r) F1[r] += Ji[r] * x1i;
+    // Status -1 (at lo), 0 (free), +1 (at hi), computed without branches (the pattern varies by problem).
+    const int s0 = static_cast<int>(v0i >= hi[i]) - static_cast<int>(v0i <= lo[i]);
+    const int s1 = static_cast<int>(v1i >= hi[i]) - static_cast<int>(v1i <= lo[i]);
+    same_status &= s0 == s1;
+  }
+  double g0 = 0.0, g1 = 0.0;
+  for (int r = 0; r < me; ++r) {
+    g0 -= delta[r] * F_(r);
+    g1 -= delta[r] * F1[r];
+  }
+  full_step_ready_ = false;
+  if (!(g0 > 0.0)) return 0.0;
+  if (same_status && g1 < g0) {
+    // phi' is linear on [0, 1]; its root g0 / (g0 - g1) is s = 1 up to the regularisation and rounding (g1 is
+    // then tiny, of either sign): take the full step.
+    const double step = g0 / (g0 - g1);
+    if (std::abs(step - 1.0) <= 1e-9) {
+      full_step_ready_ = true;
+      return 1.0;
+    }
+    if (g1 <= 0.0) return step;  // the root lies inside [0, 1]
+  }
+  int count = 0;
+  for (int i = 0; i < n; ++i) {
+    if (dv_(i) == 0.0) continue;
+    for (const double bound : {qp.lo(i), qp.hi(i)}) {
+      const double s = (bound - v_(i)) / dv_(i);
+      if (std::isfinite(s) && s > 0.0) breaks_[static_cast<std::size_t>(count++)] = s;
+    }
+  }
+  std::sort(breaks_.begin(), breaks_.begin() + count);
+  double s0 = 0.0;
+  double g_prev = g0;
+  for (int k = 0; k <= count; ++k) {
+    // Beyond the last breakpoint phi' is linear for ever; probe it one unit further.
+    const double s1 = k < count ? breaks_[static_cast<std::size_t>(k)] : s0 + std::max(1.0, s0);
+    if (s1 <= s0) continue;
+    const double g_next = slope_at(qp, s1);
+    if (g_next <= 0.0) return s0 + (s1 - s0) * g_prev / (g_prev - g_next);  // root of the linear piece
+    if (k == count && !(g_next < g_prev * (1.0 - 1e-12))) return std::numeric_limits<double>::infinity();
+    if (k == count) return s1 + (s1 - s0) * g_next / (g_prev - g_next);
+    s0 = s1;
+    g_prev = g_next;
+  }
+  return s0;
+}
+
+template double Newton::exact_step<0>(const QpProblem& qp);
+template double Newton::exact_step<2>(const QpProblem& qp);
+
+}  // namespace redres::newton_internal

@@ -90,29 +90,10 @@ def test_wrong_sizes_raise_with_the_condition():
         redres.Controller(robot, objectives=[], constraints=[redres.constraints.JointAngleMargin(margin=[0.1, 0.2])])
 
 
-def test_a_controller_from_a_scenario_relaxes_as_the_run_does(tmp_path):
+def test_a_controller_from_a_scenario_relaxes_as_the_run_does():
     # The 4R arm starting stretched: under "relax" the first steps are relaxed, not held. Controller.from_scenario
     # must carry the policy (a hand-built loop once missed it, and its steps held).
-    scenario = tmp_path / "stretched.toml"
-    scenario.write_text(f"""name = "stretched"
-robot = "{source('robots/planar_4link.toml')}"
-duration = 0.5
-step = 0.01
-theta0 = [0, 0, 0, 0]
-[path]
-type = "circle"
-radius = 0.06
-[[objectives]]
-type = "min_velocity_norm"
-[[constraints]]
-type = "task_tracking"
-gain = 8.0
-[[constraints]]
-type = "joint_velocity_limits"
-[solver]
-engine = "newton"
-on_infeasible = "relax"
-""")
+    scenario = source("tests/data/scenarios/stretched_4r.toml")
     s = redres.Scenario.load(str(scenario))
     ctrl = redres.Controller.from_scenario(s)
     assert "planar_4link" in repr(ctrl) and "engine 'newton'" in repr(ctrl) and "2 constraints" in repr(ctrl)

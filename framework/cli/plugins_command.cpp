@@ -14,6 +14,7 @@
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
 #include "redres/qp/lvi.hpp"
+#include "redres/run/scenario.hpp"
 
 namespace redres::cli {
 
@@ -98,7 +99,8 @@ void print_plugins(bool json) {
                                 {"paths", registry_json(path_registry())},
                                 {"path_common_keys", keys_json(describe_keys(PathPlacement::schema()))},
                                 {"engines", registry_json(engine_registry())},
-                                {"solver_common_keys", keys_json(solver_common_keys())}};
+                                {"solver_common_keys", keys_json(solver_common_keys())},
+                                {"solver_policy_keys", keys_json(solver_policy_keys())}};
     std::cout << out.dump(2) << "\n";
     return;
   }
@@ -109,8 +111,10 @@ void print_plugins(bool json) {
   print_registry(velocity_limit_registry(), "velocity-limit laws ([joints.velocity_limit] in a robot file)", {}, "");
   print_registry(path_registry(), "paths (the [path] table of a scenario)", describe_keys(PathPlacement::schema()),
                  "keys of every path (placement and timing):");
-  print_registry(engine_registry(), "LVI engines (the [solver] table of a scenario)", solver_common_keys(),
-                 "keys of every engine:");
+  std::vector<KeyInfo> solver_keys = solver_common_keys();
+  for (const KeyInfo& k : solver_policy_keys()) solver_keys.push_back(k);
+  print_registry(engine_registry(), "LVI engines (the [solver] table of a scenario)", solver_keys,
+                 "keys of every engine, and the run's policy for a step that is not solved:");
 }
 
 }  // namespace redres::cli

@@ -107,5 +107,19 @@ TEST(PluginLoader, BadLibrariesAreExitTwoNamingTheLibrary) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(PluginsListing, TheSolverTableListsTheRunPolicyKeysWithTheirDefaultsAndRules) {
+  // on_infeasible and relax_weight are read through a schema, like the engines' keys, and listed with them.
+  const Cli text = redres("plugins");
+  ASSERT_EQ(text.code, 0) << text.out;
+  EXPECT_NE(text.out.find("on_infeasible   = 'hold'"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("[one of 'hold', 'stop', 'relax', 'continue']"), std::string::npos);
+  EXPECT_NE(text.out.find("relax_weight    = 10000.0"), std::string::npos);
+  EXPECT_NE(text.out.find("a weight in [1, 1e8]"), std::string::npos);
+  const Cli json = redres("plugins --json");
+  ASSERT_EQ(json.code, 0);
+  EXPECT_NE(json.out.find("\"solver_policy_keys\""), std::string::npos);
+  EXPECT_NE(json.out.find("\"relax_weight\""), std::string::npos);
+}
+
 }  // namespace
 }  // namespace redres

@@ -1,7 +1,11 @@
 #include "redres/run/scenario.hpp"
 
+#include <array>
 #include <cmath>
+#include <optional>
 #include <sstream>
+#include <string_view>
+#include <utility>
 
 #include "config/overrides.hpp"
 #include "redres/common/formula.hpp"
@@ -13,6 +17,31 @@
 namespace redres {
 
 namespace {
+
+// The [solver] table's keys that are the run's, not the engine's: what a failed step does. Read through a schema,
+// like the engine's keys, so that `redres plugins` lists them with their defaults and rules.
+enum class Policy { kHold, kStop, kRelax, kContinue };
+auto enum_names(Policy) {
+  return std::array{
+      std::pair{Policy::kHold, std::string_view("hold")}, std::pair{Policy::kStop, std::string_view("stop")},
+      std::pair{Policy::kRelax, std::string_view("relax")}, std::pair{Policy::kContinue, std::string_view("continue")}};
+}
+struct SolverPolicy {
+  Policy on_infeasible = Policy::kHold;
+  double relax_weight = 1e4;
+  static const Schema<SolverPolicy>& schema() {
+    using C = SolverPolicy;
+    static const Schema<C> s{
+        {field("on_infeasible", &C::on_infeasible, "",
+               "what a step whose QP is not solved does: hold (theta_dot = 0; `continue` is the same), stop (the run "
+               "ends there), relax (solves the elastic QP, rows relaxed, every bound kept)"),
+         field("relax_weight", &C::relax_weight, "", "rho of the elastic QP; only with on_infeasible = \"relax\"",
+               rule<double>("a weight in [1, 1e8]", [](double w) { return w >= 1.0 && w <= 1e8; }))},
+        {},
+        {}};
+    return s;
+  }
+};
 
 Eigen::VectorXd read_theta0(const TableReader& r, const RobotModel& robot) {
   if (!r.has("theta0")) return robot.home();
@@ -67,6 +96,11 @@ int Scenario::steps() const {
                  "duration / step is in [1, " + std::to_string(static_cast<long long>(kMaxSteps)) + "] (got " +
                      std::to_string(ratio) + ")");
   return static_cast<int>(std::lround(ratio));
+}
+
+const std::vector<KeyInfo>& solver_policy_keys() {
+  static const std::vector<KeyInfo> keys = describe_keys(SolverPolicy::schema());
+  return keys;
 }
 
 Scenario load_scenario(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
@@ -132,21 +166,15 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   if (r.has("solver")) {
     const TableReader t = r.table("solver");
     const TableReader solver(t.file_ptr(), t.raw(), "solver");
-    const std::string policy = solver.choice("on_infeasible", {"hold", "stop", "relax", "continue"}, "hold");
-    s.on_infeasible = policy == "stop"    ? OnInfeasible::kStop
-                      : policy == "relax" ? OnInfeasible::kRelax
-                                          : OnInfeasible::kHold;
-    if (solver.has("relax_weight")) {
-      s.relax_weight = solver.number("relax_weight");
-      if (!(s.relax_weight >= 1.0 && s.relax_weight <= 1e8)) {
-        std::ostringstream m;
-        m << "expected a weight in [1, 1e8], got " << s.relax_weight;
-        solver.fail("relax_weight", m.str());
-      }
-      if (s.on_infeasible != OnInfeasible::kRelax) {
-        solver.fail("relax_weight",
-                    "is used only with on_infeasible = \"relax\" (on_infeasible is \"" + policy + "\")");
-      }
+    SolverPolicy policy;
+    read_config(solver, SolverPolicy::schema(), policy);
+    s.on_infeasible = policy.on_infeasible == Policy::kStop    ? OnInfeasible::kStop
+                      : policy.on_infeasible == Policy::kRelax ? OnInfeasible::kRelax
+                                                               : OnInfeasible::kHold;
+    s.relax_weight = policy.relax_weight;
+    if (solver.has("relax_weight") && s.on_infeasible != OnInfeasible::kRelax) {
+      solver.fail("relax_weight", "is used only with on_infeasible = \"relax\" (on_infeasible is \"" +
+                                      std::string(solver.string("on_infeasible", "hold")) + "\")");
     }
     s.engine = make_engine(solver);
   } else {

@@ -70,6 +70,9 @@ inline constexpr double kMaxSteps = 10'000'000;
 /// The most memory a run's recorded table may take (2 GiB): rows x columns x 8 bytes, made before the loop.
 inline constexpr double kMaxTableBytes = 2.0 * 1024 * 1024 * 1024;
 
+/// The [solver] table's keys that the run reads besides the engine's (on_infeasible, relax_weight), for listings.
+[[nodiscard]] const std::vector<KeyInfo>& solver_policy_keys();
+
 /// Loads and checks a scenario. `overrides` are "key.path=value" strings (TOML values; a bare word is a string;
 /// array entries by 0-based index, e.g. "objectives.1.p=1"). Every problem is a ConfigError at file:line:col.
 [[nodiscard]] Scenario load_scenario(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});

@@ -310,5 +310,31 @@ velocity_limit = { type = "constant", lower = -1, upper = 1 }
   EXPECT_DOUBLE_EQ(robot.joint(0).velocity_limit->bounds(0.0).upper, 4.0 * std::acos(0.0));
 }
 
+TEST(NumberOrFormula, OneReaderForNumbersAndConstantFormulas) {
+  const auto file = parse_toml_string("a = 2\nb = 0.25\nc = \"pi/2\"\nd = true\ne = \"pi/\"\nf = \"1/0\"\n", "<numbers>");
+  const toml::table& t = file->root;
+  double v = -1.0;
+  EXPECT_TRUE(read_number_or_formula(*t.get("a"), v));
+  EXPECT_EQ(v, 2.0);
+  EXPECT_TRUE(read_number_or_formula(*t.get("b"), v));
+  EXPECT_EQ(v, 0.25);
+  EXPECT_TRUE(read_number_or_formula(*t.get("c"), v));
+  EXPECT_DOUBLE_EQ(v, std::acos(0.0));
+  v = -1.0;
+  EXPECT_FALSE(read_number_or_formula(*t.get("d"), v));  // a boolean is neither, and leaves v alone
+  EXPECT_EQ(v, -1.0);
+  EXPECT_THROW((void)read_number_or_formula(*t.get("e"), v), std::invalid_argument);
+  // A formula may evaluate to inf: the reader returns it, and the callers refuse it where they say where.
+  EXPECT_TRUE(read_number_or_formula(*t.get("f"), v));
+  EXPECT_FALSE(std::isfinite(v));
+  const TableReader r = TableReader::root(file, "numbers");
+  try {
+    (void)r.number("f");
+    ADD_FAILURE() << "a non-finite formula was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'f': expected a finite number, got inf"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace redres

@@ -249,21 +249,30 @@ void TableReader::fail(const std::string& message) const { throw ConfigError(loc
 
 bool TableReader::has(std::string_view key) const { return find(key) != nullptr; }
 
-double TableReader::to_number(std::string_view key, const toml::node& node, const std::string& what) const {
-  double v = 0.0;
+bool read_number_or_formula(const toml::node& node, double& v) {
   if (const auto* i = node.as_integer()) {
     v = static_cast<double>(i->get());
   } else if (const auto* f = node.as_floating_point()) {
     v = f->get();
   } else if (const auto* text = node.as_string()) {
-    // Every number in a file may be a constant formula, as theta0 entries are: "pi/2", "-3*pi/4", "0.25*2".
-    try {
-      v = evaluate_constant(text->get());
-    } catch (const std::invalid_argument& e) {
-      throw ConfigError(location_of(*file_, node), prefix() + "key '" + std::string(key) + "': expected " + what +
-                                                       " or a constant formula: " + e.what());
-    }
+    v = evaluate_constant(text->get());
   } else {
+    return false;
+  }
+  return true;
+}
+
+double TableReader::to_number(std::string_view key, const toml::node& node, const std::string& what) const {
+  double v = 0.0;
+  bool number = false;
+  try {
+    // Every number in a file may be a constant formula, as theta0 entries are: "pi/2", "-3*pi/4", "0.25*2".
+    number = read_number_or_formula(node, v);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(location_of(*file_, node), prefix() + "key '" + std::string(key) + "': expected " + what +
+                                                     " or a constant formula: " + e.what());
+  }
+  if (!number) {
     throw ConfigError(location_of(*file_, node),
                       prefix() + "key '" + std::string(key) + "': expected " + what + ", got " + describe_type(node));
   }

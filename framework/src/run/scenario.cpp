@@ -8,7 +8,6 @@
 #include <utility>
 
 #include "config/overrides.hpp"
-#include "redres/common/formula.hpp"
 #include "redres/config/plugin_loader.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/parsers/robot_toml.hpp"
@@ -55,17 +54,13 @@ Eigen::VectorXd read_theta0(const TableReader& r, const RobotModel& robot) {
   for (int j = 0; j < robot.dof(); ++j) {
     const toml::node& el = (*arr)[static_cast<std::size_t>(j)];
     double v = 0.0;
-    if (const auto* i = el.as_integer()) {
-      v = static_cast<double>(i->get());
-    } else if (const auto* f = el.as_floating_point()) {
-      v = f->get();
-    } else if (const auto* s = el.as_string()) {
-      try {
-        v = evaluate_constant(s->get());
-      } catch (const std::invalid_argument& e) {
-        throw ConfigError(location_of(r.file(), el), "key 'theta0': entry " + std::to_string(j + 1) + ": " + e.what());
-      }
-    } else {
+    bool number = false;
+    try {
+      number = read_number_or_formula(el, v);
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(location_of(r.file(), el), "key 'theta0': entry " + std::to_string(j + 1) + ": " + e.what());
+    }
+    if (!number) {
       throw ConfigError(location_of(r.file(), el), "key 'theta0': entry " + std::to_string(j + 1) +
                                                        ": expected a number or a formula string, got " +
                                                        describe_type(el));

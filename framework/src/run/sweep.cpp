@@ -16,7 +16,6 @@
 #include "common/input_file.hpp"
 #include "redres/common/csv.hpp"
 #include "redres/common/error.hpp"
-#include "redres/common/formula.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/run/run_summary.hpp"
 #include "redres/run/scenario.hpp"
@@ -83,15 +82,11 @@ std::vector<Eigen::VectorXd> read_theta0(const TableReader& t, const RobotModel&
       for (int j = 0; j < n; ++j) {
         const toml::node& el = (*q)[static_cast<std::size_t>(j)];
         try {
-          if (const auto* s = el.as_string()) {
-            theta(j) = evaluate_constant(s->get());
-          } else if (const auto* i = el.as_integer()) {
-            theta(j) = static_cast<double>(i->get());
-          } else if (const auto* f = el.as_floating_point()) {
-            theta(j) = f->get();
-          } else {
+          double v = 0.0;
+          if (!read_number_or_formula(el, v)) {
             throw std::invalid_argument("expected a number or a formula, got " + describe_type(el));
           }
+          theta(j) = v;
         } catch (const std::invalid_argument& e) {
           throw ConfigError(location_of(t.file(), el), "key 'list': " + std::string(e.what()));
         }

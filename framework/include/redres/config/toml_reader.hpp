@@ -39,6 +39,12 @@ struct TomlFile {
 /// Human-readable TOML type of a node ("a string", "an array", ...).
 [[nodiscard]] std::string describe_type(const toml::node& node);
 
+/// The one reader of a number that may be written as a constant formula: an integer or a floating-point node is its
+/// value, a string is evaluated as a constant formula ("pi/2", "-3*pi/4"; common/formula.hpp). Returns false for any
+/// other node (`v` untouched); a formula that does not evaluate is std::invalid_argument with the formula's message.
+/// The value may be non-finite: the caller checks, and says where.
+[[nodiscard]] bool read_number_or_formula(const toml::node& node, double& v);
+
 /// A TOML value as the text that reads back as it (what `--set key=value` takes): floats in their shortest
 /// round-trip form, still floats ("2.0", not "2"); strings quoted; arrays and tables inline.
 [[nodiscard]] std::string toml_value_text(const toml::node& node);

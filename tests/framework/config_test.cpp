@@ -311,7 +311,8 @@ velocity_limit = { type = "constant", lower = -1, upper = 1 }
 }
 
 TEST(NumberOrFormula, OneReaderForNumbersAndConstantFormulas) {
-  const auto file = parse_toml_string("a = 2\nb = 0.25\nc = \"pi/2\"\nd = true\ne = \"pi/\"\nf = \"1/0\"\n", "<numbers>");
+  const auto file =
+      parse_toml_string("a = 2\nb = 0.25\nc = \"pi/2\"\nd = true\ne = \"pi/\"\nf = \"1/0\"\n", "<numbers>");
   const toml::table& t = file->root;
   double v = -1.0;
   EXPECT_TRUE(read_number_or_formula(*t.get("a"), v));

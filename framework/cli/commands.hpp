@@ -32,6 +32,12 @@ void add_sweep_command(CLI::App& app, Action& action);
 /// `redres plugins [--json] [--check]`.
 void add_plugins_command(CLI::App& app, Action& action);
 
+/// `redres keys [scenario|robot|sweep] [--json]`.
+void add_keys_command(CLI::App& app, Action& action);
+
+/// Prints the keys of the input files (all when `file` is empty), text or JSON; returns the exit code.
+int print_file_keys(const std::string& file, bool json);
+
 /// Prints every registry (text or JSON).
 void print_plugins(bool json);
 

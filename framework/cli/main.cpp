@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
                  "whose libraries are all loaded");
   redres::cli::add_robot_command(app, action);
   redres::cli::add_plugins_command(app, action);
+  redres::cli::add_keys_command(app, action);
   redres::cli::add_run_commands(app, action);
   redres::cli::add_sweep_command(app, action);
   // The first word that is not an option must be a command: an unknown one names itself and lists the known ones

@@ -1,10 +1,11 @@
-// Registers `redres plugins [--json] [--check]`.
+// Registers `redres plugins [--json] [--check]` and `redres keys [FILE] [--json]`.
 
 #include <iostream>
 #include <memory>
 
 #include "commands.hpp"
 #include "redres/extend/conformance.hpp"
+#include "redres/run/file_keys.hpp"
 
 namespace redres::cli {
 
@@ -37,6 +38,27 @@ void add_plugins_command(CLI::App& app, Action& action) {
       if (*check) return check_plugins(std::cout) == 0 ? kExitOk : kExitFailedSteps;
       print_plugins(*json);
       return kExitOk;
+    };
+  });
+}
+
+void add_keys_command(CLI::App& app, Action& action) {
+  auto json = std::make_shared<bool>(false);
+  auto file = std::make_shared<std::string>();
+  auto markdown = std::make_shared<bool>(false);
+  CLI::App* cmd = app.add_subcommand(
+      "keys", "List every key of the scenario, robot and sweep files, table by table: type, unit, default, rule");
+  cmd->add_option("file", *file, "only this file's keys")->check(CLI::IsMember({"scenario", "robot", "sweep"}));
+  cmd->add_flag("--json", *json, "print JSON instead of text");
+  cmd->add_flag("--markdown", *markdown, "print the file's Markdown tables, as its page in docs/ shows them")
+      ->needs(cmd->get_option("file"));
+  cmd->callback([json, file, markdown, &action] {
+    action = [json, file, markdown] {
+      if (*markdown) {
+        std::cout << file_keys_markdown(*file);
+        return kExitOk;
+      }
+      return print_file_keys(*file, *json);
     };
   });
 }

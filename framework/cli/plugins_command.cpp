@@ -14,24 +14,22 @@
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
 #include "redres/qp/lvi.hpp"
+#include "redres/run/file_keys.hpp"
 #include "redres/run/scenario.hpp"
 
 namespace redres::cli {
 
 namespace {
 
-std::string presence_text(const KeyInfo& k) {
-  switch (k.presence) {
-    case Presence::kRequired: return "(required)";
-    case Presence::kGroup: return "(group " + k.group + ")";
-    case Presence::kOptional: break;
-  }
-  return "= " + k.default_text;
+// "= default", "(required)" or "(group g)".
+std::string listed_presence(const KeyInfo& k) {
+  const std::string text = presence_text(k);
+  return k.presence == Presence::kOptional ? text : "(" + text + ")";
 }
 
 void print_keys(const std::vector<KeyInfo>& keys) {
   for (const KeyInfo& k : keys) {
-    std::cout << "      " << std::left << std::setw(16) << k.name << std::setw(14) << presence_text(k) << std::right
+    std::cout << "      " << std::left << std::setw(16) << k.name << std::setw(14) << listed_presence(k) << std::right
               << " " << k.help;
     std::string facts = k.type;
     if (!k.unit.empty()) facts += ", " + k.unit;
@@ -88,6 +86,28 @@ nlohmann::json registry_json(const R& registry) {
 }
 
 }  // namespace
+
+int print_file_keys(const std::string& file, bool json) {
+  const std::vector<KeyTable> tables = file_key_tables();
+  if (json) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const KeyTable& t : tables) {
+      if (!file.empty() && t.file != file) continue;
+      out.push_back({{"file", t.file}, {"table", t.table}, {"description", t.help}, {"keys", keys_json(t.keys)}});
+    }
+    std::cout << out.dump(2) << "\n";
+    return kExitOk;
+  }
+  for (const KeyTable& t : tables) {
+    if (!file.empty() && t.file != file) continue;
+    std::cout << t.file << " file" << (t.table.empty() ? ", top level" : ": " + t.table) << " (" << t.help << ")\n";
+    print_keys(t.keys);
+    std::cout << "\n";
+  }
+  std::cout << "The plugins' tables ([path], [[objectives]], [[constraints]], the engine's [solver] keys, a joint's "
+               "velocity_limit): redres plugins\n";
+  return kExitOk;
+}
 
 void print_plugins(bool json) {
   if (json) {

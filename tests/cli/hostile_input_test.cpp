@@ -317,7 +317,7 @@ TEST(HostileInput, CommandLineMistakesAreNamedAsTheyWereGiven) {
   };
   const std::string v = "validate configs/paper_r_fast.toml ";
   const Case cases[] = {
-      {"frobnicate", "redres: unknown command 'frobnicate'; the commands are robot, plugins, run, validate"},
+      {"frobnicate", "redres: unknown command 'frobnicate'; the commands are robot, plugins, keys, run, validate"},
       {v + "--set duration=1e400", "--set duration=1e400: '1e400' is out of range for a number"},
       {v + "--set objectives.1xyz.p=1", "'1xyz' is not an index into the array 'objectives' (expected digits"},
       {v + "--set objectives.1e0.p=1", "'1e0' is not an index into the array 'objectives'"},

@@ -47,19 +47,60 @@ std::vector<double> length_values(const TableReader& r, const char* key, std::ve
   return values;
 }
 
-// A pose table: spatial `xyz` (m) and `rpy` (rad, roll-pitch-yaw about the fixed x, y, z axes); planar `xyz`
-// ([x, y], m) and `angle` (rad, about z). `position` is accepted for `xyz` (the end effector's older key).
-Isometry3d read_pose(const TableReader& t, bool planar) {
-  if (t.has("xyz") && t.has("position")) t.fail("position", "give `xyz` or `position`, not both");
-  const char* key = t.has("position") ? "position" : "xyz";
-  if (planar) {
-    const std::vector<double> p = t.has(key) ? length_values(t, key, t.numbers(key, 2)) : std::vector<double>{0.0, 0.0};
-    return trans(p[0], p[1], 0.0) * rot_z(t.number("angle", 0.0));
+// A pose table ([base], [end_effector], a joint's `origin`): spatial `xyz` (m) and `rpy` (rad, roll-pitch-yaw
+// about the fixed x, y, z axes); planar `xyz` ([x, y], m) and `angle` (rad, about z). `position` is accepted for
+// `xyz` (the end effector's older key).
+struct PoseTable {
+  bool planar = false;  // set before the table is read
+  std::vector<double> xyz;
+  std::vector<double> rpy{0.0, 0.0, 0.0};
+  double angle = 0.0;
+  [[nodiscard]] Isometry3d pose() const {
+    const std::vector<double> p = !xyz.empty() ? xyz : std::vector<double>(planar ? 2 : 3, 0.0);
+    if (planar) return trans(p[0], p[1], 0.0) * rot_z(angle);
+    return trans(p[0], p[1], p[2]) * Isometry3d(rpy_matrix({rpy[0], rpy[1], rpy[2]}));
   }
-  const std::vector<double> p =
-      t.has(key) ? length_values(t, key, t.numbers(key, 3)) : std::vector<double>{0.0, 0.0, 0.0};
-  const std::vector<double> rpy = t.has("rpy") ? t.numbers("rpy", 3) : std::vector<double>{0.0, 0.0, 0.0};
-  return trans(p[0], p[1], p[2]) * Isometry3d(rpy_matrix({rpy[0], rpy[1], rpy[2]}));
+  static const Schema<PoseTable>& schema() {
+    using C = PoseTable;
+    const auto position = [](const char* key) {
+      return [key](const TableReader& t, C& c) {
+        if (!t.has(key)) return;
+        c.xyz = length_values(t, key, t.numbers(key, c.planar ? 2 : 3));
+      };
+    };
+    static const Schema<C> s{{
+        entry<C>("xyz", "array of 3 numbers (planar: 2)", "m", "[0, 0, 0] (planar: [0, 0])", "the position",
+                 position("xyz"), "|x| <= 1000 m"),
+        entry<C>(
+            "position", "array of 3 numbers (planar: 2)", "m", "[0, 0, 0] (planar: [0, 0])", "the older name of `xyz`",
+            [position](const TableReader& t, C& c) {
+              if (t.has("xyz") && t.has("position")) t.fail("position", "give `xyz` or `position`, not both");
+              position("position")(t, c);
+            },
+            "|x| <= 1000 m"),
+        entry<C>("rpy", "array of 3 numbers", "rad", "[0, 0, 0]",
+                 "roll, pitch, yaw about the fixed x, y, z axes (spatial)",
+                 [](const TableReader& t, C& c) {
+                   if (!c.planar && t.has("rpy")) c.rpy = t.numbers("rpy", 3);
+                 }),
+        entry<C>("angle", "number", "rad", "0", "the rotation about z (planar)",
+                 [](const TableReader& t, C& c) {
+                   if (c.planar) c.angle = t.number("angle", 0.0);
+                 }),
+    }};
+    return s;
+  }
+};
+
+// The pose table at `key` of `r`, named `context` in messages.
+Isometry3d read_pose(const TableReader& r, const char* key, const std::string& context, bool planar) {
+  const TableReader t = r.table(key);
+  const TableReader pose_reader(t.file_ptr(), t.raw(), context);
+  PoseTable pose;
+  pose.planar = planar;
+  read_config(pose_reader, PoseTable::schema(), pose);
+  pose_reader.finish();
+  return pose.pose();
 }
 
 // A joint's `limits` = [lower, upper], lower < upper, into jt.
@@ -103,98 +144,139 @@ std::map<std::string, TableReader> named_entries(const TableReader& r, const cha
   return out;
 }
 
-JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention convention, std::set<std::string>& names) {
+// A [[joints]] entry of a chain given joint by joint, read key by key in this order (the range comes before the
+// velocity-limit law, which is checked over it). The URDF's [[joints]] entries are overrides: `name`, `limits` and
+// `velocity_limit` only (load_urdf_chain).
+struct JointReading {
+  ChainKind kind = ChainKind::kPlanar;
+  DhConvention convention = DhConvention::kStandard;
   JointSpec jt;
-  jt.name = entry.string("name");
-  if (jt.name.empty()) entry.fail("name", "expected a non-empty joint name");
-  const TableReader r(entry.file_ptr(), entry.raw(), "joint '" + jt.name + "'");
-  (void)r.has("name");
-  if (!names.insert(jt.name).second) r.fail("name", "duplicate joint name '" + jt.name + "'");
+  static const Schema<JointReading>& schema();
+};
 
-  const std::string type = kind == ChainKind::kPlanar ? r.choice("type", {"revolute"}, "revolute")
-                                                      : r.choice("type", {"revolute", "prismatic"}, "revolute");
-  jt.type = type == "revolute" ? JointType::kRevolute : JointType::kPrismatic;
-
-  if (kind == ChainKind::kPlanar) {
-    jt.length = r.number("length");
-    if (!(jt.length > 0.0)) r.fail("length", "expected a link length > 0 m, got " + num(jt.length));
-    length_value(r, "length", jt.length);
-  } else if (convention == DhConvention::kJointFrames) {
-    if (auto origin = r.optional_table("origin")) {
-      const TableReader o(origin->file_ptr(), origin->raw(), "joint '" + jt.name + "' origin");
-      jt.origin = read_pose(o, false);
-      o.finish();
-    }
-    if (r.has("axis")) {
-      const std::vector<double> a = r.numbers("axis", 3);
-      jt.axis = Vector3d(a[0], a[1], a[2]);
-      if (!(jt.axis.norm() > 1e-9)) r.fail("axis", "expected a non-zero axis vector [x, y, z]");
-      jt.axis.normalize();
-    }
-  } else {
-    jt.a = length_value(r, "a", r.number("a", 0.0));
-    jt.alpha = r.number("alpha", 0.0);
-    jt.d = length_value(r, "d", r.number("d", 0.0));
-    jt.theta_offset = r.number("theta_offset", 0.0);
-  }
-
-  read_limits(r, jt);
-
-  if (r.has("collision")) {
-    config_io::read(r, "collision", jt.collision);
-    for (std::size_t k = 0; k < jt.collision.size(); ++k) {
-      const ShapeSpec& c = jt.collision[k];
-      const std::string which = "joint '" + jt.name + "': key 'collision': shape " + std::to_string(k + 1);
-      if (c.velocity) throw ConfigError(r.location("collision"), which + " has a velocity; only obstacles move");
-      const bool placed = c.xyz != std::array<double, 3>{0, 0, 0} || c.rpy != std::array<double, 3>{0, 0, 0};
-      if (c.shape == ShapeSpec::Kind::kCapsule && !c.length && !c.from && placed) {
-        throw ConfigError(r.location("collision"), which +
-                                                       ": a capsule with `xyz` or `rpy` needs its `length` (or give "
-                                                       "`from` and `to`, or none of these to run along the link)");
-      }
-    }
-  }
-
-  read_velocity_law(r, jt);
-  r.finish();
-  return jt;
+const Schema<JointReading>& JointReading::schema() {
+  using C = JointReading;
+  const auto dh = [](const char* key, double JointSpec::*member, bool length, const char* unit, const char* help) {
+    return entry<C>(key, "number", unit, "0", help, [key, member, length](const TableReader& r, C& c) {
+      if (c.kind != ChainKind::kSpatial || c.convention == DhConvention::kJointFrames) return;
+      c.jt.*member = r.number(key, 0.0);
+      if (length) length_value(r, key, c.jt.*member);
+    });
+  };
+  static const Schema<C> s{{
+      entry<C>("name", "string", "", "", "the joint's name, unique in the robot",
+               [](const TableReader& r, C&) { (void)r.has("name"); })  // read first, by load_joint
+          .required(),
+      entry<C>("type", "one of 'revolute', 'prismatic'", "", "\"revolute\"",
+               "revolute (theta in rad) or prismatic (in m; spatial chains only)",
+               [](const TableReader& r, C& c) {
+                 const std::string type = c.kind == ChainKind::kPlanar
+                                              ? r.choice("type", {"revolute"}, "revolute")
+                                              : r.choice("type", {"revolute", "prismatic"}, "revolute");
+                 c.jt.type = type == "revolute" ? JointType::kRevolute : JointType::kPrismatic;
+               }),
+      entry<C>(
+          "length", "number", "m", "none; required in a planar chain", "the link's length after the joint",
+          [](const TableReader& r, C& c) {
+            if (c.kind != ChainKind::kPlanar) return;
+            c.jt.length = r.number("length");
+            if (!(c.jt.length > 0.0)) r.fail("length", "expected a link length > 0 m, got " + num(c.jt.length));
+            length_value(r, "length", c.jt.length);
+          },
+          "> 0; |x| <= 1000 m"),
+      entry<C>("origin", "table {xyz, rpy}", "", "the identity",
+               "the joint's frame in its parent's (convention = \"joints\")",
+               [](const TableReader& r, C& c) {
+                 if (c.kind != ChainKind::kSpatial || c.convention != DhConvention::kJointFrames) return;
+                 if (r.has("origin")) c.jt.origin = read_pose(r, "origin", "joint '" + c.jt.name + "' origin", false);
+               }),
+      entry<C>(
+          "axis", "array of 3 numbers", "", "[0, 0, 1]",
+          "the joint's axis in its frame, normalised (convention = \"joints\")",
+          [](const TableReader& r, C& c) {
+            if (c.kind != ChainKind::kSpatial || c.convention != DhConvention::kJointFrames || !r.has("axis")) {
+              return;
+            }
+            const std::vector<double> a = r.numbers("axis", 3);
+            c.jt.axis = Vector3d(a[0], a[1], a[2]);
+            if (!(c.jt.axis.norm() > 1e-9)) r.fail("axis", "expected a non-zero axis vector [x, y, z]");
+            c.jt.axis.normalize();
+          },
+          "non-zero"),
+      dh("a", &JointSpec::a, true, "m", "DH link length (convention = \"dh\" or \"modified_dh\")"),
+      dh("alpha", &JointSpec::alpha, false, "rad", "DH link twist"),
+      dh("d", &JointSpec::d, true, "m", "DH link offset"),
+      dh("theta_offset", &JointSpec::theta_offset, false, "rad", "DH joint-angle offset"),
+      entry<C>(
+          "limits", "array of 2 numbers", "rad or m", "", "[lower, upper], the joint's range",
+          [](const TableReader& r, C& c) { read_limits(r, c.jt); }, "lower < upper")
+          .required(),
+      entry<C>(
+          "collision", "array of inline tables (below)", "", "[] (none)",
+          "the link's collision shapes, in the joint's frame (self-collision, obstacle avoidance)",
+          [](const TableReader& r, C& c) {
+            if (!r.has("collision")) return;
+            JointSpec& jt = c.jt;
+            config_io::read(r, "collision", jt.collision);
+            for (std::size_t k = 0; k < jt.collision.size(); ++k) {
+              const ShapeSpec& sh = jt.collision[k];
+              const std::string which = "joint '" + jt.name + "': key 'collision': shape " + std::to_string(k + 1);
+              if (sh.velocity) {
+                throw ConfigError(r.location("collision"), which + " has a velocity; only obstacles move");
+              }
+              const bool placed = sh.xyz != std::array<double, 3>{0, 0, 0} || sh.rpy != std::array<double, 3>{0, 0, 0};
+              if (sh.shape == ShapeSpec::Kind::kCapsule && !sh.length && !sh.from && placed) {
+                throw ConfigError(r.location("collision"),
+                                  which +
+                                      ": a capsule with `xyz` or `rpy` needs its `length` (or give `from` "
+                                      "and `to`, or none of these to run along the link)");
+              }
+            }
+          }),
+      entry<C>("velocity_limit", "table", "", "",
+               "the joint's velocity-limit law; `type` names it, its keys are its own (redres plugins)",
+               [](const TableReader& r, C& c) { read_velocity_law(r, c.jt); })
+          .required(),
+  }};
+  return s;
 }
 
-// A robot file that names a URDF (`urdf`, `base_link`, `tip_link`): the chain comes from the URDF
-// (read_urdf_chain); `[[joints]]` entries, by joint name, may replace a joint's `limits` and `velocity_limit`;
-// `[[links]]` entries, by link name, give collision shapes that replace (`replace = true`, the default) or add to
-// the URDF's. Fills name, kind, convention, joints and end_effector (the tip link's frame).
-void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
-  const std::filesystem::path file = r.path("urdf");
-  const std::string base_link = r.string("base_link"), tip_link = r.string("tip_link");
-  UrdfChain chain;
-  try {
-    chain = read_urdf_chain(file, base_link, tip_link);
-  } catch (const UrdfError& e) {
-    r.fail("urdf", e.what());
-  } catch (const ConfigError& e) {
-    if (e.where().line == 0) r.fail("urdf", e.what());  // missing, not a regular file, too large: at the key
-    throw;
-  }
-  spec.name = r.string("name", chain.robot_name);
-  if (spec.name.empty()) r.fail("name", "expected a non-empty robot name (the URDF gives none)");
-  if (r.has("kind") && r.choice("kind", {"spatial"}) != "spatial") r.fail("kind", "a URDF chain is spatial");
-  if (r.has("convention") && r.choice("convention", {"joints"}) != "joints") {
-    r.fail("convention", "a URDF chain is made of joint frames");
-  }
-  spec.kind = ChainKind::kSpatial;
-  spec.convention = DhConvention::kJointFrames;
-  spec.end_effector = chain.tip;
+JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention convention, std::set<std::string>& names) {
+  JointReading reading;
+  reading.kind = kind;
+  reading.convention = convention;
+  reading.jt.name = entry.string("name");
+  if (reading.jt.name.empty()) entry.fail("name", "expected a non-empty joint name");
+  const TableReader r(entry.file_ptr(), entry.raw(), "joint '" + reading.jt.name + "'");
+  if (!names.insert(reading.jt.name).second) r.fail("name", "duplicate joint name '" + reading.jt.name + "'");
+  read_config(r, JointReading::schema(), reading);
+  r.finish();
+  return std::move(reading.jt);
+}
 
-  // Overrides by joint name.
+// A robot file's top level, read key by key in this order. A file that names a URDF (`urdf`, `base_link`,
+// `tip_link`) takes its chain from it (read_urdf_chain): `[[joints]]` entries, by joint name, may replace a joint's
+// `limits` and `velocity_limit`; `[[links]]` entries, by link name, give collision shapes that replace
+// (`replace = true`, the default) or add to the URDF's.
+struct RobotReading {
+  RobotSpec spec;
+  bool from_urdf = false;
+  std::filesystem::path urdf;
+  std::string base_link, tip_link;
+  UrdfChain chain;
+  static const Schema<RobotReading>& schema();
+};
+
+// The URDF's joints, with the [[joints]] overrides.
+void read_urdf_joints(const TableReader& r, RobotReading& c) {
   const std::map<std::string, TableReader> overrides = named_entries(
       r, "joints",
       [&](const std::string& name) {
-        return std::any_of(chain.joints.begin(), chain.joints.end(),
+        return std::any_of(c.chain.joints.begin(), c.chain.joints.end(),
                            [&](const UrdfJoint& j) { return j.name == name; });
       },
-      "joint", "moving joint", " between '" + base_link + "' and '" + tip_link + "' in " + file.string());
-  for (const UrdfJoint& uj : chain.joints) {
+      "joint", "moving joint", " between '" + c.base_link + "' and '" + c.tip_link + "' in " + c.urdf.string());
+  for (const UrdfJoint& uj : c.chain.joints) {
     JointSpec jt;
     jt.name = uj.name;
     jt.type = uj.prismatic ? JointType::kPrismatic : JointType::kRevolute;
@@ -211,63 +293,245 @@ void load_urdf_chain(const TableReader& r, RobotSpec& spec) {
     if (entry && entry->has("limits")) {
       read_limits(*entry, jt);
     } else if (uj.continuous) {
-      r.fail("urdf", "joint '" + uj.name + "' is continuous in " + file.string() +
+      r.fail("urdf", "joint '" + uj.name + "' is continuous in " + c.urdf.string() +
                          ", which gives it no position limits: give its `limits` in a [[joints]] entry");
     } else if (!(uj.lower < uj.upper)) {
-      r.fail("urdf", "joint '" + uj.name + "' in " + file.string() + " has limits lower " + num(uj.lower) +
+      r.fail("urdf", "joint '" + uj.name + "' in " + c.urdf.string() + " has limits lower " + num(uj.lower) +
                          " >= upper " + num(uj.upper) + ": fix the URDF or give its `limits` in a [[joints]] entry");
     }
     if (entry && entry->has("velocity_limit")) {
       read_velocity_law(*entry, jt);
     } else if (uj.velocity > 0.0) {
-      jt.velocity_limit = symmetric_constant_law(uj.velocity, file);
+      jt.velocity_limit = symmetric_constant_law(uj.velocity, c.urdf);
     } else {
-      r.fail("urdf", "joint '" + uj.name + "' in " + file.string() +
+      r.fail("urdf", "joint '" + uj.name + "' in " + c.urdf.string() +
                          " has no velocity limit: give one in the URDF (<limit velocity=...>) or a `velocity_limit` "
                          "in a [[joints]] entry");
     }
     if (entry) entry->finish();
-    spec.joints.push_back(std::move(jt));
+    c.spec.joints.push_back(std::move(jt));
   }
+}
 
-  // Collision shapes: the URDF's, per link, unless [[links]] replaces them.
+// A [[links]] entry of a URDF robot: collision shapes for one of the chain's links.
+struct LinkEntry {
+  std::string name;
+  bool replace = true;
+  std::vector<ShapeSpec> collision;
+  static const Schema<LinkEntry>& schema() {
+    using C = LinkEntry;
+    static const Schema<C> s{{
+        field("name", &C::name, "", "the URDF link's name").required(),
+        field("replace", &C::replace, "", "the shapes replace the URDF's collision elements (false: add to them)"),
+        field("collision", &C::collision, "", "the link's shapes, in the link's frame (capsules need `length`)")
+            .listed_default("[] (none)"),
+    }};
+    return s;
+  }
+};
+
+// The collision shapes of the URDF's links, with the [[links]] entries.
+void read_urdf_links(const TableReader& r, RobotReading& c) {
   const std::map<std::string, TableReader> link_entries = named_entries(
       r, "links",
       [&](const std::string& name) {
-        return std::any_of(chain.links.begin(), chain.links.end(), [&](const UrdfLink& l) { return l.name == name; });
+        return std::any_of(c.chain.links.begin(), c.chain.links.end(),
+                           [&](const UrdfLink& l) { return l.name == name; });
       },
-      "link", "link", " that moves with the chain from '" + base_link + "' to '" + tip_link + "' in " + file.string());
-  for (const UrdfLink& link : chain.links) {
-    JointSpec& jt = spec.joints[static_cast<std::size_t>(link.joint)];
+      "link", "link",
+      " that moves with the chain from '" + c.base_link + "' to '" + c.tip_link + "' in " + c.urdf.string());
+  for (const UrdfLink& link : c.chain.links) {
+    JointSpec& jt = c.spec.joints[static_cast<std::size_t>(link.joint)];
     const auto e = link_entries.find(link.name);
     bool replace = false;
     if (e != link_entries.end()) {
       const TableReader entry(e->second.file_ptr(), e->second.raw(), "link '" + link.name + "'");
-      (void)entry.has("name");
-      replace = entry.boolean("replace", true);
-      std::vector<ShapeSpec> shapes;
-      if (entry.has("collision")) config_io::read(entry, "collision", shapes);
-      for (std::size_t k = 0; k < shapes.size(); ++k) {
-        if (shapes[k].shape == ShapeSpec::Kind::kCapsule && !shapes[k].length && !shapes[k].from) {
+      LinkEntry links;
+      read_config(entry, LinkEntry::schema(), links);
+      replace = links.replace;
+      for (std::size_t k = 0; k < links.collision.size(); ++k) {
+        const ShapeSpec& shape = links.collision[k];
+        if (shape.shape == ShapeSpec::Kind::kCapsule && !shape.length && !shape.from) {
           entry.fail("collision", "shape " + std::to_string(k + 1) +
                                       ": a capsule of a URDF link needs `length` (with `xyz`, `rpy`) or `from` and "
                                       "`to`, in the link's frame");
         }
-        if (shapes[k].velocity)
+        if (shape.velocity) {
           entry.fail("collision", "shape " + std::to_string(k + 1) + " has a velocity; only obstacles move");
-        jt.collision.push_back(shapes[k].placed(link.pose));
+        }
+        jt.collision.push_back(shape.placed(link.pose));
       }
       entry.finish();
     }
     if (replace) continue;
     if (!link.meshes.empty()) {
-      r.fail("urdf", "link '" + link.name + "' in " + file.string() + " has a mesh collision element ('" +
+      r.fail("urdf", "link '" + link.name + "' in " + c.urdf.string() + " has a mesh collision element ('" +
                          link.meshes.front() +
                          "'), which redres does not read: give the link's shapes in a [[links]] entry (replace = "
                          "true), e.g. capsules");
     }
-    for (const ShapeSpec& s : link.shapes) jt.collision.push_back(s.placed(link.pose));
+    for (const ShapeSpec& shape : link.shapes) jt.collision.push_back(shape.placed(link.pose));
   }
+}
+
+// `key` of a robot file with a URDF only: refused in one without.
+void only_with_urdf(const TableReader& r, const RobotReading& c, const char* key, const char* instead) {
+  // Looked up without marking the key known: in a robot without a URDF, the known keys are the chain's.
+  if (!c.from_urdf && r.raw().contains(key)) r.fail(key, std::string("is used only with `urdf`") + instead);
+}
+
+// `collision_exclude`: pairs of joints (their links) that self-collision does not check.
+void read_collision_exclude(const TableReader& r, RobotSpec& spec) {
+  if (!r.has("collision_exclude")) return;
+  const toml::array* pairs = r.raw().get("collision_exclude")->as_array();
+  if (pairs == nullptr) r.fail("collision_exclude", "expected an array of joint-name pairs, e.g. [[\"j1\", \"j3\"]]");
+  for (const toml::node& p : *pairs) {
+    const toml::array* pair = p.as_array();
+    const auto index = [&](std::size_t k) {
+      const toml::node* el = pair != nullptr && pair->size() == 2 ? pair->get(k) : nullptr;
+      const auto* name = el != nullptr ? el->as_string() : nullptr;
+      if (name != nullptr) {
+        for (std::size_t j = 0; j < spec.joints.size(); ++j) {
+          if (spec.joints[j].name == name->get()) return static_cast<int>(j);
+        }
+      }
+      throw ConfigError(location_of(r.file(), p),
+                        "key 'collision_exclude': expected pairs of two joint names of this robot, e.g. [\"j1\", "
+                        "\"j3\"]");
+    };
+    const int a = index(0), b = index(1);
+    if (a == b) throw ConfigError(location_of(r.file(), p), "key 'collision_exclude': a pair names one joint twice");
+    spec.collision_exclude.emplace_back(a, b);
+  }
+}
+
+const Schema<RobotReading>& RobotReading::schema() {
+  using C = RobotReading;
+  static const Schema<C> s{{
+      entry<C>("plugins", "array of strings", "", "[]",
+               "plugin libraries to load first (their velocity-limit laws may be named below)",
+               [](const TableReader& r, C&) { load_plugins_from(r); }),
+      entry<C>("urdf", "path", "", "none (the chain is [[joints]])",
+               "a URDF file whose chain from base_link to tip_link is the robot (docs/robot_format.md)",
+               [](const TableReader& r, C& c) {
+                 c.from_urdf = r.has("urdf");
+                 if (!c.from_urdf) return;
+                 c.urdf = r.path("urdf");
+                 c.base_link = r.string("base_link");
+                 c.tip_link = r.string("tip_link");
+                 try {
+                   c.chain = read_urdf_chain(c.urdf, c.base_link, c.tip_link);
+                 } catch (const UrdfError& e) {
+                   r.fail("urdf", e.what());
+                 } catch (const ConfigError& e) {
+                   if (e.where().line == 0) r.fail("urdf", e.what());  // missing, not a regular file, too large
+                   throw;
+                 }
+                 c.spec.end_effector = c.chain.tip;
+               }),
+      entry<C>("base_link", "string", "", "none; required with `urdf`",
+               "the URDF link the chain starts at (required with `urdf`)",
+               [](const TableReader& r, C& c) { only_with_urdf(r, c, "base_link", ""); }),
+      entry<C>("tip_link", "string", "", "none; required with `urdf`",
+               "the URDF link the chain ends at (required with `urdf`)",
+               [](const TableReader& r, C& c) { only_with_urdf(r, c, "tip_link", ""); }),
+      entry<C>("name", "string", "", "the URDF's; required without `urdf`", "the robot's name",
+               [](const TableReader& r, C& c) {
+                 if (c.from_urdf) {
+                   c.spec.name = r.string("name", c.chain.robot_name);
+                   if (c.spec.name.empty()) r.fail("name", "expected a non-empty robot name (the URDF gives none)");
+                 } else {
+                   c.spec.name = r.string("name");
+                   if (c.spec.name.empty()) r.fail("name", "expected a non-empty robot name");
+                 }
+               }),
+      entry<C>("kind", "one of 'planar', 'spatial'", "", "\"spatial\" with `urdf`; required without",
+               "planar (x, y in the plane, revolute joints with `length`) or spatial",
+               [](const TableReader& r, C& c) {
+                 if (c.from_urdf) {
+                   if (r.has("kind") && r.choice("kind", {"spatial"}) != "spatial") {
+                     r.fail("kind", "a URDF chain is spatial");
+                   }
+                   c.spec.kind = ChainKind::kSpatial;
+                   return;
+                 }
+                 c.spec.kind =
+                     r.choice("kind", {"planar", "spatial"}) == "planar" ? ChainKind::kPlanar : ChainKind::kSpatial;
+               }),
+      entry<C>("convention", "one of 'dh', 'modified_dh', 'joints'", "",
+               "\"joints\" with `urdf`; required for a spatial chain",
+               "how a spatial chain's joints are placed: DH parameters (a, alpha, d, theta_offset), modified DH, or "
+               "joint frames (origin, axis), as a URDF's",
+               [](const TableReader& r, C& c) {
+                 if (c.from_urdf) {
+                   if (r.has("convention") && r.choice("convention", {"joints"}) != "joints") {
+                     r.fail("convention", "a URDF chain is made of joint frames");
+                   }
+                   c.spec.convention = DhConvention::kJointFrames;
+                   return;
+                 }
+                 if (c.spec.kind != ChainKind::kSpatial) return;
+                 const std::string conv = r.choice("convention", {"dh", "modified_dh", "joints"});
+                 c.spec.convention = conv == "dh"            ? DhConvention::kStandard
+                                     : conv == "modified_dh" ? DhConvention::kModified
+                                                             : DhConvention::kJointFrames;
+               }),
+      entry<C>("task", "\"position\", \"pose\" or an array of rows", "", "\"position\"",
+               "the task rows a scenario tracks unless it sets its own `task`",
+               [](const TableReader& r, C& c) { read_task(r, c.spec); }),
+      entry<C>("joints", "array of tables [[joints]] (below)", "", "none with `urdf`; required without",
+               "the chain, base to tip (with `urdf`: overrides of `limits` and `velocity_limit` by joint name)",
+               [](const TableReader& r, C& c) {
+                 if (c.from_urdf) {
+                   read_urdf_joints(r, c);
+                   return;
+                 }
+                 std::set<std::string> names;
+                 for (const TableReader& entry : r.tables("joints")) {
+                   c.spec.joints.push_back(load_joint(entry, c.spec.kind, c.spec.convention, names));
+                 }
+               }),
+      entry<C>("links", "array of tables [[links]] (below)", "", "none",
+               "collision shapes of the URDF's links (with `urdf` only)",
+               [](const TableReader& r, C& c) {
+                 only_with_urdf(r, c, "links", " (a [[joints]] entry's `collision` gives its link's shapes)");
+                 if (c.from_urdf) read_urdf_links(r, c);
+               }),
+      entry<C>("end_effector", "table {xyz, rpy} (planar: {xyz, angle})", "", "the last joint's frame (a URDF's tip)",
+               "the end effector's frame in the last joint's (after the URDF's tip link)",
+               [](const TableReader& r, C& c) {
+                 if (!r.has("end_effector")) return;
+                 c.spec.end_effector = c.spec.end_effector *
+                                       read_pose(r, "end_effector", "end_effector", c.spec.kind == ChainKind::kPlanar);
+               }),
+      entry<C>("base", "table {xyz, rpy} (planar: {xyz, angle})", "", "the world frame",
+               "the chain's base in the world",
+               [](const TableReader& r, C& c) {
+                 if (r.has("base")) c.spec.base = read_pose(r, "base", "base", c.spec.kind == ChainKind::kPlanar);
+               }),
+      entry<C>(
+          "home", "array of numbers, one per joint", "rad or m", "zeros",
+          "the configuration a scenario starts from unless it sets theta0",
+          [](const TableReader& r, C& c) {
+            if (!r.has("home")) return;
+            RobotSpec& spec = c.spec;
+            const auto n = static_cast<Eigen::Index>(spec.joints.size());
+            const std::vector<double> h = r.numbers("home", static_cast<std::size_t>(n));
+            spec.home = Eigen::Map<const Eigen::VectorXd>(h.data(), n);
+            for (std::size_t j = 0; j < spec.joints.size(); ++j) {
+              const JointSpec& jt = spec.joints[j];
+              if (h[j] < jt.lower || h[j] > jt.upper) {
+                r.fail("home", "expected joint '" + jt.name + "' within its limits [" + num(jt.lower) + ", " +
+                                   num(jt.upper) + "], got " + num(h[j]));
+              }
+            }
+          },
+          "within the limits"),
+      entry<C>("collision_exclude", "array of joint-name pairs", "", "[] (none)",
+               "pairs of links that self-collision leaves out (neighbours always are)",
+               [](const TableReader& r, C& c) { read_collision_exclude(r, c.spec); }),
+  }};
+  return s;
 }
 
 }  // namespace
@@ -302,80 +566,24 @@ RobotModel load_robot(const std::filesystem::path& file) {
 }
 
 RobotModel load_robot(const TableReader& r) {
-  load_plugins_from(r);  // plugin libraries first: their velocity-limit laws may be named below
-  RobotSpec spec;
-  spec.source = r.file().path.string();
-  const bool from_urdf = r.has("urdf");
-  if (from_urdf) {
-    load_urdf_chain(r, spec);
-  } else {
-    spec.name = r.string("name");
-    if (spec.name.empty()) r.fail("name", "expected a non-empty robot name");
-    spec.kind = r.choice("kind", {"planar", "spatial"}) == "planar" ? ChainKind::kPlanar : ChainKind::kSpatial;
-    if (spec.kind == ChainKind::kSpatial) {
-      const std::string c = r.choice("convention", {"dh", "modified_dh", "joints"});
-      spec.convention = c == "dh"            ? DhConvention::kStandard
-                        : c == "modified_dh" ? DhConvention::kModified
-                                             : DhConvention::kJointFrames;
-    }
-  }
-  read_task(r, spec);
-
-  if (!from_urdf) {
-    std::set<std::string> names;
-    for (const TableReader& entry : r.tables("joints")) {
-      spec.joints.push_back(load_joint(entry, spec.kind, spec.convention, names));
-    }
-  }
-  const auto n = static_cast<Eigen::Index>(spec.joints.size());
-
-  if (auto ee = r.optional_table("end_effector")) {
-    const TableReader e(ee->file_ptr(), ee->raw(), "end_effector");
-    // After the URDF's tip link, when there is one (spec.end_effector holds that link's frame).
-    spec.end_effector = spec.end_effector * read_pose(e, spec.kind == ChainKind::kPlanar);
-    e.finish();
-  }
-  if (auto base = r.optional_table("base")) {
-    const TableReader b(base->file_ptr(), base->raw(), "base");
-    spec.base = read_pose(b, spec.kind == ChainKind::kPlanar);
-    b.finish();
-  }
-
-  if (r.has("home")) {
-    const std::vector<double> h = r.numbers("home", static_cast<std::size_t>(n));
-    spec.home = Eigen::Map<const Eigen::VectorXd>(h.data(), n);
-    for (Eigen::Index j = 0; j < n; ++j) {
-      const JointSpec& jt = spec.joints[static_cast<std::size_t>(j)];
-      if (h[static_cast<std::size_t>(j)] < jt.lower || h[static_cast<std::size_t>(j)] > jt.upper) {
-        r.fail("home", "expected joint '" + jt.name + "' within its limits [" + num(jt.lower) + ", " + num(jt.upper) +
-                           "], got " + num(h[static_cast<std::size_t>(j)]));
-      }
-    }
-  }
-  if (r.has("collision_exclude")) {
-    const toml::array* pairs = r.raw().get("collision_exclude")->as_array();
-    if (pairs == nullptr) r.fail("collision_exclude", "expected an array of joint-name pairs, e.g. [[\"j1\", \"j3\"]]");
-    for (const toml::node& p : *pairs) {
-      const toml::array* pair = p.as_array();
-      const auto index = [&](std::size_t k) {
-        const toml::node* el = pair != nullptr && pair->size() == 2 ? pair->get(k) : nullptr;
-        const auto* name = el != nullptr ? el->as_string() : nullptr;
-        if (name != nullptr) {
-          for (std::size_t j = 0; j < spec.joints.size(); ++j) {
-            if (spec.joints[j].name == name->get()) return static_cast<int>(j);
-          }
-        }
-        throw ConfigError(location_of(r.file(), p),
-                          "key 'collision_exclude': expected pairs of two joint names of "
-                          "this robot, e.g. [\"j1\", \"j3\"]");
-      };
-      const int a = index(0), b = index(1);
-      if (a == b) throw ConfigError(location_of(r.file(), p), "key 'collision_exclude': a pair names one joint twice");
-      spec.collision_exclude.emplace_back(a, b);
-    }
-  }
+  RobotReading reading;
+  reading.spec.source = r.file().path.string();
+  read_config(r, RobotReading::schema(), reading);
   r.finish();
-  return RobotModel(std::move(spec));
+  return RobotModel(std::move(reading.spec));
+}
+
+const std::vector<KeyTable>& robot_key_tables() {
+  static const std::vector<KeyTable> tables = {
+      {"robot", "", "a robot file's top level", describe_keys(RobotReading::schema())},
+      {"robot", "[[joints]]", "one joint and the link after it (a URDF robot's: name, limits, velocity_limit)",
+       describe_keys(JointReading::schema())},
+      {"robot", "[base], [end_effector], origin", "a pose", describe_keys(PoseTable::schema())},
+      {"robot", "[[links]]", "collision shapes of a URDF link", describe_keys(LinkEntry::schema())},
+      {"robot", "collision = [{...}]", "one collision shape (of a joint's link, a URDF link or an obstacle)",
+       describe_keys(ShapeSpec::schema())},
+  };
+  return tables;
 }
 
 }  // namespace redres

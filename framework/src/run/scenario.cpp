@@ -83,6 +83,207 @@ Eigen::VectorXd read_theta0(const TableReader& r, const RobotModel& robot) {
   return theta;
 }
 
+// [output]: what a run writes besides trajectory.csv and summary.json.
+struct OutputTable {
+  RecordOptions record;
+  bool plots = false;
+  bool animate = false;
+  static const Schema<OutputTable>& schema() {
+    using C = OutputTable;
+    static const Schema<C> s{
+        {entry<C>("record", "\"all\", \"none\" or \"every=N\"", "", "\"all\"",
+                  "which steps trajectory.csv has a row for (every=N: every N-th step and the last)",
+                  [](const TableReader& r, C& c) { c.record = read_record(r, "record", "all"); }),
+         field("plots", &C::plots, "", "render the figures with tools/plot_run.py after the run"),
+         field("animate", &C::animate, "", "render the animation (animation.mp4, or animation.gif without ffmpeg)")}};
+    return s;
+  }
+};
+
+// [orientation]: the end effector's orientation reference (a pose task).
+struct OrientationTable {
+  bool planar = false;  // set by the reader before the table is read
+  Eigen::Vector3d turn = Eigen::Vector3d::Zero();
+  static const Schema<OrientationTable>& schema() {
+    using C = OrientationTable;
+    static const Schema<C> s{{entry<C>(
+        "turn", "number (planar) or array of 3 numbers (spatial)", "rad", "0 (hold the orientation at t = 0)",
+        "the rotation the end effector turns through over the run (a world-frame rotation vector; planar: about z)",
+        [](const TableReader& o, C& c) {
+          if (!o.has("turn")) return;
+          if (c.planar) {
+            c.turn = Eigen::Vector3d(0.0, 0.0, o.number("turn"));
+          } else {
+            const std::vector<double> w = o.numbers("turn", 3);
+            c.turn = Eigen::Vector3d(w[0], w[1], w[2]);
+          }
+          const double bound = *physical_bound("rad");
+          if (!(c.turn.cwiseAbs().maxCoeff() <= bound)) {
+            std::ostringstream m;
+            m << "expected |x| <= " << bound << " rad (a physical range), got " << c.turn.cwiseAbs().maxCoeff();
+            o.fail("turn", m.str());
+          }
+        },
+        "|x| <= 1e+06 rad")}};
+    return s;
+  }
+};
+
+// A scenario file's top level, read key by key in this order: each key's reader may use what the keys before it
+// gave (the robot bounds theta0, the duration bounds the step, the path starts where the arm does).
+struct ScenarioReading {
+  Scenario s;
+  OutputTable output;
+  static const Schema<ScenarioReading>& schema();
+};
+
+const Schema<ScenarioReading>& ScenarioReading::schema() {
+  using C = ScenarioReading;
+  static const Schema<C> keys{{
+      entry<C>("plugins", "array of strings", "", "[]",
+               "plugin libraries to load first (their plugins may be named below and in the robot file)",
+               [](const TableReader& r, C&) { load_plugins_from(r); }),
+      entry<C>("name", "string", "", "the file's stem", "the scenario's name (in summary.json and comparisons)",
+               [](const TableReader& r, C& c) {
+                 if (!r.has("name")) return;
+                 c.s.name = r.string("name");
+                 if (c.s.name.empty())
+                   r.fail("name", "expected a non-empty name (or leave `name` out: the file's stem)");
+               }),
+      entry<C>("robot", "path", "", "", "the robot file (TOML; docs/robot_format.md), relative to this file",
+               [](const TableReader& r, C& c) {
+                 try {
+                   c.s.robot = std::make_unique<RobotModel>(load_robot(r.path("robot")));
+                 } catch (const ConfigError& e) {
+                   // A robot file that is missing, a directory or empty is reported at the key that names it; an
+                   // error inside the file keeps its own file:line:col.
+                   if (e.where().line == 0) r.fail("robot", e.what());
+                   throw;
+                 }
+               })
+          .required(),
+      entry<C>("task", "\"position\", \"pose\" or an array of rows", "", "the robot file's task",
+               "the task rows (\"pose\": position and orientation; or some rows, e.g. [\"x\", \"y\", \"phi\"])",
+               [](const TableReader& r, C& c) {
+                 // The scenario chooses the task rows (the robot file's `task` is only the default), so that one
+                 // robot file serves position and pose scenarios alike.
+                 if (!r.has("task")) return;
+                 RobotSpec spec = c.s.robot->spec();
+                 read_task(r, spec);
+                 c.s.robot = std::make_unique<RobotModel>(std::move(spec));
+               }),
+      entry<C>("theta0", "array of numbers or formulas, one per joint", "rad or m", "the robot's home",
+               "theta(0), within the joint limits",
+               [](const TableReader& r, C& c) { c.s.theta0 = read_theta0(r, *c.s.robot); }),
+      entry<C>(
+          "duration", "number", "s", "", "T, the run's duration",
+          [](const TableReader& r, C& c) {
+            c.s.duration = r.number("duration");
+            if (!(c.s.duration > 0.0)) r.fail("duration", "expected a duration T > 0 s");
+          },
+          "> 0")
+          .required(),
+      entry<C>(
+          "step", "number", "s", "", "tau, the control step",
+          [](const TableReader& r, C& c) {
+            Scenario& s = c.s;
+            s.tau = r.number("step");
+            if (!(s.tau > 0.0 && s.tau <= s.duration)) r.fail("step", "expected a step 0 < tau <= duration");
+            if (!(s.duration / s.tau <= kMaxSteps)) {
+              std::ostringstream m;
+              m << "expected at most " << static_cast<long long>(kMaxSteps)
+                << " steps, got duration / step = " << s.duration << " / " << s.tau << " = " << s.duration / s.tau
+                << " (use a longer step or a shorter duration)";
+              r.fail("step", m.str());
+            }
+            if (std::abs(s.steps() * s.tau - s.duration) > 1e-9 * s.duration) {
+              r.fail("step", "expected a step that divides the duration (T / tau = " +
+                                 std::to_string(s.duration / s.tau) + ")");
+            }
+          },
+          "0 < step <= duration, dividing it; duration / step <= 1e7")
+          .required(),
+      entry<C>("integrator", "one of 'euler', 'heun'", "", "\"euler\"",
+               "how theta_dot is integrated: euler (the paper's), heun (second order)",
+               [](const TableReader& r, C& c) {
+                 c.s.integrator = r.choice("integrator", {"euler", "heun"}, "euler") == "euler" ? Integrator::kEuler
+                                                                                                : Integrator::kHeun;
+               }),
+      entry<C>("path", "table", "", "", "the desired path r_d(t); its keys are its type's (redres plugins)",
+               [](const TableReader& r, C& c) {
+                 Scenario& s = c.s;
+                 KinematicsData k(*s.robot);
+                 compute_kinematics(*s.robot, s.theta0, k, KinematicsLevel::kPosition);
+                 PathContext pc;
+                 pc.dim = s.robot->kind() == ChainKind::kPlanar ? 2 : 3;
+                 pc.start.head(pc.dim) = k.f.head(pc.dim);
+                 pc.duration = s.duration;
+                 const TableReader path_table = r.table("path");
+                 s.path = make_path(TableReader(path_table.file_ptr(), path_table.raw(), "path"), pc);
+               })
+          .required(),
+      entry<C>("objectives", "array of tables [[objectives]]", "", "",
+               "the weighted objectives, at least one; their keys are their type's (redres plugins)",
+               [](const TableReader& r, C& c) {
+                 Scenario& s = c.s;
+                 // Reads `constraints` too: one scheme holds both.
+                 s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot, s.duration, s.tau));
+                 const std::size_t width = trajectory_width(s);
+                 if (const double bytes = (s.steps() + 1.0) * static_cast<double>(width) * 8.0;
+                     bytes > kMaxTableBytes) {
+                   std::ostringstream m;
+                   m << "expected a run whose recorded table fits in " << kMaxTableBytes / (1024.0 * 1024 * 1024)
+                     << " GiB, got " << s.steps() + 1 << " rows of " << width << " columns ("
+                     << bytes / (1024.0 * 1024 * 1024) << " GiB; use a longer step or a shorter duration)";
+                   r.fail("step", m.str());
+                 }
+               })
+          .required(),
+      entry<C>("constraints", "array of tables [[constraints]]", "", "none",
+               "the hard constraints; their keys are their type's (redres plugins)",
+               [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
+      entry<C>("solver", "table", "", "engine = \"projection\"",
+               "the LVI engine and its settings (redres plugins), and what a step that is not solved does",
+               [](const TableReader& r, C& c) {
+                 Scenario& s = c.s;
+                 if (!r.has("solver")) {
+                   s.engine = make_engine("projection");
+                   return;
+                 }
+                 const TableReader t = r.table("solver");
+                 const TableReader solver(t.file_ptr(), t.raw(), "solver");
+                 SolverPolicy policy;
+                 read_config(solver, SolverPolicy::schema(), policy);
+                 s.on_infeasible = policy.on_infeasible == Policy::kStop    ? OnInfeasible::kStop
+                                   : policy.on_infeasible == Policy::kRelax ? OnInfeasible::kRelax
+                                                                            : OnInfeasible::kHold;
+                 s.relax_weight = policy.relax_weight;
+                 if (solver.has("relax_weight") && s.on_infeasible != OnInfeasible::kRelax) {
+                   solver.fail("relax_weight", "is used only with on_infeasible = \"relax\" (on_infeasible is \"" +
+                                                   std::string(solver.string("on_infeasible", "hold")) + "\")");
+                 }
+                 s.engine = make_engine(solver);
+               }),
+      entry<C>("orientation", "table [orientation]", "", "none",
+               "the end effector's orientation reference, for a pose task (below)",
+               [](const TableReader& r, C& c) {
+                 if (!r.has("orientation")) return;
+                 (void)r.table("orientation");
+                 if (!c.s.robot->has_orientation_rows()) {
+                   r.fail("orientation",
+                          "the task has no orientation rows: set task = \"pose\" (in the scenario or the robot file)");
+                 }
+                 OrientationTable o;
+                 o.planar = c.s.robot->kind() == ChainKind::kPlanar;
+                 config_io::read(r, "orientation", o);
+                 c.s.orientation_turn = o.turn;
+               }),
+      field("output", &C::output, "", "what a run writes besides trajectory.csv and summary.json (below)")
+          .listed_default("record = \"all\", no figures"),
+  }};
+  return keys;
+}
+
 }  // namespace
 
 int Scenario::steps() const {
@@ -98,114 +299,34 @@ const std::vector<KeyInfo>& solver_policy_keys() {
   return keys;
 }
 
+const std::vector<KeyTable>& scenario_key_tables() {
+  static const std::vector<KeyTable> tables = {
+      {"scenario", "", "a scenario file's top level", describe_keys(ScenarioReading::schema())},
+      {"scenario", "[output]", "what a run writes besides trajectory.csv and summary.json",
+       describe_keys(OutputTable::schema())},
+      {"scenario", "[orientation]", "the orientation reference of a pose task",
+       describe_keys(OrientationTable::schema())},
+      {"scenario", "[solver]", "the run's policy for a step that is not solved (the engine's keys: redres plugins)",
+       solver_policy_keys()},
+  };
+  return tables;
+}
+
 Scenario load_scenario(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   const std::shared_ptr<TomlFile> parsed = parse_toml_file(file);
   apply_overrides(parsed->root, overrides);
   const std::shared_ptr<const TomlFile> doc = parsed;
   const TableReader r = TableReader::root(doc, "scenario");
 
-  load_plugins_from(r);  // plugin libraries first: their plugins may be named below (and in the robot file)
-  Scenario s;
-  s.source = file.string();
-  s.name = r.string("name", file.stem().string());
-  if (s.name.empty()) r.fail("name", "expected a non-empty name (or leave `name` out: the file's stem)");
-  try {
-    s.robot = std::make_unique<RobotModel>(load_robot(r.path("robot")));
-  } catch (const ConfigError& e) {
-    // A robot file that is missing, a directory or empty is reported at the key that names it; an error inside the
-    // file keeps its own file:line:col.
-    if (e.where().line == 0) r.fail("robot", e.what());
-    throw;
-  }
-  if (r.has("task")) {
-    // The scenario chooses the task rows (the robot file's `task` is only the default), so that one robot file
-    // serves position and pose scenarios alike.
-    RobotSpec spec = s.robot->spec();
-    read_task(r, spec);
-    s.robot = std::make_unique<RobotModel>(std::move(spec));
-  }
-  s.theta0 = read_theta0(r, *s.robot);
-  s.duration = r.number("duration");
-  s.tau = r.number("step");
-  if (!(s.duration > 0.0)) r.fail("duration", "expected a duration T > 0 s");
-  if (!(s.tau > 0.0 && s.tau <= s.duration)) r.fail("step", "expected a step 0 < tau <= duration");
-  if (!(s.duration / s.tau <= kMaxSteps)) {
-    std::ostringstream m;
-    m << "expected at most " << static_cast<long long>(kMaxSteps) << " steps, got duration / step = " << s.duration
-      << " / " << s.tau << " = " << s.duration / s.tau << " (use a longer step or a shorter duration)";
-    r.fail("step", m.str());
-  }
-  if (std::abs(s.steps() * s.tau - s.duration) > 1e-9 * s.duration) {
-    r.fail("step", "expected a step that divides the duration (T / tau = " + std::to_string(s.duration / s.tau) + ")");
-  }
-  s.integrator = r.choice("integrator", {"euler", "heun"}, "euler") == "euler" ? Integrator::kEuler : Integrator::kHeun;
-
-  KinematicsData k(*s.robot);
-  compute_kinematics(*s.robot, s.theta0, k, KinematicsLevel::kPosition);
-  PathContext pc;
-  pc.dim = s.robot->kind() == ChainKind::kPlanar ? 2 : 3;
-  pc.start.head(pc.dim) = k.f.head(pc.dim);
-  pc.duration = s.duration;
-  const TableReader path_table = r.table("path");
-  s.path = make_path(TableReader(path_table.file_ptr(), path_table.raw(), "path"), pc);
-
-  s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot, s.duration, s.tau));
-  const std::size_t width = trajectory_width(s);
-  if (const double bytes = (s.steps() + 1.0) * static_cast<double>(width) * 8.0; bytes > kMaxTableBytes) {
-    std::ostringstream m;
-    m << "expected a run whose recorded table fits in " << kMaxTableBytes / (1024.0 * 1024 * 1024) << " GiB, got "
-      << s.steps() + 1 << " rows of " << width << " columns (" << bytes / (1024.0 * 1024 * 1024)
-      << " GiB; use a longer step or a shorter duration)";
-    r.fail("step", m.str());
-  }
-  if (r.has("solver")) {
-    const TableReader t = r.table("solver");
-    const TableReader solver(t.file_ptr(), t.raw(), "solver");
-    SolverPolicy policy;
-    read_config(solver, SolverPolicy::schema(), policy);
-    s.on_infeasible = policy.on_infeasible == Policy::kStop    ? OnInfeasible::kStop
-                      : policy.on_infeasible == Policy::kRelax ? OnInfeasible::kRelax
-                                                               : OnInfeasible::kHold;
-    s.relax_weight = policy.relax_weight;
-    if (solver.has("relax_weight") && s.on_infeasible != OnInfeasible::kRelax) {
-      solver.fail("relax_weight", "is used only with on_infeasible = \"relax\" (on_infeasible is \"" +
-                                      std::string(solver.string("on_infeasible", "hold")) + "\")");
-    }
-    s.engine = make_engine(solver);
-  } else {
-    s.engine = make_engine("projection");
-  }
-  if (auto orientation = r.optional_table("orientation")) {
-    const TableReader o(orientation->file_ptr(), orientation->raw(), "orientation");
-    const bool planar = s.robot->kind() == ChainKind::kPlanar;
-    if (!s.robot->has_orientation_rows()) {
-      r.fail("orientation",
-             "the task has no orientation rows: set task = \"pose\" (in the scenario or the robot file)");
-    }
-    if (o.has("turn")) {
-      if (planar) {
-        s.orientation_turn = Eigen::Vector3d(0.0, 0.0, o.number("turn"));
-      } else {
-        const std::vector<double> w = o.numbers("turn", 3);
-        s.orientation_turn = Eigen::Vector3d(w[0], w[1], w[2]);
-      }
-      const double bound = *physical_bound("rad");
-      if (!(s.orientation_turn.cwiseAbs().maxCoeff() <= bound)) {
-        std::ostringstream m;
-        m << "expected |x| <= " << bound << " rad (a physical range), got " << s.orientation_turn.cwiseAbs().maxCoeff();
-        o.fail("turn", m.str());
-      }
-    }
-    o.finish();
-  }
-  if (auto out = r.optional_table("output")) {
-    const TableReader o(out->file_ptr(), out->raw(), "output");
-    s.record = read_record(o, "record", "all");
-    s.plots = o.boolean("plots", false);
-    s.animate = o.boolean("animate", false);
-    o.finish();
-  }
+  ScenarioReading reading;
+  reading.s.source = file.string();
+  reading.s.name = file.stem().string();
+  read_config(r, ScenarioReading::schema(), reading);
   r.finish();
+  Scenario s = std::move(reading.s);
+  s.record = reading.output.record;
+  s.plots = reading.output.plots;
+  s.animate = reading.output.animate;
   return s;
 }
 

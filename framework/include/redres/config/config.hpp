@@ -22,8 +22,8 @@
 /// Supported member types: double (a number or a constant formula such as "pi/2"), int, bool, std::string,
 /// std::filesystem::path (relative to the file that names it), enums with an `enum_names()` overload found by
 /// argument-dependent lookup, std::vector of double, int or std::string, std::array<double, N>, PerJoint (one
-/// number or one per joint), std::optional of these, and std::vector<S> for a struct S with its own schema (an
-/// array of inline tables).
+/// number or one per joint), std::optional of these, a struct S with its own schema (a sub-table), and
+/// std::vector<S> (an array of inline tables). A key whose reading needs more than its own value is an entry().
 
 #include <array>
 #include <cmath>
@@ -94,6 +94,14 @@ struct KeyInfo {
   std::string type;          //!< "number", "integer", "string", "one of 'a', 'b'", ...
   Presence presence = Presence::kOptional;
   std::string group;  //!< the group's name when presence is kGroup
+};
+
+/// One table of an input file and its keys, as `redres keys` and the docs list them.
+struct KeyTable {
+  std::string file;   //!< "scenario", "robot" or "sweep"
+  std::string table;  //!< "" for the file's top level, else e.g. "[output]" or "[[joints]]"
+  std::string help;   //!< what the table is for
+  std::vector<KeyInfo> keys;
 };
 
 /// A validity rule for a value of type T: `ok` returns true when valid; `text` says what is expected.
@@ -260,6 +268,32 @@ std::string type_name(const std::vector<S>*) {
   return "array of inline tables {" + keys + "}";
 }
 
+// A sub-table: a member S with its own schema, read from the table at `key` (a [key] table or an inline one). Its
+// messages name the table by its key ("output: key 'plots': ...").
+template <class S, class = has_schema_t<S>>
+void read(const TableReader& r, std::string_view key, S& v) {
+  const TableReader t = r.table(key);
+  const TableReader sub(t.file_ptr(), t.raw(), std::string(key));
+  read_config(sub, S::schema(), v);
+  sub.finish();
+}
+template <class S, class = has_schema_t<S>>
+void write(toml::table& t, std::string_view key, const S& v) {
+  toml::table e;
+  write_config(v, S::schema(), e);
+  t.insert_or_assign(key, std::move(e));
+}
+template <class S, class = has_schema_t<S>>
+std::string type_name(const S*) {
+  std::string keys;
+  for (const auto& f : S::schema().fields) keys += (keys.empty() ? "" : ", ") + f.name;
+  return "table {" + keys + "}";
+}
+template <class S, class = has_schema_t<S>>
+bool given(const S&) {
+  return true;
+}
+
 // Optional values: absent when nullopt (nothing is written back).
 template <class T>
 void read(const TableReader& r, std::string_view key, std::optional<T>& v) {
@@ -296,10 +330,17 @@ struct Field {
   std::function<void(const C&, toml::table&)> write;          //!< writes the member
   std::function<bool(const C&)> given;                        //!< member holds a value (required keys)
   std::function<std::optional<std::string>(const C&)> check;  //!< nullopt, or what was expected and got
+  std::string default_text;  //!< the default as listed when it is not a member's value ("the file's stem")
+  bool always = false;       //!< `read` runs when the key is absent too (it applies its own default): entry()
 
   /// Marks the key as required: no default; a Config built in C++ must set it.
   Field&& required() && {
     presence = Presence::kRequired;
+    return std::move(*this);
+  }
+  /// The default as listed, when the member's value does not show it (a table's: "see [output]").
+  Field&& listed_default(std::string text) && {
+    default_text = std::move(text);
     return std::move(*this);
   }
   /// Puts the key in a group of alternatives; the schema's group rule says which combinations are valid.
@@ -408,6 +449,27 @@ Field<C> field(std::string name, T C::*member, std::string unit, std::string hel
   return f;
 }
 
+/// A key whose reader is its own: reading it needs more than its value (a key read before it, the robot, a
+/// registry, another file), or it keeps messages of its own. `read` runs in the schema's order whether the key is
+/// present or not, and applies the default itself; `default_text` says what that default is ("" and
+/// .required(): the reader refuses a missing key). The key is listed, known and located like any field's.
+template <class C>
+Field<C> entry(std::string name, std::string type, std::string unit, std::string default_text, std::string help,
+               std::function<void(const TableReader&, C&)> read, std::string rule = "") {
+  Field<C> f;
+  f.name = std::move(name);
+  f.type = std::move(type);
+  f.unit = std::move(unit);
+  f.default_text = std::move(default_text);
+  f.help = std::move(help);
+  f.rule = std::move(rule);
+  f.always = true;
+  f.read = std::move(read);
+  f.write = [](const C&, toml::table&) {};
+  f.given = [](const C&) { return true; };
+  return f;
+}
+
 // --- rules --------------------------------------------------------------------------------------------------------
 
 namespace detail {
@@ -485,17 +547,22 @@ void check_config(const C& c, const Schema<C>& schema) {
 
 /// Reads a Config from a table (starting from the defaults in `c`), marking every schema key as known; checks it.
 /// Does not call finish(): the caller may read more keys from the same table first.
+/// The keys are read in the schema's order, and each is checked as soon as it is read, so that a later key's reader
+/// (an entry()) sees checked values.
 template <class C>
 void read_config(const TableReader& r, const Schema<C>& schema, C& c) {
   for (const auto& f : schema.fields) {
-    if (r.has(f.name)) {
+    if (f.always || r.has(f.name)) {
       f.read(r, c);
     } else if (f.presence == Presence::kRequired) {
       r.fail("missing required key '" + f.name + "'" + (f.help.empty() ? "" : " (" + f.help + ")"));
     }
+    if (f.check) {
+      if (auto why = f.check(c)) rethrow_at(r, FieldError(f.name, *why));
+    }
   }
   try {
-    check_config(c, schema);
+    if (schema.validate) schema.validate(c);
   } catch (const FieldError& e) {
     rethrow_at(r, e);
   }
@@ -520,7 +587,9 @@ std::vector<KeyInfo> describe_keys(const Schema<C>& schema, const C& defaults = 
     k.type = f.type;
     k.presence = f.presence;
     k.group = f.group;
-    if (f.presence == Presence::kOptional) {
+    if (f.presence == Presence::kOptional && !f.default_text.empty()) {
+      k.default_text = f.default_text;
+    } else if (f.presence == Presence::kOptional) {
       toml::table t;
       f.write(defaults, t);
       if (const toml::node* n = t.get(f.name)) {

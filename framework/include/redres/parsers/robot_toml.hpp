@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "redres/config/toml_reader.hpp"
+#include "redres/config/config.hpp"
 #include "redres/model/robot.hpp"
 
 namespace redres {
@@ -19,5 +19,9 @@ namespace redres {
 /// Reads the key `task` of a robot or scenario table into spec.task and spec.task_axes: "position", "pose", or an
 /// array naming a subset of the pose's rows in order (e.g. ["x", "y", "z", "wz"]). spec.kind must be set.
 void read_task(const TableReader& table, RobotSpec& spec);
+
+/// Every table of a robot file with its keys (from the schemas the reader reads them with), for `redres keys` and
+/// docs/robot_format.md.
+[[nodiscard]] const std::vector<KeyTable>& robot_key_tables();
 
 }  // namespace redres

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "redres/config/config.hpp"
 #include "redres/control/controller.hpp"
 #include "redres/run/record.hpp"
 
@@ -72,6 +73,11 @@ inline constexpr double kMaxTableBytes = 2.0 * 1024 * 1024 * 1024;
 
 /// The [solver] table's keys that the run reads besides the engine's (on_infeasible, relax_weight), for listings.
 [[nodiscard]] const std::vector<KeyInfo>& solver_policy_keys();
+
+/// Every table of a scenario file with its keys (from the schemas the reader reads them with), for `redres keys` and
+/// docs/scenario_format.md. The plugins' tables ([path], [[objectives]], [[constraints]], the engine's [solver]
+/// keys) are listed by `redres plugins`.
+[[nodiscard]] const std::vector<KeyTable>& scenario_key_tables();
 
 /// Loads and checks a scenario. `overrides` are "key.path=value" strings (TOML values; a bare word is a string;
 /// array entries by 0-based index, e.g. "objectives.1.p=1"). Every problem is a ConfigError at file:line:col.

@@ -35,6 +35,7 @@
 
 #include <Eigen/Core>
 
+#include "redres/config/config.hpp"
 #include "redres/run/run_output.hpp"
 
 namespace redres {
@@ -71,6 +72,10 @@ struct Variation {
 /// Loads a sweep file; the base scenario is loaded once to check it and to sample theta0 within its robot's
 /// limits. Every problem is a ConfigError at file:line:col.
 [[nodiscard]] SweepSpec load_sweep(const std::filesystem::path& file);
+
+/// Every table of a sweep file with its keys (from the schemas the reader reads them with), for `redres keys` and
+/// docs/sweeps.md.
+[[nodiscard]] const std::vector<KeyTable>& sweep_key_tables();
 
 /// Variation `index` (< spec.size()).
 [[nodiscard]] Variation variation(const SweepSpec& spec, std::size_t index);

@@ -30,6 +30,8 @@ import os
 import shutil
 import sys
 
+from redres_output import OutputError, save_output  # noqa: E402  (beside this script)
+
 # A missing library has its own exit code, so that `redres --plots` can say what to install instead of reporting a
 # failed plot; the check costs nothing, as the figures need these imports anyway.
 EXIT_MISSING_LIBRARY = 3
@@ -407,7 +409,7 @@ def fig_task(run_dir, data, summary, frames, n, name):
     ax_d.set_title(r"(d) $\theta$ profiles")
     fig.suptitle(f"{name}: end-effector task")
     fig.tight_layout()
-    fig.savefig(os.path.join(run_dir, "fig4_task.png"), dpi=110)
+    save_output(os.path.join(run_dir, "fig4_task.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
 
 
@@ -426,7 +428,7 @@ def joint_panels(run_dir, n, name, title, filename, ylabel, draw):
         axes[k // cols][k % cols].axis("off")
     fig.suptitle(f"{name}: {title}")
     fig.tight_layout()
-    fig.savefig(os.path.join(run_dir, filename), dpi=110)
+    save_output(os.path.join(run_dir, filename), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
 
 
@@ -494,7 +496,7 @@ def fig_error(run_dir, data, name):
         ax2.grid(alpha=0.3)
     axes[-1][0].set_xlabel("t (s)")
     fig.tight_layout()
-    fig.savefig(os.path.join(run_dir, "fig9b_position_error.png"), dpi=110)
+    save_output(os.path.join(run_dir, "fig9b_position_error.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
 
 
@@ -524,7 +526,7 @@ def fig_distances(run_dir, data, summary, name):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(os.path.join(run_dir, "fig_collision_distances.png"), dpi=110)
+    save_output(os.path.join(run_dir, "fig_collision_distances.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
 
 
@@ -535,7 +537,7 @@ def fig_profiles(run_dir, data, n, name):
     b.set_title(r"(b) $\theta$ profiles")
     fig.suptitle(f"{name}: joint-velocity and joint-angle profiles")
     fig.tight_layout()
-    fig.savefig(os.path.join(run_dir, "fig3_profiles.png"), dpi=110)
+    save_output(os.path.join(run_dir, "fig3_profiles.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
 
 
@@ -678,7 +680,7 @@ def animate_run(run_dir, quiet):
     fig.tight_layout()
     anim = matplotlib.animation.FuncAnimation(fig, update, frames=len(rows), blit=False)
     path = os.path.join(run_dir, file_name)
-    anim.save(path, writer=writer, dpi=90 if planar else 80)
+    save_output(path, lambda target: anim.save(target, writer=writer, dpi=90 if planar else 80))
     plt.close(fig)
     if not quiet:
         print(f"{len(rows)} frames at {fps} frames/s with {type(writer).__name__}"
@@ -698,7 +700,7 @@ def plot_compare(dirs, out, quiet):
     ax.grid(alpha=0.3)
     fig.tight_layout()
     os.makedirs(out, exist_ok=True)
-    fig.savefig(os.path.join(out, "fig5_manipulability.png"), dpi=110)
+    save_output(os.path.join(out, "fig5_manipulability.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
     if not quiet:
         print(f"comparison figure written to {out}")
@@ -729,4 +731,8 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except OutputError as e:
+        print(f"plot_run.py: {e}", file=sys.stderr)
+        sys.exit(2)

@@ -17,6 +17,8 @@ import json
 import os
 import sys
 
+from redres_output import OutputError, save_output  # noqa: E402  (beside this script)
+
 EXIT_MISSING_LIBRARY = 3
 try:
     import matplotlib
@@ -103,7 +105,10 @@ def main():
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.25), fontsize=8, frameon=False)
     fig.tight_layout()
     out = args.out or os.path.join(args.sweep_dir, "sweep_heatmap.png")
-    fig.savefig(out, dpi=120)
+    try:
+        save_output(out, lambda target: fig.savefig(target, dpi=120))
+    except OutputError as e:
+        fail(str(e))
     print(f"written: {out}")
 
 

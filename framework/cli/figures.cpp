@@ -114,11 +114,15 @@ void render_plots(const Plotter& p, std::vector<std::string> args, bool quiet, c
 std::filesystem::path render_animation(const Plotter& p, const std::filesystem::path& dir, bool quiet,
                                        const std::string& outputs) {
   const std::filesystem::path files[] = {dir / "animation.mp4", dir / "animation.gif"};
-  for (const auto& f : files) std::filesystem::remove(f);
+  FileStamp before[2];
+  for (int i = 0; i < 2; ++i) {
+    (void)remove_earlier_output(dir, files[i].filename().string());  // only an animation an earlier run made
+    before[i] = stamp_of(files[i]);
+  }
   render_plots(p, {"--animate", dir.string()}, quiet, outputs);
-  for (const auto& f : files) {
-    std::error_code ec;
-    if (std::filesystem::file_size(f, ec) > 0 && !ec) return f;
+  for (int i = 0; i < 2; ++i) {
+    const FileStamp now = stamp_of(files[i]);
+    if (now.exists && now.size > 0 && !(now == before[i])) return files[i];
   }
   throw std::runtime_error(p.request + ": plot_run.py --animate wrote neither animation.mp4 nor animation.gif in " +
                            dir.string() + "; " + outputs + " were written");

@@ -1,14 +1,18 @@
 // `redres sweep`: a scenario over a grid of variations on a thread pool, one slice of it (--shard, or a Slurm job
 // array), and the merge of the slices' tables.
 
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <system_error>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -29,21 +33,48 @@ struct SweepOptions {
   bool runs = false, quiet = false;
 };
 
-// The slice this process runs: --shard, else a Slurm job array's task (SLURM_ARRAY_TASK_ID counted from
-// SLURM_ARRAY_TASK_MIN, which defaults to 0, out of SLURM_ARRAY_TASK_COUNT), else everything.
+// A Slurm variable's value: decimal digits only (no sign, no suffix: "1abc" is refused), as a count that cannot
+// wrap.
+std::size_t slurm_number(const char* name, const char* text) {
+  std::size_t out = 0;
+  const std::string_view t(text);
+  const auto res = std::from_chars(t.data(), t.data() + t.size(), out);
+  if (t.empty() || res.ec != std::errc() || res.ptr != t.data() + t.size()) {
+    throw std::invalid_argument(std::string(name) + "=" + text + ": expected a whole number of at most " +
+                                std::to_string(std::numeric_limits<std::size_t>::max()));
+  }
+  return out;
+}
+
+// The slice this process runs: --shard, else a Slurm job array's task, else everything. A job array
+// (sbatch --array=MIN-MAX[:STEP]) runs its tasks with SLURM_ARRAY_TASK_ID = MIN, MIN + STEP, ...; task k of
+// SLURM_ARRAY_TASK_COUNT runs slice k = (ID - MIN) / STEP (MIN defaults to 0, STEP to 1).
 SweepShard shard_of(const SweepOptions& o) {
   if (!o.shard.empty()) return parse_shard(o.shard);
   const char* id = std::getenv("SLURM_ARRAY_TASK_ID");
   const char* count = std::getenv("SLURM_ARRAY_TASK_COUNT");
   if (id == nullptr || count == nullptr) return {};
   const char* min = std::getenv("SLURM_ARRAY_TASK_MIN");
+  const char* step = std::getenv("SLURM_ARRAY_TASK_STEP");
+  std::string where = std::string("SLURM_ARRAY_TASK_ID=") + id + ", SLURM_ARRAY_TASK_COUNT=" + count;
+  if (min != nullptr) where += std::string(", SLURM_ARRAY_TASK_MIN=") + min;
+  if (step != nullptr) where += std::string(", SLURM_ARRAY_TASK_STEP=") + step;
   try {
-    const long i = std::stol(id) - (min != nullptr ? std::stol(min) : 0L);
-    return parse_shard(std::to_string(i) + "/" + count);
-  } catch (const std::exception& e) {
-    throw std::invalid_argument(std::string("SLURM_ARRAY_TASK_ID=") + id + ", SLURM_ARRAY_TASK_COUNT=" + count +
-                                (min != nullptr ? std::string(", SLURM_ARRAY_TASK_MIN=") + min : std::string()) + ": " +
-                                e.what());
+    const std::size_t i = slurm_number("SLURM_ARRAY_TASK_ID", id);
+    const std::size_t n = slurm_number("SLURM_ARRAY_TASK_COUNT", count);
+    const std::size_t lo = min != nullptr ? slurm_number("SLURM_ARRAY_TASK_MIN", min) : 0;
+    const std::size_t by = step != nullptr ? slurm_number("SLURM_ARRAY_TASK_STEP", step) : 1;
+    if (by == 0) throw std::invalid_argument("the step is 0");
+    if (i < lo) throw std::invalid_argument("the task id is below the array's first");
+    if ((i - lo) % by != 0) throw std::invalid_argument("the task id is not the first plus a multiple of the step");
+    const std::size_t k = (i - lo) / by;
+    if (n == 0 || k >= n) {
+      throw std::invalid_argument("task " + std::to_string(k) + " of an array of " + std::to_string(n) +
+                                  " tasks (expected 0 <= (ID - MIN) / STEP < COUNT)");
+    }
+    return {k, n};
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(where + ": " + e.what());
   }
 }
 
@@ -52,8 +83,16 @@ std::string table_name(const SweepShard& s) {
   return s.count == 1 ? "sweep" : "sweep-shard-" + std::to_string(s.shard) + "-of-" + std::to_string(s.count);
 }
 
-void write_meta(const std::filesystem::path& file, const nlohmann::json& meta) {
-  write_text_file(file, meta.dump(2) + "\n");
+// TABLE.csv and TABLE.json together: both are staged and finished before either is renamed into place, so that a
+// full disk (or any failed write) leaves the old pair, never a new table beside an old description.
+void write_table_and_meta(const SweepTable& table, const std::filesystem::path& csv, const nlohmann::json& meta) {
+  StagedFile table_file(csv);
+  write_sweep_csv(table, table_file);
+  StagedFile meta_file(std::filesystem::path(csv).replace_extension(".json"));
+  meta_file.write(meta.dump(2) + "\n");
+  meta_file.finish();
+  table_file.install();
+  meta_file.install();
 }
 
 int run(const SweepOptions& o) {
@@ -79,16 +118,16 @@ int run(const SweepOptions& o) {
   const bool interrupted = g_stop_requested.load();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string name = table_name(shard);
-  write_sweep_csv(table, std::filesystem::path(o.out) / (name + ".csv"));
-  write_meta(std::filesystem::path(o.out) / (name + ".json"),
-             {{"name", spec.name},
-              {"sweep", spec.source},
-              {"scenario", spec.scenario.string()},
-              {"variations", spec.size()},
-              {"shard", std::to_string(shard.shard) + "/" + std::to_string(shard.count)},
-              {"rows", table.rows.size()},
-              {"failed", table.failed()},
-              {"interrupted", interrupted}});
+  write_table_and_meta(table, std::filesystem::path(o.out) / (name + ".csv"),
+                       {{"name", spec.name},
+                        {"identity", sweep_identity(spec)},
+                        {"sweep", spec.source},
+                        {"scenario", spec.scenario.string()},
+                        {"variations", spec.size()},
+                        {"shard", std::to_string(shard.shard) + "/" + std::to_string(shard.count)},
+                        {"rows", table.rows.size()},
+                        {"failed", table.failed()},
+                        {"interrupted", interrupted}});
   if (interrupted) {
     std::cerr << spec.name << ": interrupted after " << table.rows.size() << " of " << spec.size() << " variations; "
               << (std::filesystem::path(o.out) / (name + ".csv")).string()
@@ -106,6 +145,8 @@ int run(const SweepOptions& o) {
 int merge(const SweepOptions& o) {
   std::vector<SweepTable> tables;
   std::size_t expected = 0;
+  std::string identity, name;
+  std::filesystem::path first;  // the table that set `identity`
   for (const auto& dir : o.merge) {
     if (!std::filesystem::is_directory(dir)) throw std::invalid_argument("--merge: " + dir + " is not a directory");
     std::vector<std::filesystem::path> files;
@@ -118,19 +159,46 @@ int merge(const SweepOptions& o) {
     if (files.empty()) throw std::invalid_argument("--merge: no sweep.csv or sweep-shard-*.csv in " + dir);
     std::sort(files.begin(), files.end());
     for (const auto& f : files) {
+      // Each table's .json says which sweep it belongs to: tables of different sweeps (another grid, another base
+      // scenario) are never mixed.
+      const std::filesystem::path meta_file = std::filesystem::path(f).replace_extension(".json");
+      nlohmann::json meta;
+      try {
+        if (!std::filesystem::is_regular_file(meta_file)) throw std::runtime_error("not a regular file");
+        std::ifstream in(meta_file);
+        meta = nlohmann::json::parse(in);
+      } catch (const std::exception& e) {
+        throw std::invalid_argument("--merge: " + f.string() + ": its description " + meta_file.filename().string() +
+                                    " cannot be read (" + e.what() + "), so its sweep cannot be told");
+      }
+      const std::string id = meta.value("identity", "");
+      if (id.empty()) {
+        throw std::invalid_argument("--merge: " + meta_file.string() +
+                                    " has no \"identity\" (written by an older redres): run that shard again");
+      }
+      if (identity.empty()) {
+        identity = id;
+        first = f;
+        name = meta.value("name", "");
+      } else if (id != identity) {
+        throw std::invalid_argument("--merge: " + f.string() + " belongs to another sweep than " + first.string() +
+                                    " (identity " + id + " against " + identity +
+                                    "; a different grid, name, overrides or base scenario)");
+      }
       tables.push_back(read_sweep_csv(f));
-      std::ifstream meta(std::filesystem::path(f).replace_extension(".json"));
-      if (meta) expected = std::max<std::size_t>(expected, nlohmann::json::parse(meta).value("variations", 0UL));
+      expected = std::max<std::size_t>(expected, meta.value("variations", std::size_t{0}));
     }
   }
   const SweepTable merged = merge_sweep_tables(tables);
   std::filesystem::create_directories(o.out);
-  write_sweep_csv(merged, std::filesystem::path(o.out) / "sweep.csv");
-  write_meta(std::filesystem::path(o.out) / "sweep.json", {{"merged_from", o.merge},
-                                                           {"variations", expected},
-                                                           {"shard", "0/1"},
-                                                           {"rows", merged.rows.size()},
-                                                           {"failed", merged.failed()}});
+  write_table_and_meta(merged, std::filesystem::path(o.out) / "sweep.csv",
+                       {{"merged_from", o.merge},
+                        {"name", name},
+                        {"identity", identity},
+                        {"variations", expected},
+                        {"shard", "0/1"},
+                        {"rows", merged.rows.size()},
+                        {"failed", merged.failed()}});
   if (!o.quiet) {
     std::cout << "merged " << tables.size() << " tables: " << merged.rows.size() << " of " << expected
               << " variations, " << merged.failed() << " not ok -> "

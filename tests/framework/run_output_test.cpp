@@ -193,11 +193,13 @@ TEST(RunOutput, FilesAreReplacedWholeAndAFailedWriteLeavesTheDirectoryAsItWas) {
   const std::string trajectory = file_text(dir / "trajectory.csv"), frames = file_text(dir / "frames.csv"),
                     summary = file_text(dir / "summary.json");
   EXPECT_EQ(std::count(trajectory.begin(), trajectory.end(), '\n'), 1002);  // header and 1,001 rows
-  // A write that fails half-way (here frames.csv cannot be created) changes nothing and leaves no temporary.
-  const auto blocker = dir / (".frames.csv.tmp." + std::to_string(::getpid()));
-  std::filesystem::create_directory(blocker);
+  // A write that fails half-way (here frames.csv cannot be staged: its name is taken by a directory, which is
+  // never replaced) changes nothing else and leaves no temporary.
+  std::filesystem::rename(dir / "frames.csv", dir / "frames.keep");
+  std::filesystem::create_directory(dir / "frames.csv");
   EXPECT_THROW(write_run(*sa.robot, ra, ma, dir), std::runtime_error);
-  std::filesystem::remove(blocker);
+  std::filesystem::remove(dir / "frames.csv");
+  std::filesystem::rename(dir / "frames.keep", dir / "frames.csv");
   EXPECT_TRUE(hidden(dir).empty());
   EXPECT_EQ(file_text(dir / "trajectory.csv"), trajectory);
   EXPECT_EQ(file_text(dir / "frames.csv"), frames);

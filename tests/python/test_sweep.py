@@ -44,3 +44,28 @@ def test_the_heat_map_marks_the_variations_that_did_not_run_through(tmp_path):
     assert os.path.getsize(tmp_path / "sweep_heatmap.png") > 5000
     bad = subprocess.run([sys.executable, tool, str(tmp_path), "--x", "nope"], capture_output=True, text=True)
     assert bad.returncode == 2 and "'nope' is not a column" in bad.stderr
+
+
+def test_a_sweep_that_writes_its_runs_without_out_dir_gets_a_private_directory_it_names(tmp_path):
+    import shutil
+    import stat
+    import warnings
+
+    sweep_file = tmp_path / "runs.toml"
+    sweep_file.write_text(f'name = "runs"\nscenario = "{source("configs/paper_r_fast.toml")}"\n'
+                          '[[vary]]\nkey = "objectives.1.p"\nvalues = [1.0, 2.0]\n[output]\nruns = true\n')
+    dirs = []
+    for _ in range(2):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rows = redres.sweep(str(sweep_file), jobs=1)
+        assert [r["status"] for r in rows] == ["ok", "ok"]
+        said = [str(w.message) for w in caught if "no out_dir" in str(w.message)]
+        assert len(said) == 1, [str(w.message) for w in caught]
+        where = said[0].split("written into ")[1]
+        dirs.append(where)
+        assert stat.S_IMODE(os.lstat(where).st_mode) == 0o700
+        assert os.path.isfile(os.path.join(where, "runs", "1", "summary.json"))
+    assert dirs[0] != dirs[1]  # a new directory each time, never a fixed name
+    for d in dirs:
+        shutil.rmtree(d)

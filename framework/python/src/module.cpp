@@ -562,11 +562,18 @@ PYBIND11_MODULE(_redres, m) {
       "_sweep",
       [](const std::filesystem::path& file, unsigned jobs, const std::string& shard, const std::string& out_dir) {
         const SweepSpec spec = load_sweep(file);
+        // Without out_dir, a sweep that writes its runs gets a new private directory (never a fixed name in the
+        // shared temporary directory), named in a warning so that the runs are not lost.
+        std::filesystem::path dir = out_dir;
+        if (dir.empty() && spec.write_runs) {
+          dir = make_private_directory("redres-sweep-");
+          const std::string where = "redres.sweep: no out_dir; the runs are written into " + dir.string();
+          if (PyErr_WarnEx(PyExc_UserWarning, where.c_str(), 1) < 0) throw py::error_already_set();
+        }
         SweepTable table;
         {
           py::gil_scoped_release release;
-          table = run_sweep(spec, shard.empty() ? SweepShard{} : parse_shard(shard), jobs,
-                            out_dir.empty() ? std::filesystem::temp_directory_path() : std::filesystem::path(out_dir));
+          table = run_sweep(spec, shard.empty() ? SweepShard{} : parse_shard(shard), jobs, dir);
         }
         return py::make_tuple(table.columns, typed_rows(table, spec));
       },

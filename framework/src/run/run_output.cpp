@@ -5,7 +5,6 @@
 #include <charconv>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -13,7 +12,9 @@
 
 #include <unistd.h>
 
+#include "common/input_file.hpp"
 #include "redres/common/error.hpp"
+#include "redres/common/output_file.hpp"
 #include "redres/model/kinematics.hpp"
 
 namespace redres {
@@ -23,19 +24,10 @@ namespace {
 // A table as comma-separated text with one header line. Numbers are written by std::to_chars in their shortest
 // round-trip form (reading the text back gives the same doubles, bit for bit), into a buffer written in large
 // blocks: several times faster than printf("%.17g").
-// `shown` is the name errors give (the final name of a staged file).
-void write_csv(const Trajectory& table, const std::filesystem::path& file, const std::filesystem::path& shown,
-               std::size_t every = 1) {
-  std::FILE* f = std::fopen(file.string().c_str(), "w");
-  if (f == nullptr) throw std::runtime_error("cannot write " + shown.string());
+void write_csv(const Trajectory& table, StagedFile& file, std::size_t every = 1) {
   constexpr std::size_t kBlock = 1 << 16;
   std::string out;
   out.reserve(kBlock + 4096);
-  bool ok = true;
-  const auto flush = [&] {
-    ok = ok && std::fwrite(out.data(), 1, out.size(), f) == out.size();
-    out.clear();
-  };
   const auto& cols = table.columns();
   for (std::size_t c = 0; c < cols.size(); ++c) (out += c ? "," : "") += cols[c];
   out += '\n';
@@ -49,16 +41,13 @@ void write_csv(const Trajectory& table, const std::filesystem::path& file, const
       out.append(number, end);
     }
     out += '\n';
-    if (out.size() >= kBlock) flush();
+    if (out.size() >= kBlock) {
+      file.write(out);
+      out.clear();
+    }
   }
-  flush();
-  if (std::fclose(f) != 0 || !ok) throw std::runtime_error("cannot write " + shown.string());
-}
-
-// Where `file` is written before it is renamed into place: beside it (rename is atomic within a directory), hidden,
-// and unique to this process.
-std::filesystem::path staging_path(const std::filesystem::path& file) {
-  return file.parent_path() / ("." + file.filename().string() + ".tmp." + std::to_string(::getpid()));
+  file.write(out);
+  file.finish();
 }
 
 // Columns per joint in frames.csv: origin, then the rotation row by row.
@@ -117,55 +106,102 @@ Trajectory joint_frames(const RobotModel& robot, const Trajectory& run, std::siz
 namespace {
 
 bool manifest_name_ok(const std::string& name) {
-  return !name.empty() && name.find('/') == std::string::npos && name[0] != '.';
+  return !name.empty() && name.find('/') == std::string::npos && name.find('\t') == std::string::npos && name[0] != '.';
 }
 
-void write_manifest(const std::filesystem::path& dir, const std::vector<std::string>& names) {
-  std::string text =
-      "# the files the last redres run wrote into this directory; the next run removes those it does not write "
-      "again\n";
-  for (const auto& n : names) text += n + "\n";
+constexpr const char* kManifestHeader =
+    "# redres outputs: the files the last run wrote into this directory, each with its size, modification time (ns) "
+    "and inode when written; the next run removes those it does not write again, and only while they are unchanged";
+
+struct ManifestEntry {
+  std::string name;
+  FileStamp stamp;  // exists == false: named without a stamp (hand-written, or an old manifest): never removed
+};
+
+std::vector<ManifestEntry> read_manifest(const std::filesystem::path& dir) {
+  std::vector<ManifestEntry> entries;
+  const std::filesystem::path file = dir / kOutputManifest;
+  if (!stamp_of(file).exists) return entries;  // missing, or not a regular file (a link is never followed)
+  std::string text;
+  try {
+    text = read_input_file(file, "output manifest", std::uintmax_t{1} << 20);
+  } catch (const std::exception&) {
+    return entries;  // unreadable: nothing is recognised, so nothing is removed
+  }
+  std::size_t at = 0;
+  while (at < text.size()) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = text.substr(at, end - at);
+    at = end + 1;
+    if (line.empty() || line[0] == '#') continue;
+    ManifestEntry e;
+    const std::size_t tab = line.find('\t');
+    e.name = line.substr(0, tab);
+    if (!manifest_name_ok(e.name)) continue;
+    if (tab != std::string::npos) {
+      unsigned long long size = 0, inode = 0;
+      long long mtime = 0;
+      char extra = 0;
+      if (std::sscanf(line.c_str() + tab + 1, "%llu\t%lld\t%llu%c", &size, &mtime, &inode, &extra) == 3) {
+        e.stamp = {true, size, mtime, inode};
+      }
+    }
+    entries.push_back(std::move(e));
+  }
+  return entries;
+}
+
+void write_manifest(const std::filesystem::path& dir, const std::vector<ManifestEntry>& entries) {
+  std::string text = std::string(kManifestHeader) + "\n";
+  for (const auto& e : entries) {
+    text += e.name;
+    if (e.stamp.exists) {
+      text += "\t" + std::to_string(e.stamp.size) + "\t" + std::to_string(e.stamp.mtime_ns) + "\t" +
+              std::to_string(e.stamp.inode);
+    }
+    text += "\n";
+  }
   write_text_file(dir / kOutputManifest, text);
+}
+
+// The entries for files just written into DIR: stamped as they are now.
+std::vector<ManifestEntry> stamped(const std::filesystem::path& dir, const std::vector<std::string>& names) {
+  std::vector<ManifestEntry> entries;
+  for (const auto& n : names) {
+    if (!manifest_name_ok(n)) continue;
+    const FileStamp s = stamp_of(dir / n);
+    if (s.exists) entries.push_back({n, s});
+  }
+  return entries;
 }
 
 }  // namespace
 
-void write_text_file(const std::filesystem::path& file, const std::string& text) {
-  const std::filesystem::path tmp = staging_path(file);
-  std::ofstream out(tmp);
-  out << text;
-  out.close();
-  if (!out) {
-    const int e = errno;
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(e));
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw std::runtime_error("cannot write " + file.string() + ": " + ec.message());
-  }
-}
-
 std::vector<std::string> read_output_manifest(const std::filesystem::path& dir) {
   std::vector<std::string> names;
-  std::ifstream in(dir / kOutputManifest);
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    if (manifest_name_ok(line)) names.push_back(line);
-  }
+  for (auto& e : read_manifest(dir)) names.push_back(std::move(e.name));
   return names;
 }
 
 void add_to_output_manifest(const std::filesystem::path& dir, const std::vector<std::string>& names) {
-  std::vector<std::string> all = read_output_manifest(dir);
-  for (const auto& n : names) {
-    if (manifest_name_ok(n) && std::find(all.begin(), all.end(), n) == all.end()) all.push_back(n);
+  std::vector<ManifestEntry> all = read_manifest(dir);
+  for (auto& e : stamped(dir, names)) {
+    const auto same = std::find_if(all.begin(), all.end(), [&e](const ManifestEntry& a) { return a.name == e.name; });
+    if (same == all.end()) {
+      all.push_back(std::move(e));
+    } else {
+      *same = std::move(e);
+    }
   }
   write_manifest(dir, all);
+}
+
+bool remove_earlier_output(const std::filesystem::path& dir, const std::string& name) {
+  for (const auto& e : read_manifest(dir)) {
+    if (e.name == name) return remove_if_unchanged(dir / name, e.stamp);
+  }
+  return false;
 }
 
 void prepare_output_dir(const std::filesystem::path& dir, const std::string& what) {
@@ -179,17 +215,16 @@ void prepare_output_dir(const std::filesystem::path& dir, const std::string& wha
     std::filesystem::create_directories(dir, ec);
     if (ec) throw std::runtime_error(where + "cannot create the directory: " + ec.message());
   }
-  const std::filesystem::path probe = staging_path(dir / "probe");
-  {
-    std::ofstream out(probe);
-    out << "probe\n";
-    out.close();
-    if (!out) {
-      std::filesystem::remove(probe, ec);
-      throw std::runtime_error(where + "cannot write into the directory (" + std::strerror(errno) + ")");
-    }
+  try {
+    StagedFile probe(dir / "probe");  // created exclusively and removed again: never installed
+    probe.write("probe\n");
+    probe.finish();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(where + "cannot write into the directory (" + e.what() + ")");
   }
-  std::filesystem::remove(probe, ec);
+  for (const char* name : {"trajectory.csv", "frames.csv", "summary.json", kOutputManifest}) {
+    require_replaceable(dir / name, what + ": redres cannot write");
+  }
 }
 
 std::vector<std::string> write_run(const RobotModel& robot, const RunResult& run, const RunSummary& summary,
@@ -200,40 +235,26 @@ std::vector<std::string> write_run(const RobotModel& robot, const RunResult& run
   // directory) leaves the directory as it was. Then the old summary goes, the tables are renamed into place, and
   // the summary comes last: a reader that finds summary.json finds the complete tables of the same run.
   const std::filesystem::path summary_file = dir / "summary.json";
-  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged;  // temporary, final
-  const auto stage = [&staged](const std::filesystem::path& file) {
-    staged.emplace_back(staging_path(file), file);
-    return staged.back().first;
-  };
-  try {
-    if (!record.none) {
-      write_csv(run.trajectory, stage(dir / "trajectory.csv"), dir / "trajectory.csv", record.every);
-      write_csv(joint_frames(robot, run.trajectory), stage(dir / "frames.csv"), dir / "frames.csv");
-    }
-    const std::filesystem::path js_file = stage(summary_file);
-    std::ofstream js(js_file);
-    js << to_json(summary) << "\n";
-    js.close();
-    if (!js) throw std::runtime_error("cannot write " + summary_file.string());
-  } catch (...) {
-    std::error_code ignored;
-    for (const auto& [tmp, file] : staged) std::filesystem::remove(tmp, ignored);
-    throw;
+  std::vector<StagedFile> staged;  // installed in this order, summary.json last
+  if (!record.none) {
+    write_csv(run.trajectory, staged.emplace_back(dir / "trajectory.csv"), record.every);
+    write_csv(joint_frames(robot, run.trajectory), staged.emplace_back(dir / "frames.csv"));
   }
+  StagedFile& js = staged.emplace_back(summary_file);
+  js.write(to_json(summary));
+  js.write("\n");
+  js.finish();
   std::vector<std::string> written;
-  for (const auto& [tmp, file] : staged) written.push_back(file.filename().string());
-  // What an earlier run wrote and this one does not is stale: removed, before this run's files appear. A
-  // directory from before manifests existed may hold tables that would not belong to a summary-only run.
-  std::vector<std::string> stale = read_output_manifest(dir);
-  if (record.none) stale.insert(stale.end(), {"trajectory.csv", "frames.csv"});
-  std::filesystem::remove(summary_file);
-  for (const auto& name : stale) {
-    if (std::find(written.begin(), written.end(), name) != written.end()) continue;
-    std::error_code ec;
-    if (std::filesystem::is_regular_file(dir / name, ec)) std::filesystem::remove(dir / name, ec);
+  for (const auto& f : staged) written.push_back(f.final_name().filename().string());
+  // What an earlier run wrote and this one does not is stale: removed, before this run's files appear, when it is
+  // still the file that run wrote (same size, time and inode; never a link). A file the manifest does not stamp
+  // (a hand-written or planted manifest, a file edited or replaced since) stays.
+  for (const auto& e : read_manifest(dir)) {
+    if (std::find(written.begin(), written.end(), e.name) != written.end()) continue;
+    (void)remove_if_unchanged(dir / e.name, e.stamp);
   }
-  for (const auto& [tmp, file] : staged) std::filesystem::rename(tmp, file);  // summary.json last
-  write_manifest(dir, written);
+  for (auto& f : staged) f.install();
+  write_manifest(dir, stamped(dir, written));
   return written;
 }
 

@@ -5,10 +5,12 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <random>
 #include <sstream>
+#include <system_error>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -248,7 +250,17 @@ const Schema<SweepReading>& SweepReading::schema() {
                [](const TableReader& r, C& c) {
                  SweepSpec& spec = c.spec;
                  if (r.has("vary")) {
-                   for (const TableReader& t : r.tables("vary")) spec.axes.push_back(read_axis(t));
+                   for (const TableReader& t : r.tables("vary")) {
+                     SweepAxis axis = read_axis(t);
+                     for (const auto& earlier : spec.axes) {
+                       if (earlier.key == axis.key) {
+                         t.fail("key", "'" + axis.key +
+                                           "' is varied by an earlier [[vary]] already; one axis per key (a second "
+                                           "would override the first one's values)");
+                       }
+                     }
+                     spec.axes.push_back(std::move(axis));
+                   }
                  }
                  if (!spec.zip) return;
                  for (const auto& a : spec.axes) {
@@ -352,14 +364,42 @@ SweepTable to_table(const std::vector<Cells>& rows) {
 }  // namespace
 
 std::size_t SweepSpec::size() const {
+  // Saturating: a product that does not fit is SIZE_MAX, far above kMaxSweepVariations, never a wrapped count.
+  const auto times = [](std::size_t a, std::size_t b) {
+    std::size_t out = 0;
+    return __builtin_mul_overflow(a, b, &out) ? std::numeric_limits<std::size_t>::max() : out;
+  };
   std::size_t grid = 1;
   if (zip) {
     grid = axes.empty() ? 1 : axes.front().values.size();
   } else {
-    for (const auto& a : axes) grid *= a.values.size();
+    for (const auto& a : axes) grid = times(grid, a.values.size());
   }
-  return grid * std::max<std::size_t>(1, theta0.size());
+  return times(grid, std::max<std::size_t>(1, theta0.size()));
 }
+
+namespace {
+
+// "65536 x 65536 x ... = 1.8e19 variations", for the message of a grid that is too large.
+std::string grid_size_text(const SweepSpec& spec) {
+  std::string text;
+  double product = 1;
+  const auto factor = [&](std::size_t k) {
+    text += (text.empty() ? "" : " x ") + std::to_string(k);
+    product *= static_cast<double>(k);
+  };
+  if (spec.zip) {
+    factor(spec.axes.empty() ? 1 : spec.axes.front().values.size());
+  } else {
+    for (const auto& a : spec.axes) factor(a.values.size());
+  }
+  if (!spec.theta0.empty()) factor(spec.theta0.size());
+  char total[32];
+  std::snprintf(total, sizeof total, "%.3g", product);
+  return text + " = " + total;
+}
+
+}  // namespace
 
 SweepSpec load_sweep(const std::filesystem::path& file) {
   const TableReader r = TableReader::root(parse_toml_file(file), "sweep");
@@ -371,8 +411,36 @@ SweepSpec load_sweep(const std::filesystem::path& file) {
   SweepSpec spec = std::move(reading.spec);
   spec.write_runs = reading.output.runs;
   spec.record = reading.output.record;
-  if (spec.size() > 10000000) r.fail("vary", "expected at most 1e7 variations, got " + std::to_string(spec.size()));
+  if (spec.size() > kMaxSweepVariations) {
+    r.fail("vary", "expected at most 1e7 variations, got " + grid_size_text(spec));
+  }
   return spec;
+}
+
+std::string sweep_identity(const SweepSpec& spec) {
+  std::uint64_t h = 14695981039346656037ULL;
+  const auto mix = [&h](std::string_view part) {
+    for (const char c : part) {
+      h ^= static_cast<unsigned char>(c);
+      h *= 1099511628211ULL;
+    }
+    h ^= 0xff;  // a separator no text ends with, so that ("ab", "c") and ("a", "bc") differ
+    h *= 1099511628211ULL;
+  };
+  mix(spec.name);
+  mix(spec.zip ? "zip" : "cross");
+  for (const auto& a : spec.axes) {
+    mix(a.key);
+    for (const auto& v : a.values) mix(v);
+  }
+  for (const auto& q : spec.theta0) {
+    for (Eigen::Index j = 0; j < q.size(); ++j) mix(shortest(q(j)));
+  }
+  for (const auto& o : spec.set) mix(o);
+  mix(read_input_file(spec.scenario, "scenario file"));
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
 }
 
 const std::vector<KeyTable>& sweep_key_tables() {
@@ -441,7 +509,11 @@ SweepTable run_sweep(const SweepSpec& spec, const SweepShard& shard, unsigned jo
                      const std::atomic<bool>* stop) {
   REDRES_REQUIRE(shard.count >= 1 && shard.shard < shard.count, "run_sweep", "0 <= shard < count");
   std::vector<std::size_t> mine;
-  for (std::size_t i = shard.shard; i < spec.size(); i += shard.count) mine.push_back(i);
+  const std::size_t total = spec.size();
+  for (std::size_t i = shard.shard; i < total; i += shard.count) {  // (no wrap: i + count is formed only below total)
+    mine.push_back(i);
+    if (total - i <= shard.count) break;
+  }
   std::vector<Cells> rows(mine.size());
   std::atomic<std::size_t> next{0};
   std::size_t done = 0;
@@ -458,23 +530,38 @@ SweepTable run_sweep(const SweepSpec& spec, const SweepShard& shard, unsigned jo
   if (jobs == 0) jobs = std::max(1U, std::thread::hardware_concurrency());
   const std::size_t threads = std::min<std::size_t>(jobs, std::max<std::size_t>(1, mine.size()));
   std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  try {
+    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  } catch (const std::system_error&) {
+    // The system gives no more threads (a process or memory limit): the ones running, and this one, do the work.
+  }
   work();
   for (auto& t : pool) t.join();
   rows.erase(std::remove_if(rows.begin(), rows.end(), [](const Cells& c) { return c.empty(); }), rows.end());
   return to_table(rows);
 }
 
-void write_sweep_csv(const SweepTable& table, const std::filesystem::path& file) {
-  std::ofstream out(file);
-  for (std::size_t c = 0; c < table.columns.size(); ++c) out << (c ? "," : "") << csv_field(table.columns[c]);
-  out << "\n";
+void write_sweep_csv(const SweepTable& table, StagedFile& file) {
+  std::string text;
+  const auto flush = [&] {
+    file.write(text);
+    text.clear();
+  };
+  for (std::size_t c = 0; c < table.columns.size(); ++c) (text += c ? "," : "") += csv_field(table.columns[c]);
+  text += "\n";
   for (const auto& row : table.rows) {
-    for (std::size_t c = 0; c < row.size(); ++c) out << (c ? "," : "") << csv_field(row[c]);
-    out << "\n";
+    for (std::size_t c = 0; c < row.size(); ++c) (text += c ? "," : "") += csv_field(row[c]);
+    text += "\n";
+    if (text.size() >= (std::size_t{1} << 16)) flush();
   }
-  out.close();
-  if (!out) throw std::runtime_error("cannot write " + file.string());
+  flush();
+  file.finish();
+}
+
+void write_sweep_csv(const SweepTable& table, const std::filesystem::path& file) {
+  StagedFile out(file);
+  write_sweep_csv(table, out);
+  out.install();
 }
 
 SweepTable read_sweep_csv(const std::filesystem::path& file) {

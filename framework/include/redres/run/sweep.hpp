@@ -35,6 +35,7 @@
 
 #include <Eigen/Core>
 
+#include "redres/common/output_file.hpp"
 #include "redres/config/config.hpp"
 #include "redres/run/run_output.hpp"
 
@@ -57,7 +58,8 @@ struct SweepSpec {
   std::vector<Eigen::VectorXd> theta0;  //!< initial configurations (empty: the scenario's own)
   RecordOptions record{1, true};        //!< rows of each run's trajectory.csv (with write_runs)
   bool write_runs = false;              //!< write runs/<index>/ for every variation
-  /// Number of variations.
+  /// Number of variations; SIZE_MAX when the product of the axes' sizes does not fit (load_sweep refuses any
+  /// count above kMaxSweepVariations, so a loaded spec's count is exact).
   [[nodiscard]] std::size_t size() const;
 };
 
@@ -68,6 +70,14 @@ struct Variation {
   std::vector<std::string> values;        //!< each axis's value (TOML text)
   std::optional<Eigen::VectorXd> theta0;  //!< when the sweep varies theta0
 };
+
+/// The most variations a sweep file may describe.
+inline constexpr std::size_t kMaxSweepVariations = 10000000;
+
+/// What identifies a sweep, as 16 hex digits: a hash (FNV-1a, 64 bits) of what decides its rows, namely the name,
+/// how the axes combine, each axis's key and values, the initial configurations, the overrides and the base
+/// scenario file's text. Each shard's .json carries it, and `--merge` refuses tables whose identities differ.
+[[nodiscard]] std::string sweep_identity(const SweepSpec& spec);
 
 /// Loads a sweep file; the base scenario is loaded once to check it and to sample theta0 within its robot's
 /// limits. Every problem is a ConfigError at file:line:col.
@@ -109,8 +119,11 @@ using SweepProgress = std::function<void(std::size_t done, std::size_t total)>;
                                    const std::filesystem::path& out_dir, const SweepProgress& progress = {},
                                    const std::atomic<bool>* stop = nullptr);
 
-/// Writes the table as CSV (RFC 4180 quoting) to `file`; std::runtime_error naming it on failure.
+/// Writes the table as CSV (RFC 4180 quoting) to `file` through a StagedFile (exclusive, never through a link; a
+/// failed write leaves the old file); std::runtime_error naming it on failure.
 void write_sweep_csv(const SweepTable& table, const std::filesystem::path& file);
+/// The same into a staged file, finished but not installed: a caller installs it with the files that go with it.
+void write_sweep_csv(const SweepTable& table, StagedFile& file);
 /// Reads a sweep.csv back; ConfigError at file:line for malformed files.
 [[nodiscard]] SweepTable read_sweep_csv(const std::filesystem::path& file);
 /// Merges shard tables into one: the union of their columns (in order of first appearance), rows sorted by index.

@@ -85,8 +85,14 @@ StagedFile::StagedFile(StagedFile&& other) noexcept
 }
 
 StagedFile::~StagedFile() {
+  if (!installed_) discard();
+}
+
+void StagedFile::discard() noexcept {
   if (file_ != nullptr) std::fclose(file_);
-  if (!installed_ && !temp_.empty()) ::unlink(temp_.c_str());  // only the name this object created
+  file_ = nullptr;
+  if (!temp_.empty()) ::unlink(temp_.c_str());  // only the name this object created
+  temp_.clear();
 }
 
 void StagedFile::write(std::string_view bytes) {
@@ -98,10 +104,7 @@ void StagedFile::write(std::string_view bytes) {
 }
 
 void StagedFile::fail(const std::string& why) {
-  if (file_ != nullptr) std::fclose(file_);
-  file_ = nullptr;
-  if (!temp_.empty()) ::unlink(temp_.c_str());
-  temp_.clear();
+  discard();
   throw std::runtime_error("cannot write " + final_.string() + ": " + why);
 }
 
@@ -129,8 +132,7 @@ void StagedFile::install() {
   try {
     require_replaceable(final_, "cannot write");  // not turned into a link or a directory meanwhile
   } catch (const std::exception&) {
-    if (!temp_.empty()) ::unlink(temp_.c_str());
-    temp_.clear();
+    discard();
     throw;
   }
   if (std::rename(temp_.c_str(), final_.c_str()) != 0) fail(std::strerror(errno));

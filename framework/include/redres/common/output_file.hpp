@@ -42,6 +42,7 @@ class StagedFile {
 
  private:
   [[noreturn]] void fail(const std::string& why);
+  void discard() noexcept;  // closes the stream and removes the temporary, if any
   std::filesystem::path final_;
   std::filesystem::path temp_;
   std::FILE* file_ = nullptr;

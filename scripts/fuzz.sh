@@ -8,7 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
-read -r -a targets <<<"${FUZZ_TARGETS:-robot_loader scenario_loader overrides formula}"
+read -r -a targets <<<"${FUZZ_TARGETS:-robot_loader urdf_loader scenario_loader overrides formula}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 out=build/fuzz
 
@@ -47,6 +47,9 @@ seed_corpus() {  # seed_corpus TARGET DIR
   case "$target" in
     robot_loader)
       add_seed "$dir" robots/*.toml tests/data/*.toml tests/data/robots/*.toml tests/data/robot_corpus/*.toml ;;
+    urdf_loader)
+      # The shipped URDFs, the test URDFs (hostile ones among them) and any other URDF in the test data.
+      add_seed "$dir" robots/urdf/*.urdf tests/data/urdf/*.urdf ;;
     scenario_loader)
       add_seed "$dir" configs/*.toml tests/data/scenario_corpus/*.toml ;;
     overrides)
@@ -66,6 +69,7 @@ seed_corpus() {  # seed_corpus TARGET DIR
 dict_of() {
   case "$1" in
     robot_loader | scenario_loader) echo tests/fuzz/dictionaries/toml.dict ;;
+    urdf_loader) echo tests/fuzz/dictionaries/urdf.dict ;;
     *) echo "tests/fuzz/dictionaries/$1.dict" ;;
   esac
 }

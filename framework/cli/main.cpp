@@ -60,11 +60,11 @@ int main(int argc, char** argv) {
     }
     return action ? action() : redres::cli::kExitOk;
   } catch (const redres::ConfigError& e) {
-    std::cerr << e.what() << "\n";
+    std::cerr << redres::printable(e.what()) << "\n";  // a name from a file may hold escape sequences
   } catch (const std::invalid_argument& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    std::cerr << "error: " << redres::printable(e.what()) << "\n";
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    std::cerr << "error: " << redres::printable(e.what()) << "\n";
   }
   return redres::cli::kExitBadInput;
 }

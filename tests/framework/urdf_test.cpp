@@ -31,9 +31,8 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> capsule_in_world(const RobotModel& r
 
 class UrdfRobots : public ::testing::TestWithParam<std::pair<const char*, const char*>> {};
 
-// Each shipped URDF robot is its DH twin: position rows, their Jacobian and the capsules in the world agree (the
-// orientation rows too, for the Panda, whose URDF flange frame is the DH one; the iiwa's URDF flange frame is turned
-// against its DH one, so only its position rows are compared).
+// Each shipped URDF robot is its DH twin: the flange frame (position and orientation), the position rows' Jacobian
+// and the capsules in the world agree.
 TEST_P(UrdfRobots, TheUrdfRobotIsItsDhTwin) {
   const RobotModel dh = load_robot(source_path(GetParam().first));
   const RobotModel urdf = load_robot(source_path(GetParam().second));
@@ -41,13 +40,14 @@ TEST_P(UrdfRobots, TheUrdfRobotIsItsDhTwin) {
   ASSERT_EQ(urdf.link_shapes().size(), dh.link_shapes().size());
   KinematicsData a(dh), b(urdf);
   std::mt19937 rng(21);
-  double worst_f = 0.0, worst_j = 0.0, worst_w = 0.0, worst_w_abs = 0.0, worst_shape = 0.0;
+  double worst_f = 0.0, worst_j = 0.0, worst_r = 0.0, worst_w = 0.0, worst_w_abs = 0.0, worst_shape = 0.0;
   for (int k = 0; k < 1000; ++k) {
     const Eigen::VectorXd theta = random_inside(dh, rng);
     compute_kinematics(dh, theta, a, KinematicsLevel::kManipulability);
     compute_kinematics(urdf, theta, b, KinematicsLevel::kManipulability);
     worst_f = std::max(worst_f, (a.f.head(3) - b.f.head(3)).cwiseAbs().maxCoeff());
     worst_j = std::max(worst_j, (a.J.topRows(3) - b.J.topRows(3)).cwiseAbs().maxCoeff());
+    worst_r = std::max(worst_r, (a.ee_pose.linear() - b.ee_pose.linear()).cwiseAbs().maxCoeff());
     if (dh.task() == urdf.task() && dh.task() == TaskRows::kPosition) {
       worst_w = std::max(worst_w, std::abs(a.w - b.w) / (1e-12 + a.w));
       worst_w_abs = std::max(worst_w_abs, std::abs(a.w - b.w));
@@ -67,11 +67,13 @@ TEST_P(UrdfRobots, TheUrdfRobotIsItsDhTwin) {
   };
   RecordProperty("max_f_difference", sci(worst_f));
   RecordProperty("max_J_difference", sci(worst_j));
+  RecordProperty("max_flange_rotation_difference", sci(worst_r));
   RecordProperty("max_w_difference", sci(worst_w_abs));
   RecordProperty("max_w_relative_difference", sci(worst_w));
   RecordProperty("max_capsule_end_difference", sci(worst_shape));
   EXPECT_LE(worst_f, 1e-12);
   EXPECT_LE(worst_j, 1e-12);
+  EXPECT_LE(worst_r, 1e-12);
   EXPECT_LE(worst_w_abs, 1e-12);
   EXPECT_LE(worst_w, 1e-10);
   EXPECT_LE(worst_shape, 1e-12);
@@ -302,5 +304,135 @@ velocity_limit = { type = "push_rod", a = 0.1, b = 0.2, s = 0.1, sigma_min = -0.
   EXPECT_EQ(robot.joint(0).velocity_limit->type(), "push_rod");
 }
 
+// The message of loading a robot file that names `urdf` (an absolute path) from `base` to `tip`; "" if it loads.
+std::string load_error(const Files& f, const std::filesystem::path& urdf, const std::string& base,
+                       const std::string& tip) {
+  const auto file = f.write(
+      "robot.toml", "urdf = \"" + urdf.string() + "\"\nbase_link = \"" + base + "\"\ntip_link = \"" + tip + "\"\n");
+  try {
+    (void)load_robot(file);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// `count` moving joints in a chain l0 -> l1 -> ... (each 0.01 m along x), with `branch` fixed links hanging from
+// l1 in a line, and `extra` text before </robot>.
+std::string generated_urdf(int count, int branch, const std::string& extra = "") {
+  std::string x = "<?xml version=\"1.0\"?>\n<robot name=\"generated\">\n<link name=\"l0\"/>\n";
+  for (int k = 1; k <= count; ++k) {
+    x += "<link name=\"l" + std::to_string(k) + "\"/>\n<joint name=\"j" + std::to_string(k) +
+         "\" type=\"revolute\"><origin xyz=\"0.01 0 0\"/><parent link=\"l" + std::to_string(k - 1) +
+         "\"/><child link=\"l" + std::to_string(k) +
+         "\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" velocity=\"1\" effort=\"1\"/></joint>\n";
+  }
+  for (int k = 1; k <= branch; ++k) {
+    x += "<link name=\"s" + std::to_string(k) +
+         "\"><collision><geometry><sphere radius=\"0.01\"/></geometry></collision></link>\n<joint name=\"f" +
+         std::to_string(k) + "\" type=\"fixed\"><origin xyz=\"0 0.001 0\"/><parent link=\"" +
+         (k == 1 ? std::string("l1") : "s" + std::to_string(k - 1)) + "\"/><child link=\"s" + std::to_string(k) +
+         "\"/></joint>\n";
+  }
+  return x + extra + "</robot>\n";
+}
+
+// Hostile URDFs (the second reliability probe's): each is refused with a message naming the element (and its line
+// where the file has one), in bounded time and memory, instead of looping, growing without end or overflowing a
+// stack.
+TEST(UrdfBounds, CyclesSelfParentsAndBadValuesAreRefusedNamingTheElement) {
+  const Files f("hostile");
+  struct Case {
+    const char* file;
+    const char* base;
+    const char* tip;
+    std::vector<std::string> says;
+  };
+  const std::vector<Case> cases = {
+      {"cycle_beside_the_chain.urdf", "base", "tip", {"is on a cycle of joints ('", "a URDF's joints form a tree"}},
+      {"own_parent.urdf",
+       "base",
+       "tip",
+       {"own_parent.urdf:10: joint 'loop' has link 'tip' as both its parent and its child"}},
+      {"cycle_off_the_chain.urdf",
+       "base",
+       "tip",
+       {"cycle_off_the_chain.urdf:14: joint 'js3' and joint 'js1' both have link 's1' as their child"}},
+      {"origin_1e300.urdf",
+       "base",
+       "tip",
+       {"origin_1e300.urdf:11: joint 'j2': <origin> xyz expected |x| <= 1000 m (a physical range), got 1e+300"}},
+      {"names.urdf", "base", "tip", {"joint 'red\\x1b[31m': the name is not UTF-8 without control characters"}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file);
+    const std::string what = load_error(f, data_path(std::string("urdf/") + c.file), c.base, c.tip);
+    ASSERT_FALSE(what.empty()) << "loaded";
+    EXPECT_EQ(what.rfind((f.dir / "robot.toml").string() + ":", 0), 0u) << what;
+    for (const std::string& s : c.says)
+      EXPECT_NE(what.find(s), std::string::npos) << "missing '" << s << "' in: " << what;
+    EXPECT_EQ(what.find('\x1b'), std::string::npos) << "a raw escape character in the message";
+  }
+  // A name that is not UTF-8 (Latin-1 e-acute), printed escaped.
+  const std::string latin = replace(read_text(data_path("urdf/names.urdf")), "red\x1b[31m", "red");
+  const std::string what = load_error(f, f.write("latin.urdf", latin), "base", "tip");
+  EXPECT_NE(what.find("joint 'latin\\xe9xyz': the name is not UTF-8"), std::string::npos) << what;
+  // Two joints with one child.
+  const std::string two =
+      generated_urdf(2, 0, "<joint name=\"again\" type=\"fixed\"><parent link=\"l0\"/><child link=\"l2\"/></joint>\n");
+  const std::string twice = load_error(f, f.write("two_parents.urdf", two), "l0", "l2");
+  EXPECT_NE(twice.find("both have link 'l2' as their child; a link has one parent"), std::string::npos) << twice;
+}
+
+TEST(UrdfBounds, DepthElementsLinksAndJointsAreBoundedWithTheBoundInTheMessage) {
+  const Files f("bounds");
+  // 50,000 nested elements (350 KB) once overflowed TinyXML's stack.
+  std::string nested = "<?xml version=\"1.0\"?>\n<robot name=\"deep\">\n";
+  for (int k = 0; k < 50000; ++k) nested += "<a>";
+  for (int k = 0; k < 50000; ++k) nested += "</a>";
+  nested += "</robot>\n";
+  std::string what = load_error(f, f.write("deep.urdf", nested), "l0", "l1");
+  EXPECT_NE(what.find("deep.urdf:3: <a> is nested 65 elements deep; a URDF nests at most 64"), std::string::npos)
+      << what;
+  // More elements than the bound, none nested.
+  std::string wide = "<robot name=\"wide\">\n";
+  for (int k = 0; k <= 500000; ++k) wide += "<a/>";  // one more than the bound
+  what = load_error(f, f.write("wide.urdf", wide + "</robot>\n"), "l0", "l1");
+  EXPECT_NE(what.find("more than 500000 XML elements"), std::string::npos) << what;
+  // A side branch of 12,000 fixed links (once a segfault in add_branch): more links than the bound.
+  what = load_error(f, f.write("branch.urdf", generated_urdf(2, 12000)), "l0", "l2");
+  EXPECT_NE(what.find("12003 links and 12002 joints; a URDF has at most 10000 of each"), std::string::npos) << what;
+  // A chain of 1,200 moving joints (once 3.4 GB): more than kMaxJoints.
+  what = load_error(f, f.write("long.urdf", generated_urdf(1200, 0)), "l0", "l1200");
+  EXPECT_NE(what.find("joint 'j1001': the chain from 'l0' to 'l1200' has more than 1000 moving joints"),
+            std::string::npos)
+      << what;
+  // The same from a robot file: 1,001 [[joints]].
+  std::string toml = "name = \"long\"\nkind = \"planar\"\n";
+  for (int k = 0; k <= 1000; ++k) {
+    toml += "[[joints]]\nname = \"j" + std::to_string(k) +
+            "\"\nlength = 0.1\nlimits = [-1, 1]\nvelocity_limit = { type = \"constant\", lower = -1, upper = 1 }\n";
+  }
+  try {
+    (void)load_robot(f.write("long.toml", toml));
+    ADD_FAILURE() << "loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'joints': expected at most 1000 joints, got 1001"), std::string::npos)
+        << e.what();
+  }
+}
+
+// Within the bounds, a long side branch is walked without recursion and every one of its shapes rides on l1.
+TEST(UrdfBounds, ALongSideBranchRidesOnItsLink) {
+  const Files f("branch");
+  const std::string urdf = generated_urdf(2, 9000);
+  f.write("branch.urdf", urdf);
+  const RobotModel robot =
+      load_robot(f.write("robot.toml", "urdf = \"branch.urdf\"\nbase_link = \"l0\"\ntip_link = \"l2\"\n"));
+  ASSERT_EQ(robot.link_shapes().size(), 9000u);
+  for (const auto& s : robot.link_shapes()) ASSERT_EQ(s.link, 0);
+  // The last sphere is 9,000 steps of 1 mm along y from l1's frame.
+  EXPECT_NEAR(robot.link_shapes().back().pose.translation().y(), 9.0, 1e-9);
+}
 }  // namespace
 }  // namespace redres

@@ -39,7 +39,12 @@ using Eigen::Vector3d;
 void validate(const RobotSpec& spec) {
   const char* fn = "RobotModel";
   REDRES_REQUIRE(!spec.name.empty(), fn, "name is not empty");
+  REDRES_REQUIRE(is_printable_name(spec.name), fn,
+                 "the name is UTF-8 without control characters (got '" + printable(spec.name) + "')");
   REDRES_REQUIRE(!spec.joints.empty(), fn, "the chain has at least one joint");
+  REDRES_REQUIRE(spec.joints.size() <= kMaxJoints, fn,
+                 "the chain has at most " + std::to_string(kMaxJoints) + " joints (got " +
+                     std::to_string(spec.joints.size()) + ")");
   REDRES_REQUIRE(spec.end_effector.matrix().allFinite(), fn, "end_effector is finite");
   REDRES_REQUIRE(spec.base.matrix().allFinite(), fn, "base is finite");
   if (spec.kind == ChainKind::kPlanar) {
@@ -53,6 +58,9 @@ void validate(const RobotSpec& spec) {
     const JointSpec& jt = spec.joints[j];
     const std::string who = "joint " + std::to_string(j + 1) + " ('" + jt.name + "')";
     REDRES_REQUIRE(!jt.name.empty(), fn, "joint " + std::to_string(j + 1) + " has a name");
+    REDRES_REQUIRE(is_printable_name(jt.name), fn,
+                   "joint " + std::to_string(j + 1) + "'s name is UTF-8 without control characters (got '" +
+                       printable(jt.name) + "')");
     REDRES_REQUIRE(names.insert(jt.name).second, fn, who + " has a unique name");
     REDRES_REQUIRE(std::isfinite(jt.lower) && std::isfinite(jt.upper), fn, who + " limits are finite");
     REDRES_REQUIRE(jt.lower < jt.upper, fn,

@@ -247,6 +247,9 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
   reading.convention = convention;
   reading.jt.name = entry.string("name");
   if (reading.jt.name.empty()) entry.fail("name", "expected a non-empty joint name");
+  if (!is_printable_name(reading.jt.name)) {
+    entry.fail("name", "expected a name without control characters, got '" + printable(reading.jt.name) + "'");
+  }
   const TableReader r(entry.file_ptr(), entry.raw(), "joint '" + reading.jt.name + "'");
   if (!names.insert(reading.jt.name).second) r.fail("name", "duplicate joint name '" + reading.jt.name + "'");
   read_config(r, JointReading::schema(), reading);
@@ -443,6 +446,9 @@ const Schema<RobotReading>& RobotReading::schema() {
                  } else {
                    c.spec.name = r.string("name");
                    if (c.spec.name.empty()) r.fail("name", "expected a non-empty robot name");
+                   if (!is_printable_name(c.spec.name)) {
+                     r.fail("name", "expected a name without control characters, got '" + printable(c.spec.name) + "'");
+                   }
                  }
                }),
       entry<C>("kind", "one of 'planar', 'spatial'", "", "\"spatial\" with `urdf`; required without",
@@ -487,7 +493,12 @@ const Schema<RobotReading>& RobotReading::schema() {
                    return;
                  }
                  std::set<std::string> names;
-                 for (const TableReader& entry : r.tables("joints")) {
+                 const std::vector<TableReader> entries = r.tables("joints");
+                 if (entries.size() > kMaxJoints) {
+                   r.fail("joints", "expected at most " + std::to_string(kMaxJoints) + " joints, got " +
+                                        std::to_string(entries.size()));
+                 }
+                 for (const TableReader& entry : entries) {
                    c.spec.joints.push_back(load_joint(entry, c.spec.kind, c.spec.convention, names));
                  }
                }),

@@ -3,15 +3,21 @@
 #include "parsers/urdf.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <map>
 #include <mutex>
 #include <sstream>
+#include <unordered_map>
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include "common/input_file.hpp"
+#include "common/text.hpp"
 #include "redres/common/error.hpp"
+#include "redres/config/config.hpp"
+#include "redres/model/robot.hpp"
 
 namespace redres {
 
@@ -28,6 +34,94 @@ class Collect final : public console_bridge::OutputHandler {
   std::string messages, errors;  // warnings and errors; errors only
 };
 
+// Where each <link> and <joint> of the file starts, by name (for messages), from the bounded scan below.
+struct XmlOutline {
+  std::map<std::string, std::size_t> link_lines, joint_lines;
+};
+
+// A linear scan of the XML before urdfdom sees it: the nesting depth and the element count are bounded (TinyXML
+// parses recursively, so 50,000 nested elements overflow its stack, and 20,000 take seconds), and each top-level
+// <link> and <joint> is found with its line. Comments, CDATA, processing instructions and the DOCTYPE are skipped;
+// what is malformed is left for the parser to report.
+XmlOutline outline_xml(const std::string& where, const std::string& xml) {
+  XmlOutline out;
+  std::size_t line = 1, depth = 0, elements = 0;
+  const std::size_t n = xml.size();
+  // Moves i to just past `end` (counting lines); false if the file ends first.
+  const auto skip_to = [&](std::size_t& i, std::string_view end) {
+    const std::size_t at = xml.find(end, i);
+    const std::size_t stop = at == std::string::npos ? n : at + end.size();
+    line += static_cast<std::size_t>(std::count(xml.begin() + static_cast<std::ptrdiff_t>(i),
+                                                xml.begin() + static_cast<std::ptrdiff_t>(stop), '\n'));
+    i = stop;
+    return at != std::string::npos;
+  };
+  for (std::size_t i = 0; i < n;) {
+    if (xml[i] != '<') {
+      if (xml[i] == '\n') ++line;
+      ++i;
+      continue;
+    }
+    if (xml.compare(i, 4, "<!--") == 0) {
+      if (!skip_to(i, "-->")) break;
+    } else if (xml.compare(i, 9, "<![CDATA[") == 0) {
+      if (!skip_to(i, "]]>")) break;
+    } else if (xml.compare(i, 2, "<?") == 0) {
+      if (!skip_to(i, "?>")) break;
+    } else if (xml.compare(i, 2, "<!") == 0) {  // a DOCTYPE, with its internal subset in [...]
+      const std::size_t open = xml.find_first_of("[>", i);
+      if (open != std::string::npos && xml[open] == '[') {
+        if (!skip_to(i, "]")) break;
+      }
+      if (!skip_to(i, ">")) break;
+    } else if (xml.compare(i, 2, "</") == 0) {
+      if (depth > 0) --depth;
+      if (!skip_to(i, ">")) break;
+    } else {
+      const std::size_t start_line = line;
+      std::size_t k = i + 1;
+      while (k < n && !std::isspace(static_cast<unsigned char>(xml[k])) && xml[k] != '>' && xml[k] != '/') ++k;
+      const std::string tag = xml.substr(i + 1, k - i - 1);
+      // The attributes up to the closing '>' (one outside quotes).
+      std::string name;
+      char quote = 0;
+      std::size_t end = k;
+      for (; end < n && (quote != 0 || xml[end] != '>'); ++end) {
+        if (xml[end] == '\n') ++line;
+        if (quote != 0) {
+          if (xml[end] == quote) quote = 0;
+        } else if (xml[end] == '"' || xml[end] == '\'') {
+          quote = xml[end];
+        }
+      }
+      if (end >= n) break;
+      const bool empty = xml[end - 1] == '/';
+      if (++elements > kMaxUrdfElements) {
+        throw UrdfError(where + ":" + std::to_string(start_line) + ": more than " + std::to_string(kMaxUrdfElements) +
+                        " XML elements; a URDF has at most that many");
+      }
+      if (!empty && ++depth > kMaxUrdfDepth) {
+        throw UrdfError(where + ":" + std::to_string(start_line) + ": <" + printable(tag) + "> is nested " +
+                        std::to_string(depth) + " elements deep; a URDF nests at most " +
+                        std::to_string(kMaxUrdfDepth));
+      }
+      if ((tag == "link" || tag == "joint") && depth <= 2) {
+        const std::string attributes = xml.substr(k, end - k);
+        for (const char* q : {"name=\"", "name='"}) {
+          const std::size_t a = attributes.find(q);
+          if (a == std::string::npos || (a > 0 && !std::isspace(static_cast<unsigned char>(attributes[a - 1]))))
+            continue;
+          const std::size_t b = attributes.find(q[5], a + 6);
+          if (b != std::string::npos) name = attributes.substr(a + 6, b - a - 6);
+        }
+        (tag == "link" ? out.link_lines : out.joint_lines).emplace(name, start_line);
+      }
+      i = end + 1;
+    }
+  }
+  return out;
+}
+
 Eigen::Isometry3d pose_of(const urdf::Pose& p) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
@@ -35,15 +129,50 @@ Eigen::Isometry3d pose_of(const urdf::Pose& p) {
   return t;
 }
 
+// Names each element in messages, with its line where the scan found it: "file:12: link 'forearm'".
+struct Namer {
+  const std::string& where;
+  const XmlOutline& outline;
+  [[nodiscard]] std::string link(const std::string& name) const { return at(outline.link_lines, "link", name); }
+  [[nodiscard]] std::string joint(const std::string& name) const { return at(outline.joint_lines, "joint", name); }
+
+ private:
+  std::string at(const std::map<std::string, std::size_t>& lines, const char* kind, const std::string& name) const {
+    const auto it = lines.find(name);
+    return where + (it == lines.end() ? std::string() : ":" + std::to_string(it->second)) + ": " + kind + " '" +
+           printable(name) + "'";
+  }
+};
+
+// A length of the URDF (an origin's coordinate, a radius, a side) within the robot file's physical range.
+void check_length(const std::string& who, const char* what, double value, bool positive) {
+  const double bound = *physical_bound("m");
+  if (!(std::abs(value) <= bound) || (positive && !(value > 0.0))) {
+    throw UrdfError(who + ": " + what + " expected " + (positive ? "> 0 and " : "") + "|x| <= " + num(bound) +
+                    " m (a physical range), got " + num(value));
+  }
+}
+
+void check_pose(const std::string& who, const char* what, const urdf::Pose& p) {
+  const std::string xyz = std::string(what) + " xyz";
+  for (double v : {p.position.x, p.position.y, p.position.z}) check_length(who, xyz.c_str(), v, false);
+  const double q[4] = {p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z};
+  if (!std::all_of(std::begin(q), std::end(q), [](double v) { return std::isfinite(v); })) {
+    throw UrdfError(who + ": " + what + " rpy is not finite");
+  }
+}
+
 // The collision elements of `link`, whose frame is `at` in the frame of the UrdfLink `out` gathers shapes for.
-void add_shapes(const std::string& where, const urdf::Link& link, const Eigen::Isometry3d& at,
-                const std::string& messages, UrdfLink& out) {
+void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometry3d& at, const std::string& messages,
+                UrdfLink& out) {
+  const std::string who = names.link(link.name);
   for (const urdf::CollisionSharedPtr& c : link.collision_array) {
     if (!c) continue;
     if (!c->geometry) {
-      throw UrdfError(where + ": link '" + link.name + "' has a <collision> element whose geometry could not be read" +
-                      (messages.empty() ? std::string() : " (" + messages + ")"));
+      throw UrdfError(who + " has a <collision> element whose geometry could not be read" +
+                      (messages.empty() ? std::string() : " (" + printable(messages) + ")"));
     }
+    check_pose(who, "<collision> <origin>", c->origin);
     const Eigen::Isometry3d pose = at * pose_of(c->origin);
     ShapeSpec s;
     s.xyz = {pose.translation().x(), pose.translation().y(), pose.translation().z()};
@@ -52,11 +181,13 @@ void add_shapes(const std::string& where, const urdf::Link& link, const Eigen::I
       case urdf::Geometry::SPHERE:
         s.shape = ShapeSpec::Kind::kSphere;
         s.radius = static_cast<const urdf::Sphere&>(*c->geometry).radius;
+        check_length(who, "<sphere> radius", *s.radius, true);
         break;
       case urdf::Geometry::BOX: {
         const urdf::Vector3& d = static_cast<const urdf::Box&>(*c->geometry).dim;
         s.shape = ShapeSpec::Kind::kBox;
         s.size = std::array<double, 3>{d.x, d.y, d.z};
+        for (double v : *s.size) check_length(who, "<box> size", v, true);
         break;
       }
       case urdf::Geometry::CYLINDER: {
@@ -64,6 +195,8 @@ void add_shapes(const std::string& where, const urdf::Link& link, const Eigen::I
         s.shape = ShapeSpec::Kind::kCylinder;
         s.radius = cyl.radius;
         s.length = cyl.length;
+        check_length(who, "<cylinder> radius", cyl.radius, true);
+        check_length(who, "<cylinder> length", cyl.length, true);
         break;
       }
       case urdf::Geometry::MESH: out.meshes.push_back(static_cast<const urdf::Mesh&>(*c->geometry).filename); continue;
@@ -72,14 +205,75 @@ void add_shapes(const std::string& where, const urdf::Link& link, const Eigen::I
   }
 }
 
-// A side branch below `joint` (taken at position 0), its frames placed from `at`.
-void add_branch(const std::string& where, const urdf::ModelInterface& model, const urdf::Joint& joint,
+// The side branch below `joint` (its joints taken at position 0), its frames placed from `at`: walked with a stack
+// of its own, so that a branch of 10,000 fixed links is as safe as one of 3 (the graph is a tree: checked first).
+void add_branch(const Namer& names, const urdf::ModelInterface& model, const urdf::Joint& joint,
                 const Eigen::Isometry3d& at, const std::string& messages, UrdfLink& out) {
-  const urdf::LinkConstSharedPtr link = model.getLink(joint.child_link_name);
-  if (!link) return;
-  const Eigen::Isometry3d frame = at * pose_of(joint.parent_to_joint_origin_transform);
-  add_shapes(where, *link, frame, messages, out);
-  for (const urdf::JointSharedPtr& child : link->child_joints) add_branch(where, model, *child, frame, messages, out);
+  std::vector<std::pair<const urdf::Joint*, Eigen::Isometry3d>> stack{{&joint, at}};
+  while (!stack.empty()) {
+    const auto [j, from] = stack.back();
+    stack.pop_back();
+    const urdf::LinkConstSharedPtr link = model.getLink(j->child_link_name);
+    if (!link) continue;
+    check_pose(names.joint(j->name), "<origin>", j->parent_to_joint_origin_transform);
+    const Eigen::Isometry3d frame = from * pose_of(j->parent_to_joint_origin_transform);
+    add_shapes(names, *link, frame, messages, out);
+    for (auto it = link->child_joints.rbegin(); it != link->child_joints.rend(); ++it) {
+      if (*it) stack.emplace_back(it->get(), frame);
+    }
+  }
+}
+
+// The joints form a tree: at most kMaxUrdfLinks links and joints, each link the child of at most one joint, no
+// joint its own link's parent, and no cycle (a link whose parents never reach a root). urdfdom checks only that
+// one link has no parent; a cycle beside it would send the walks below round for ever.
+void check_tree(const Namer& names, const urdf::ModelInterface& model) {
+  if (model.links_.size() > kMaxUrdfLinks || model.joints_.size() > kMaxUrdfLinks) {
+    throw UrdfError(names.where + ": " + std::to_string(model.links_.size()) + " links and " +
+                    std::to_string(model.joints_.size()) + " joints; a URDF has at most " +
+                    std::to_string(kMaxUrdfLinks) + " of each");
+  }
+  std::unordered_map<std::string, const urdf::Joint*> parent;  // child link -> the joint above it
+  for (const auto& [name, joint] : model.joints_) {
+    if (!joint) continue;
+    if (joint->child_link_name == joint->parent_link_name) {
+      throw UrdfError(names.joint(name) + " has link '" + printable(joint->child_link_name) +
+                      "' as both its parent and its child");
+    }
+    const auto [it, fresh] = parent.emplace(joint->child_link_name, joint.get());
+    if (!fresh) {
+      throw UrdfError(names.joint(name) + " and joint '" + printable(it->second->name) + "' both have link '" +
+                      printable(joint->child_link_name) + "' as their child; a link has one parent");
+    }
+  }
+  // Each link's way up, followed once: 1 while on the current way, 2 when it is known to reach a root.
+  std::unordered_map<std::string, int> state;
+  std::vector<std::string> way;
+  for (const auto& entry : model.links_) {
+    std::string at = entry.first;
+    way.clear();
+    while (state[at] == 0) {
+      state[at] = 1;
+      way.push_back(at);
+      const auto up = parent.find(at);
+      if (up == parent.end()) break;
+      at = up->second->parent_link_name;
+    }
+    if (state[at] == 1 && parent.count(at) != 0) {
+      std::string cycle;
+      const auto first = std::find(way.begin(), way.end(), at);
+      for (auto it = first; it != way.end(); ++it) cycle += "'" + printable(*it) + "' -> ";
+      throw UrdfError(names.link(at) + " is on a cycle of joints (" + cycle + "'" + printable(at) +
+                      "'): a URDF's joints form a tree");
+    }
+    for (const std::string& l : way) state[l] = 2;
+  }
+}
+
+void check_name(const std::string& who, const std::string& name) {
+  if (!is_printable_name(name)) {
+    throw UrdfError(who + ": the name is not UTF-8 without control characters (it reads '" + printable(name) + "')");
+  }
 }
 
 }  // namespace
@@ -93,6 +287,8 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
   } catch (const ConfigError& e) {
     throw UrdfError(e.what());
   }
+  const XmlOutline outline = outline_xml(where, xml);
+  const Namer names{where, outline};
 
   urdf::ModelInterfaceSharedPtr model;
   std::string messages;
@@ -113,28 +309,33 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
     // urdfdom drops an element it cannot read (a <collision> with a bad <cylinder>, say) and still returns a model:
     // any error it reported fails the file, so that nothing is lost without a word.
     if (model && !collect.errors.empty())
-      throw UrdfError(where + ": urdfdom could not read all of it (" + collect.errors + ")");
+      throw UrdfError(where + ": urdfdom could not read all of it (" + printable(collect.errors) + ")");
   }
-  if (!model)
-    throw UrdfError(where + ": not a valid URDF (" + (messages.empty() ? "urdfdom gave no reason" : messages) + ")");
+  if (!model) {
+    throw UrdfError(where + ": not a valid URDF (" +
+                    (messages.empty() ? std::string("urdfdom gave no reason") : printable(messages)) + ")");
+  }
+  check_tree(names, *model);
 
   UrdfChain chain;
   chain.robot_name = model->getName();
+  check_name(where + ": <robot>", chain.robot_name);
   const urdf::LinkConstSharedPtr base = model->getLink(base_link);
-  if (!base) throw UrdfError(where + ": no link named '" + base_link + "' (base_link)");
+  if (!base) throw UrdfError(where + ": no link named '" + printable(base_link) + "' (base_link)");
   urdf::LinkConstSharedPtr link = model->getLink(tip_link);
-  if (!link) throw UrdfError(where + ": no link named '" + tip_link + "' (tip_link)");
+  if (!link) throw UrdfError(where + ": no link named '" + printable(tip_link) + "' (tip_link)");
 
-  // Walk up from the tip to the base; the joints met, reversed, are the chain.
+  // Walk up from the tip to the base (the tree is checked: this ends); the joints met, reversed, are the chain.
   std::vector<urdf::LinkConstSharedPtr> links{link};
   while (link->name != base_link) {
     const urdf::JointConstSharedPtr joint = link->parent_joint;
     if (!joint) {
-      throw UrdfError(where + ": link '" + tip_link + "' (tip_link) is not below link '" + base_link +
-                      "' (base_link): walking up from it reaches the root '" + link->name + "'");
+      throw UrdfError(where + ": link '" + printable(tip_link) + "' (tip_link) is not below link '" +
+                      printable(base_link) + "' (base_link): walking up from it reaches the root '" +
+                      printable(link->name) + "'");
     }
     link = model->getLink(joint->parent_link_name);
-    if (!link) throw UrdfError(where + ": joint '" + joint->name + "' names a missing parent link");
+    if (!link) throw UrdfError(names.joint(joint->name) + " names a missing parent link");
     links.push_back(link);
   }
   std::reverse(links.begin(), links.end());  // base first
@@ -142,14 +343,21 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
   Eigen::Isometry3d fixed = Eigen::Isometry3d::Identity();  // fixed joints since the last moving one
   for (std::size_t k = 1; k < links.size(); ++k) {
     const urdf::JointConstSharedPtr joint = links[k]->parent_joint;
-    const std::string who = where + ": joint '" + joint->name + "'";
+    const std::string who = names.joint(joint->name);
+    check_name(who, joint->name);
+    check_name(names.link(links[k]->name), links[k]->name);
     if (joint->mimic) throw UrdfError(who + " is a mimic joint; a chain of independent joints is expected");
+    check_pose(who, "<origin>", joint->parent_to_joint_origin_transform);
     const Eigen::Isometry3d origin = pose_of(joint->parent_to_joint_origin_transform);
     switch (joint->type) {
       case urdf::Joint::FIXED: fixed = fixed * origin; break;
       case urdf::Joint::REVOLUTE:
       case urdf::Joint::CONTINUOUS:
       case urdf::Joint::PRISMATIC: {
+        if (chain.joints.size() == kMaxJoints) {
+          throw UrdfError(who + ": the chain from '" + printable(base_link) + "' to '" + printable(tip_link) +
+                          "' has more than " + std::to_string(kMaxJoints) + " moving joints, the most a robot has");
+        }
         UrdfJoint j;
         j.name = joint->name;
         j.prismatic = joint->type == urdf::Joint::PRISMATIC;
@@ -157,12 +365,25 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
         j.origin = fixed * origin;
         fixed = Eigen::Isometry3d::Identity();
         j.axis = Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
-        if (!(j.axis.norm() > 1e-9)) throw UrdfError(who + " has a zero axis");
+        if (!j.axis.allFinite() || !(j.axis.norm() > 1e-9)) {
+          throw UrdfError(who + ": <axis> expected a finite, non-zero vector, got [" + num(j.axis.x()) + ", " +
+                          num(j.axis.y()) + ", " + num(j.axis.z()) + "]");
+        }
         j.axis.normalize();
         if (joint->limits) {
           j.lower = joint->limits->lower;
           j.upper = joint->limits->upper;
           j.velocity = joint->limits->velocity;
+          const double bound = *physical_bound(j.prismatic ? "m" : "rad");
+          const char* unit = j.prismatic ? " m" : " rad";
+          if (!j.continuous && !(std::abs(j.lower) <= bound && std::abs(j.upper) <= bound)) {
+            throw UrdfError(who + ": <limit> lower and upper expected |x| <= " + num(bound) + unit +
+                            " (a physical range), got " + num(j.lower) + " and " + num(j.upper));
+          }
+          if (!(std::abs(j.velocity) <= *physical_bound("rad/s or m/s")) || j.velocity < 0.0) {
+            throw UrdfError(who + ": <limit> velocity expected 0 <= v <= " + num(*physical_bound("rad/s or m/s")) +
+                            (j.prismatic ? " m/s" : " rad/s") + ", got " + num(j.velocity));
+          }
         }
         chain.joints.push_back(j);
         break;
@@ -179,17 +400,18 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
     l.name = links[k]->name;
     l.joint = static_cast<int>(chain.joints.size()) - 1;
     l.pose = fixed;
-    add_shapes(where, *links[k], Eigen::Isometry3d::Identity(), messages, l);
+    add_shapes(names, *links[k], Eigen::Isometry3d::Identity(), messages, l);
     // Side branches hanging from this link by fixed joints (a hand, a camera) ride on it; joints that could move
     // in them are taken at position 0 (they are not part of the chain).
     for (const urdf::JointSharedPtr& child : links[k]->child_joints) {
       if (k + 1 < links.size() && child->child_link_name == links[k + 1]->name) continue;  // the chain itself
-      add_branch(where, *model, *child, Eigen::Isometry3d::Identity(), messages, l);
+      add_branch(names, *model, *child, Eigen::Isometry3d::Identity(), messages, l);
     }
     chain.links.push_back(std::move(l));
   }
   if (chain.joints.empty()) {
-    throw UrdfError(where + ": no moving joint between '" + base_link + "' and '" + tip_link + "'");
+    throw UrdfError(where + ": no moving joint between '" + printable(base_link) + "' and '" + printable(tip_link) +
+                    "'");
   }
   chain.tip = fixed;
   return chain;

@@ -17,6 +17,11 @@
 
 namespace redres {
 
+/// The bounds a URDF file is read within (checked before and after urdfdom parses it; the message names the bound).
+inline constexpr std::size_t kMaxUrdfDepth = 64;          //!< XML elements nested in each other
+inline constexpr std::size_t kMaxUrdfElements = 500'000;  //!< XML elements in the file
+inline constexpr std::size_t kMaxUrdfLinks = 10'000;      //!< links, and joints, in the file
+
 /// A problem with a URDF file: the message names the file and the element.
 class UrdfError : public std::runtime_error {
  public:
@@ -52,8 +57,12 @@ struct UrdfChain {
 };
 
 /// Reads the chain. Throws UrdfError naming the file and the element for: a missing or unparsable file (with
-/// urdfdom's own messages), a missing link, a tip that is not below the base, a floating, planar or mimic joint in
-/// the chain, and a chain without moving joints.
+/// urdfdom's own messages), XML nested deeper or with more elements than the bounds above, joints that do not form
+/// a tree (a cycle, a link that is its own parent, a link with two parents), more links or joints than
+/// kMaxUrdfLinks or more moving joints than kMaxJoints, a name that is not UTF-8 or holds control characters, a
+/// length, position limit or velocity outside the robot file's physical range, a missing link, a tip that is not
+/// below the base, a floating, planar or mimic joint in the chain, and a chain without moving joints. Messages
+/// give the element's line where the file has it.
 [[nodiscard]] UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link,
                                         const std::string& tip_link);
 

@@ -8,8 +8,20 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace redres {
+
+/// Whether `text` is well-formed UTF-8 (no overlong forms, surrogates or code points above U+10FFFF).
+[[nodiscard]] bool is_utf8(std::string_view text) noexcept;
+
+/// Whether `name` can name a joint, link or robot: non-empty UTF-8 without control characters (C0, DEL, C1), so
+/// that it prints as itself and goes into JSON and CSV unchanged.
+[[nodiscard]] bool is_printable_name(std::string_view name) noexcept;
+
+/// `text` safe to print on a terminal: control characters other than newline and tab, and bytes that are not
+/// UTF-8, become \xNN escapes (an escape sequence from a file never reaches the terminal raw).
+[[nodiscard]] std::string printable(std::string_view text);
 
 /// Where in a configuration file something was found. `line` and `column` are 1-based; 0 means unknown.
 struct SourceLocation {

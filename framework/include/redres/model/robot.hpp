@@ -75,6 +75,10 @@ struct JointSpec {
 };
 
 /// Everything needed to build a RobotModel; filled by the TOML loader or by code (tests, generators).
+/// The most joints a chain may have. Every step works on n x n matrices, so a chain past this (a generated 12,000-joint
+/// URDF, say) would need gigabytes; robots are refused beyond it at load.
+inline constexpr std::size_t kMaxJoints = 1000;
+
 struct RobotSpec {
   std::string name;                                   //!< robot name
   ChainKind kind = ChainKind::kPlanar;                //!< planar or spatial

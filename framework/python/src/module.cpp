@@ -1,10 +1,13 @@
 // redres._redres: the C++ side of the Python module. The pure-Python package (redres/__init__.py) builds on it:
 // typed plugin configurations, compare(), and the base classes of Python-defined plugins.
 
+#include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <variant>
 #include <vector>
 
@@ -51,6 +54,12 @@ Eigen::VectorXd checked_theta(const RobotModel& robot, const Eigen::VectorXd& th
     throw std::invalid_argument(std::string(who) + ": theta has " + std::to_string(theta.size()) +
                                 " entries, expected dof = " + std::to_string(robot.dof()));
   }
+  for (Eigen::Index j = 0; j < theta.size(); ++j) {
+    if (!std::isfinite(theta(j))) {
+      throw std::invalid_argument(std::string(who) + ": theta is finite (theta[" + std::to_string(j) +
+                                  "] = " + std::to_string(theta(j)) + ")");
+    }
+  }
   return theta;
 }
 
@@ -72,10 +81,42 @@ KinematicsResult kinematics_of(const RobotModel& robot, const Eigen::VectorXd& t
 
 // --- scenarios and runs ------------------------------------------------------------------------------------------
 
-// redres.Scenario: a loaded scenario; one run at a time (a lock), any number of Python threads.
+// One user at a time of what a scenario or a controller holds (its plugins' state, the engine's warm start, the
+// step's buffers). Another thread waits its turn; the thread that holds it already (a plugin that runs its own
+// scenario or steps its own controller from inside the step) is refused, where waiting would never end.
+struct Exclusive {
+  std::mutex mutex;
+  std::atomic<std::thread::id> owner{};
+};
+
+class Hold {
+ public:
+  // Call without the GIL: the thread waited for may need it to finish.
+  Hold(Exclusive& e, const char* what) : e_(e) {
+    if (e_.owner.load() == std::this_thread::get_id()) {
+      throw std::runtime_error(std::string(what) +
+                               ": called again from inside its own step (a plugin of it called it); a scenario or "
+                               "controller takes one step at a time: use another one inside a plugin");
+    }
+    e_.mutex.lock();
+    e_.owner.store(std::this_thread::get_id());
+  }
+  ~Hold() {
+    e_.owner.store(std::thread::id());
+    e_.mutex.unlock();
+  }
+  Hold(const Hold&) = delete;
+  Hold& operator=(const Hold&) = delete;
+
+ private:
+  Exclusive& e_;
+};
+
+// redres.Scenario: a loaded scenario; one run at a time (the controllers made from it share its turn), any number
+// of Python threads.
 struct PyScenario {
   std::shared_ptr<Scenario> scenario;
-  std::shared_ptr<std::mutex> lock = std::make_shared<std::mutex>();
+  std::shared_ptr<Exclusive> use = std::make_shared<Exclusive>();
 };
 
 // redres.Result: a finished run, its summary, and the scenario it came from (for write()).
@@ -105,7 +146,7 @@ PyResult run_scenario(PyScenario& s, const py::object& progress) {
   PyResult out;
   {
     py::gil_scoped_release release;
-    std::lock_guard<std::mutex> guard(*s.lock);
+    const Hold hold(*s.use, "Scenario.run");
     auto run = std::make_shared<RunResult>(simulate(*s.scenario, callback));
     out.summary = std::make_shared<RunSummary>(summarise(*s.scenario, *run));
     out.run = std::move(run);
@@ -210,6 +251,7 @@ struct PyController {
   std::unique_ptr<Path> path;
   std::unique_ptr<Controller> controller;
   StepOutput out;
+  std::shared_ptr<Exclusive> use = std::make_shared<Exclusive>();  // a scenario's controller shares its turn
 };
 
 bool is_spec(py::handle item) { return py::hasattr(item, "_spec_table"); }
@@ -265,6 +307,7 @@ std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::li
 std::unique_ptr<PyController> controller_of(const PyScenario& s) {
   auto c = std::make_unique<PyController>();
   c->scenario = s.scenario;
+  c->use = s.use;
   Scenario& sc = *s.scenario;
   c->robot = std::shared_ptr<const RobotModel>(s.scenario, sc.robot.get());
   c->controller = Controller::from_scenario(sc);  // what simulate() runs, the relax policy included
@@ -272,8 +315,37 @@ std::unique_ptr<PyController> controller_of(const PyScenario& s) {
   return c;
 }
 
-py::tuple step_result(const PyController& c) {
-  return py::make_tuple(Eigen::VectorXd(c.out.theta_dot), info_of(c.out.info));
+// The controller behind a method's `self`, or nullptr when it was never made (its __init__ raised, or was not
+// called: the half-made object a traceback keeps), which pybind11 would hand over as garbage.
+PyController* made(py::handle self) {
+  auto* inst = reinterpret_cast<py::detail::instance*>(self.ptr());
+  const py::detail::value_and_holder vh =
+      inst->get_value_and_holder(py::detail::get_type_info(typeid(PyController)), false);
+  return vh.inst != nullptr && vh && vh.holder_constructed() ? vh.value_ptr<PyController>() : nullptr;
+}
+
+PyController& live(py::handle self) {
+  PyController* c = made(self);
+  if (c == nullptr) throw std::runtime_error("redres.Controller: this controller was never made (its __init__ raised)");
+  return *c;
+}
+
+// f(c.controller) in c's turn, without the GIL (f touches no Python object); its result is a copy.
+template <class F>
+auto in_turn(PyController& c, const char* what, F&& f) {
+  py::gil_scoped_release release;
+  const Hold hold(*c.use, what);
+  return f(*c.controller);
+}
+
+// One step's (theta_dot, StepInfo), copied in the step's turn.
+template <class Step>
+py::tuple step_in_turn(PyController& c, Step&& step) {
+  auto [theta_dot, info] = in_turn(c, "Controller.step", [&](Controller& k) {
+    step(k);
+    return std::make_pair(Eigen::VectorXd(c.out.theta_dot), info_of(c.out.info));
+  });
+  return py::make_tuple(std::move(theta_dot), std::move(info));
 }
 
 // --- the registries' listing ---------------------------------------------------------------------------------------
@@ -475,8 +547,8 @@ PYBIND11_MODULE(_redres, m) {
            "runs (Python threads can run other scenarios meanwhile); progress(fraction, t), if given, is called "
            "about 200 times. Failed steps are counted in the result, not raised.")
       .def("controller", &controller_of,
-           "A redres.Controller for this scenario's robot, scheme, engine and path (sharing them: do not run the "
-           "scenario while stepping the controller).")
+           "A redres.Controller for this scenario's robot, scheme, engine and path (sharing them: its steps and "
+           "the scenario's runs take turns).")
       .def("__repr__", [](const PyScenario& s) {
         return "<redres.Scenario '" + s.scenario->name + "' " + std::to_string(s.scenario->steps()) + " steps>";
       });
@@ -500,7 +572,9 @@ PYBIND11_MODULE(_redres, m) {
            "configuration) and the optional path (placed at f(theta0)); T and tau in s. Sized here: step() "
            "allocates nothing.")
       .def("__repr__",
-           [](const PyController& c) {
+           [](py::handle p) {
+             if (made(p) == nullptr) return std::string("<redres.Controller, never made>");
+             PyController& c = live(p);
              const Controller& k = *c.controller;
              return "<redres.Controller robot '" + k.robot().name() + "', " + std::to_string(k.robot().dof()) +
                     " joints, " + std::to_string(k.scheme().objectives().size()) + " objectives, " +
@@ -509,42 +583,63 @@ PYBIND11_MODULE(_redres, m) {
            })
       .def(
           "step",
-          [](PyController& c, const Eigen::VectorXd& theta, double t) {
-            {
-              py::gil_scoped_release release;
-              c.controller->step(theta, t, c.out);
-            }
-            return step_result(c);
+          [](py::handle p, const Eigen::VectorXd& theta, double t) {
+            PyController& c = live(p);
+            return step_in_turn(c, [&](Controller& k) { k.step(theta, t, c.out); });
           },
           py::arg("theta"), py::arg("t"),
           "One control step at (theta, t) with r_d and r_d_dot from the path: returns (theta_dot, StepInfo).")
       .def(
           "step",
-          [](PyController& c, const Eigen::VectorXd& theta, double t, const Eigen::VectorXd& r_d,
+          [](py::handle p, const Eigen::VectorXd& theta, double t, const Eigen::VectorXd& r_d,
              const Eigen::VectorXd& r_d_dot) {
-            {
-              py::gil_scoped_release release;
-              c.controller->step(theta, t, r_d, r_d_dot, c.out);
-            }
-            return step_result(c);
+            PyController& c = live(p);
+            return step_in_turn(c, [&](Controller& k) { k.step(theta, t, r_d, r_d_dot, c.out); });
           },
           py::arg("theta"), py::arg("t"), py::arg("r_d"), py::arg("r_d_dot"),
           "One control step with the caller's r_d and r_d_dot (reference_dim entries): returns (theta_dot, StepInfo).")
       .def(
-          "reset", [](PyController& c) { c.controller->reset(); }, "Forgets the engine's warm start.")
-      .def_property_readonly("robot", [](const PyController& c) { return PyRobot{c.robot}; })
+          "reset",
+          [](py::handle p) {
+            PyController& c = live(p);
+            in_turn(c, "Controller.reset", [](Controller& k) { k.reset(); });
+          },
+          "Forgets the engine's warm start.")
+      .def_property_readonly("robot",
+                             [](py::handle p) {
+                               PyController& c = live(p);
+                               return PyRobot{c.robot};
+                             })
       .def_property_readonly(
-          "r_d", [](const PyController& c) { return Eigen::VectorXd(c.controller->r_d()); },
+          "r_d",
+          [](py::handle p) {
+            PyController& c = live(p);
+            return in_turn(c, "Controller.r_d", [](Controller& k) { return Eigen::VectorXd(k.r_d()); });
+          },
           "the last step's desired task coordinates")
-      .def_property_readonly("r_d_dot", [](const PyController& c) { return Eigen::VectorXd(c.controller->r_d_dot()); })
+      .def_property_readonly("r_d_dot",
+                             [](py::handle p) {
+                               PyController& c = live(p);
+                               return in_turn(c, "Controller.r_d_dot",
+                                              [](Controller& k) { return Eigen::VectorXd(k.r_d_dot()); });
+                             })
       .def_property_readonly(
-          "f", [](const PyController& c) { return Eigen::VectorXd(c.controller->kinematics().f); },
+          "f",
+          [](py::handle p) {
+            PyController& c = live(p);
+            return in_turn(c, "Controller.f", [](Controller& k) { return Eigen::VectorXd(k.kinematics().f); });
+          },
           "the last step's task coordinates f(theta)")
-      .def_property_readonly("w", [](const PyController& c) { return c.controller->kinematics().w; })
+      .def_property_readonly("w",
+                             [](py::handle p) {
+                               PyController& c = live(p);
+                               return in_turn(c, "Controller.w", [](Controller& k) { return k.kinematics().w; });
+                             })
       .def_property_readonly(
           "qp",
-          [](const PyController& c) {
-            const QpProblem& qp = c.controller->qp();
+          [](py::handle p) {
+            PyController& c = live(p);
+            const QpProblem qp = in_turn(c, "Controller.qp", [](Controller& k) { return QpProblem(k.qp()); });
             py::dict d;
             d["W"] = Eigen::MatrixXd(qp.W);
             d["zeta"] = Eigen::VectorXd(qp.zeta);

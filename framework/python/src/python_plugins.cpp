@@ -28,6 +28,26 @@ SharedObject share(py::object object) {
   });
 }
 
+PythonError::PythonError(py::error_already_set& e, const std::string& who)
+    : std::runtime_error(who + ": " + e.what()),
+      type_(share(e.type())),
+      value_(share(e.value())),
+      trace_(share(e.trace())) {
+  // Python 3.11 notes: the traceback then says which plugin raised.
+  if (*value_ && py::hasattr(*value_, "add_note")) {
+    try {
+      value_->attr("add_note")("raised in " + who);
+    } catch (py::error_already_set&) {
+      // an exception whose add_note is not the standard one: it keeps what it has
+    }
+  }
+}
+
+void PythonError::restore() const {
+  PyErr_Restore(py::object(*type_).release().ptr(), py::object(*value_).release().ptr(),
+                py::object(*trace_).release().ptr());
+}
+
 namespace {
 
 // Calls sink(value) with the TOML value of a Python value.
@@ -203,7 +223,7 @@ void call_contribute(const py::object& instance, const Context& ctx, QpBuilder& 
     c.cast<StepContext&>().ctx = nullptr;
     q.cast<StepQp&>().builder = nullptr;
   } catch (py::error_already_set& e) {
-    throw std::runtime_error(who + ": " + e.what());
+    throw PythonError(e, who);
   }
 }
 
@@ -225,7 +245,7 @@ class PythonObjective final : public Objective {
       if (v.is_none()) return std::nullopt;
       return v.cast<double>();
     } catch (py::error_already_set& e) {
-      throw std::runtime_error("python objective '" + name() + "': potential: " + e.what());
+      throw PythonError(e, "python objective '" + name() + "': potential");
     }
   }
 
@@ -282,7 +302,7 @@ class PythonConstraint final : public Constraint {
     try {
       return instance_->attr("violated")().cast<bool>();
     } catch (py::error_already_set& e) {
-      throw std::runtime_error("python constraint '" + name() + "': violated: " + e.what());
+      throw PythonError(e, "python constraint '" + name() + "': violated");
     }
   }
   [[nodiscard]] std::string describe_violation(const PluginData* /*data*/) const override {
@@ -489,9 +509,18 @@ void unregister_all() {
 }
 
 void bind_python_plugins(py::module_& m) {
-  py::class_<StepContext>(m, "StepContext",
-                          "What a Python plugin may read at one control step (valid during contribute() only).\n\n"
-                          "Arrays are read-only views of the step's values, without a copy: copy() them to keep them.")
+  // A plugin's Python exception is raised again as itself at the Python call that ran the step.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const PythonError& e) {
+      e.restore();
+    }
+  });
+  py::class_<StepContext>(
+      m, "StepContext",
+      "What a Python plugin may read at one control step (valid during contribute() only).\n\n"
+      "Arrays are copies of the step's values, taken when read: they stay as they were when kept past the call.")
       .def_property_readonly(
           "t", [](const StepContext& c) { return c.get().t; }, "time since the start (s)")
       .def_property_readonly(
@@ -501,32 +530,24 @@ void bind_python_plugins(py::module_& m) {
       .def_property_readonly(
           "robot", [](const StepContext& c) { return borrowed(*c.get().robot); }, "the robot")
       .def_property_readonly(
-          "theta", [](py::object self) { return view(self.cast<const StepContext&>().get().theta(), self); },
-          "joint positions (n,)")
+          "theta", [](const StepContext& c) { return copy_of(c.get().theta()); }, "joint positions (n,)")
       .def_property_readonly(
-          "f", [](py::object self) { return view(self.cast<const StepContext&>().get().kinematics->f, self); },
+          "f", [](const StepContext& c) { return copy_of(c.get().kinematics->f); },
           "task coordinates f(theta) (every reference row)")
       .def_property_readonly(
-          "J", [](py::object self) { return view(self.cast<const StepContext&>().get().kinematics->J, self); },
-          "task Jacobian (m, n)")
+          "J", [](const StepContext& c) { return copy_of(c.get().kinematics->J); }, "task Jacobian (m, n)")
       .def_property_readonly(
           "w", [](const StepContext& c) { return c.get().kinematics->w; }, "w = det(J J')")
       .def_property_readonly(
-          "grad_w",
-          [](py::object self) { return view(self.cast<const StepContext&>().get().kinematics->grad_w, self); },
-          "d w / d theta (n,)")
+          "grad_w", [](const StepContext& c) { return copy_of(c.get().kinematics->grad_w); }, "d w / d theta (n,)")
       .def_property_readonly(
           "mu", [](const StepContext& c) { return c.get().kinematics->mu; }, "Yoshikawa's sqrt(det(J J'))")
       .def_property_readonly(
-          "grad_mu",
-          [](py::object self) { return view(self.cast<const StepContext&>().get().kinematics->grad_mu, self); },
-          "d mu / d theta (n,)")
+          "grad_mu", [](const StepContext& c) { return copy_of(c.get().kinematics->grad_mu); }, "d mu / d theta (n,)")
       .def_property_readonly(
-          "r_d", [](py::object self) { return view(*self.cast<const StepContext&>().get().r_d, self); },
-          "desired task coordinates r_d(t)")
+          "r_d", [](const StepContext& c) { return copy_of(*c.get().r_d); }, "desired task coordinates r_d(t)")
       .def_property_readonly(
-          "r_d_dot", [](py::object self) { return view(*self.cast<const StepContext&>().get().r_d_dot, self); },
-          "desired task velocity")
+          "r_d_dot", [](const StepContext& c) { return copy_of(*c.get().r_d_dot); }, "desired task velocity")
       .def_property_readonly(
           "ee_pose", [](const StepContext& c) { return Eigen::Matrix4d(c.get().kinematics->ee_pose.matrix()); },
           "end-effector pose in the world (4, 4), a copy");

@@ -4,6 +4,7 @@
 // between Python values and TOML nodes that the typed plugin configurations go through.
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include <pybind11/pybind11.h>
@@ -18,6 +19,20 @@ namespace py = pybind11;
 /// interpreter has finalised (static registries outlive it).
 using SharedObject = std::shared_ptr<py::object>;
 SharedObject share(py::object object);
+
+/// A Python exception raised inside a plugin, carried through the C++ step (which runs without the GIL) to the
+/// Python caller, where it is raised again with its own type and value (a KeyboardInterrupt stays one), a note
+/// naming the plugin added. what() is "<who>: <Type>: <message>" for C++ callers.
+class PythonError : public std::runtime_error {
+ public:
+  /// Takes the exception out of `e`, with the GIL held.
+  PythonError(py::error_already_set& e, const std::string& who);
+  /// Raises it again in Python (the GIL held): the translator registered by bind_python_plugins calls this.
+  void restore() const;
+
+ private:
+  SharedObject type_, value_, trace_;
+};
 
 /// A Python value (bool, int, float, str, a sequence or a dict of these, numpy scalars and arrays, pathlib paths) as
 /// the TOML value stored under `key` of `table`; TypeError naming the key for anything else.

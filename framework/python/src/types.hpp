@@ -3,7 +3,6 @@
 
 #include <memory>
 
-#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
@@ -24,18 +23,10 @@ inline PyRobot borrowed(const RobotModel& robot) {
   return PyRobot{std::shared_ptr<const RobotModel>(std::shared_ptr<void>(), &robot)};
 }
 
-/// A read-only numpy view of an Eigen matrix (column-major) or vector, kept alive by `base`; no copy.
-inline py::array view(const Eigen::MatrixXd& m, py::handle base) {
-  py::array a(py::dtype::of<double>(), {m.rows(), m.cols()},
-              {static_cast<py::ssize_t>(sizeof(double)), static_cast<py::ssize_t>(sizeof(double) * m.rows())}, m.data(),
-              base);
-  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  return a;
-}
-inline py::array view(const Eigen::VectorXd& v, py::handle base) {
-  py::array a(py::dtype::of<double>(), {v.size()}, {static_cast<py::ssize_t>(sizeof(double))}, v.data(), base);
-  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  return a;
+/// A copy of an Eigen matrix or vector (what a plugin keeps stays as it was when read).
+template <class Derived>
+typename Derived::PlainObject copy_of(const Eigen::MatrixBase<Derived>& m) {
+  return m;
 }
 
 }  // namespace redres::python

@@ -107,6 +107,49 @@ TEST(PluginLoader, BadLibrariesAreExitTwoNamingTheLibrary) {
   std::filesystem::remove_all(dir);
 }
 
+// Static initialisers that throw, or call exit(0), after registering a plugin: the library is refused naming it and
+// the file:line:col that named it, nothing of it stays registered, and redres goes on (here, to say so, exit 2).
+TEST(PluginLoader, InitialisersThatThrowOrExitAreRefusedAndLeaveNothingRegistered) {
+  const auto dir = scratch("plugin_hostile");
+  for (const auto& [library, says] :
+       {std::pair<std::string, std::string>{REDRES_TEST_PLUGIN_THROW,
+                                            "its static initialisers threw std::runtime_error: the plugin's "
+                                            "configuration file is missing; nothing of it was loaded"},
+        {REDRES_TEST_PLUGIN_EXIT, "its static initialisers called exit() while loading; nothing of it was loaded"}}) {
+    SCOPED_TRACE(library);
+    const Cli r = redres("validate '" + write_scenario(dir, "[\"" + library + "\"]").string() + "'");
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("scenario.toml:1:12: plugin library " + library + ": " + says), std::string::npos) << r.out;
+    // Loaded by --plugin before a command that lists the plugins: refused before anything registers.
+    const Cli listed = redres("--plugin '" + library + "' plugins");
+    EXPECT_EQ(listed.code, 2) << listed.out;
+    EXPECT_EQ(listed.out.find("test_registered_before_the_failure   (from"), std::string::npos) << listed.out;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// A file that exists but cannot be read, or a directory, is not reported as missing; an open directory on
+// REDRES_PLUGIN_PATH is warned about.
+TEST(PluginLoader, UnreadableLibrariesAndOpenSearchDirectoriesAreToldApart) {
+  const auto dir = scratch("plugin_unreadable");
+  std::filesystem::create_directories(dir / "libdir.so");
+  const Cli directory = redres("validate '" + write_scenario(dir, "[\"libdir.so\"]").string() + "'");
+  EXPECT_EQ(directory.code, 2);
+  EXPECT_NE(directory.out.find("libdir.so: is a directory, not a library"), std::string::npos) << directory.out;
+  std::filesystem::create_directories(dir / "open");
+  std::filesystem::copy_file(kPlugin, dir / "open" / "libmine.so");
+  std::filesystem::permissions(dir / "open", std::filesystem::perms::all);
+  const Cli warned = redres_env("REDRES_PLUGIN_PATH='" + (dir / "open").string() + "' ", "plugins");
+  EXPECT_EQ(warned.code, 0) << warned.out;
+  EXPECT_NE(warned.out.find("redres: warning: REDRES_PLUGIN_PATH directory '" + (dir / "open").string() +
+                            "' is writable by every user"),
+            std::string::npos)
+      << warned.out;
+  const Cli relative = redres_env("cd '" + dir.string() + "' && REDRES_PLUGIN_PATH=open ", "plugins");
+  EXPECT_NE(relative.out.find("REDRES_PLUGIN_PATH directory 'open' is relative"), std::string::npos) << relative.out;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(PluginsListing, TheSolverTableListsTheRunPolicyKeysWithTheirDefaultsAndRules) {
   // on_infeasible and relax_weight are read through a schema, like the engines' keys, and listed with them.
   const Cli text = redres("plugins");

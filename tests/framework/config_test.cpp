@@ -337,5 +337,41 @@ TEST(NumberOrFormula, OneReaderForNumbersAndConstantFormulas) {
   }
 }
 
+struct NothingToConfigure {
+  static const Schema<NothingToConfigure>& schema() {
+    static const Schema<NothingToConfigure> s{};
+    return s;
+  }
+};
+
+// A library that registers hundreds of plugins does not make every message about an unknown type list them all
+// (`redres plugins --check` printed each failing plugin's message with every name, quadratic in the count): the
+// message lists the 24 names closest to the one asked for, and how many more there are.
+TEST(Registry, AnUnknownTypeListsTheClosestNamesAndHowManyMore) {
+  Registry<Objective, const RobotModel&> registry("test objective");
+  const auto make = [](const NothingToConfigure&, const RobotModel&) -> std::unique_ptr<Objective> { return nullptr; };
+  for (int k = 0; k < 500; ++k) registry.add<NothingToConfigure>("bulk_" + std::to_string(k), "", make);
+  registry.add<NothingToConfigure>("centering", "", make);
+  try {
+    (void)registry.at("centring");
+    FAIL() << "found";
+  } catch (const std::invalid_argument& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("unknown test objective type 'centring'; known types: "), std::string::npos) << m;
+    EXPECT_NE(m.find("centering"), std::string::npos) << "the closest name is listed: " << m;
+    EXPECT_NE(m.find(" and 477 more (`redres plugins` lists them all)"), std::string::npos) << m;
+    EXPECT_LT(m.size(), 600u) << m;
+  }
+  // A few names are all listed.
+  Registry<Objective, const RobotModel&> few("few");
+  few.add<NothingToConfigure>("a", "", make);
+  few.add<NothingToConfigure>("b", "", make);
+  try {
+    (void)few.at("c");
+    FAIL() << "found";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("known types: a, b"), std::string::npos) << e.what();
+  }
+}
 }  // namespace
 }  // namespace redres

@@ -197,3 +197,32 @@ def test_nan_and_wrong_sizes_raise_naming_the_condition():
         robot.kinematics(theta)
     with pytest.raises(ValueError, match="theta has 5 entries, expected dof = 6"):
         robot.velocity_limits(robot.home[:5])
+
+
+def test_a_library_whose_initialisers_throw_leaves_loading_and_registering_working(tmp_path):
+    import os
+    import pathlib
+    library = pathlib.Path(os.environ["REDRES_CLI"]).resolve().parents[1] / "test-plugins-hostile" / \
+        "libredres_test_plugin_throw.so"
+    assert library.is_file(), library
+    text = pathlib.Path(source("configs/paper_r_fast.toml")).read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(f'plugins = ["{library}"]\n' + text.replace('"../robots/', f'"{source("robots")}/'))
+    with pytest.raises(redres.ConfigError, match="its static initialisers threw std::runtime_error"):
+        redres.Scenario.load(str(bad))
+    assert not any(e["type"] == "test_registered_before_the_failure" for e in redres.plugins("objective"))
+    # Loading from another thread, and registering, go on as before.
+    out = {}
+    worker = threading.Thread(target=lambda: out.setdefault("r", redres.Scenario.load(
+        source("configs/paper_r_fast.toml")).run()))
+    worker.start()
+    worker.join(timeout=60)
+    assert not worker.is_alive() and out["r"].failures == 0
+
+    class Later(redres.Objective):
+        type = "py_registered_after_a_bad_library"
+
+        def contribute(self, ctx, qp):
+            qp.add_identity(0.0)
+    redres.register(Later, replace=True)
+    assert any(e["type"] == "py_registered_after_a_bad_library" for e in redres.plugins("objective"))

@@ -54,7 +54,7 @@ std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSett
   const auto* e = engine_registry().find(name);
   if (e == nullptr) {
     throw std::invalid_argument("make_engine: unknown engine '" + name +
-                                "'; known engines: " + engine_registry().names());
+                                "'; known engines: " + engine_registry().names_like(name));
   }
   require_valid(settings, SolverSettings::schema(), "make_engine(" + name + ")");
   return e->make(e->defaults, settings);

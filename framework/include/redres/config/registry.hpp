@@ -8,6 +8,7 @@
 /// remembers the library as the entry's origin, and a name that exists already is recorded as a load error of that
 /// library instead of being thrown from its static initialisation.
 
+#include <algorithm>
 #include <any>
 #include <functional>
 #include <map>
@@ -147,7 +148,7 @@ class Registry : public RegistryBase {
   [[nodiscard]] const Entry& at(const std::string& type) const {
     const Entry* e = find(type);
     if (e == nullptr)
-      throw std::invalid_argument("unknown " + kind() + " type '" + type + "'; known types: " + names());
+      throw std::invalid_argument("unknown " + kind() + " type '" + type + "'; known types: " + names_like(type));
     return *e;
   }
 
@@ -173,7 +174,8 @@ class Registry : public RegistryBase {
   [[nodiscard]] std::unique_ptr<Base> create(const TableReader& table, Args... args) const {
     const std::string type = table.string("type");
     const Entry* e = find(type);
-    if (e == nullptr) table.fail("type", "unknown " + kind() + " type '" + type + "'; known types: " + names());
+    if (e == nullptr)
+      table.fail("type", "unknown " + kind() + " type '" + type + "'; known types: " + names_like(type));
     const std::any config = e->read(table);
     try {
       return e->make(config, args...);
@@ -194,6 +196,27 @@ class Registry : public RegistryBase {
     std::string out;
     for (const auto& kv : entries_) out += (out.empty() ? "" : ", ") + kv.first;
     return out;
+  }
+
+  /// The names a message about the unknown `type` lists: all of them while there are at most kListed, else the
+  /// kListed that share the longest prefix with `type` and how many more there are (a message stays short however
+  /// many plugins a library registers).
+  [[nodiscard]] std::string names_like(const std::string& type) const {
+    static constexpr std::size_t kListed = 24;
+    if (entries_.size() <= kListed) return names();
+    std::vector<std::pair<std::size_t, std::string>> by_prefix;  // (-shared prefix length, name)
+    for (const auto& kv : entries_) {
+      std::size_t k = 0;
+      while (k < type.size() && k < kv.first.size() && type[k] == kv.first[k]) ++k;
+      by_prefix.emplace_back(type.size() - k, kv.first);
+    }
+    std::partial_sort(by_prefix.begin(), by_prefix.begin() + kListed, by_prefix.end());
+    std::vector<std::string> listed;
+    for (std::size_t i = 0; i < kListed; ++i) listed.push_back(by_prefix[i].second);
+    std::sort(listed.begin(), listed.end());
+    std::string out;
+    for (const auto& n : listed) out += (out.empty() ? "" : ", ") + n;
+    return out + " and " + std::to_string(entries_.size() - kListed) + " more (`redres plugins` lists them all)";
   }
 
   std::size_t remove_origin(const std::string& origin) override {

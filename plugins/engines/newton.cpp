@@ -29,6 +29,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -87,9 +88,7 @@ void Newton::do_setup(int n, int m_e, int m_i) {
   // Sized by a factorisation (LLT(n) leaves its status uninitialised, and copying that is undefined).
   ha_.setIdentity(n, n);
   llt_.compute(ha_);
-  fallback_ = make_engine("projection", settings());
-  fallback_result_.x.resize(0);
-  fallback_->setup(n, m_e, m_i, fallback_result_);
+  setup_fallback(n, m_e, m_i);
 }
 
 bool Newton::slack_rows_only(const QpProblem& qp) {
@@ -125,8 +124,8 @@ void Newton::do_solve(const QpProblem& qp, SolverResult& result) {
   }
   if (!applicable) {
     if (general_solve(qp, result)) return;
-    result.info.diagnosis = "newton's general path did not settle; fell back to projection";
-    run_fallback(qp, result);
+    result.info.diagnosis = "newton's general path did not settle";
+    run_fallback(qp, result, 0, std::numeric_limits<double>::infinity(), u_.head(qp.n()));
     return;
   }
   // Planar position tasks (2 rows) get loops of fixed length; the arithmetic is the same.
@@ -147,8 +146,8 @@ void Newton::run(const QpProblem& qp, SolverResult& result) {
     case Reduced::kInfeasible: finish(result, SolverStatus::kInfeasible, k, f2); return;
     case Reduced::kStalled:
       result.info.diagnosis = "newton did not converge in " + std::to_string(k) + " iterations (residual " +
-                              std::to_string(std::sqrt(f2)) + "); fell back to projection";
-      run_fallback(qp, result);
+                              std::to_string(std::sqrt(f2)) + ")";
+      run_fallback(qp, result, k, std::sqrt(f2), x_);
       return;
   }
 }

@@ -1,23 +1,69 @@
-/// `newton`'s fallback (newton.cpp): a step that neither path settles is solved by `projection`, which the info
-/// then names as the engine that ran.
+/// `newton`'s fallback (newton.cpp). A step that neither path settles is first checked: rows that cannot be met
+/// inside the bounds (LviEngine::rows_unmeetable) make it infeasible at once, since no engine would meet them.
+/// Otherwise `projection` gets at most kFallbackIterations iterations: a step it solves names it as the engine that
+/// ran; a step it does not solve stays newton's, and its diagnosis says once what both did.
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
 
 #include "newton_internal.hpp"
+#include "redres/control/engine_registry.hpp"
 
 namespace redres::newton_internal {
 
-void Newton::run_fallback(const QpProblem& qp, SolverResult& result) {
-  fallback_->solve(qp, fallback_result_);
-  result.x = fallback_result_.x;
-  result.y = fallback_result_.y;
-  result.z = fallback_result_.z;
-  // Field by field, so that result.info.diagnosis keeps the capacity reserved at setup (no allocation).
+void Newton::setup_fallback(int n, int m_e, int m_i) {
+  SolverSettings s = settings();
+  s.max_iterations = std::min(s.max_iterations, kFallbackIterations);
+  fallback_ = make_engine("projection", s);
+  fallback_->set_diagnoses(false);  // newton diagnoses the step once, naming both
+  fallback_result_.x.resize(0);
+  fallback_->setup(n, m_e, m_i, fallback_result_);
+}
+
+void Newton::run_fallback(const QpProblem& qp, SolverResult& result, int newton_iterations, double newton_residual,
+                          const Eigen::Ref<const Eigen::VectorXd>& x) {
+  result.info.iterations = newton_iterations;
+  result.info.residual = newton_residual;
+  result.x = x;
+  result.z.setZero();
+  result.y.setZero();
+  // The general path keeps no residual of its own: the LVI residual of the answer handed back.
+  if (!std::isfinite(newton_residual))
+    newton_residual = result.info.residual = lvi_residual(qp, result, settings().varpi);
+  if (rows_unmeetable(qp)) {
+    // The rows cannot be met: projection's iterations would be spent for nothing. diagnose_failure names the rows.
+    result.info.status = SolverStatus::kInfeasible;
+    return;
+  }
+  fallback_->solve_valid(qp, fallback_result_);
   const SolverInfo& fb = fallback_result_.info;
+  if (fb.status == SolverStatus::kSolved) {
+    result.x = fallback_result_.x;
+    result.y = fallback_result_.y;
+    result.z = fallback_result_.z;
+    result.info.status = SolverStatus::kSolved;
+    result.info.iterations = newton_iterations + fb.iterations;
+    result.info.residual = fb.residual;
+    result.info.engine = fb.engine;  // names "projection" as the engine that solved the step
+    result.info.diagnosis.clear();
+    y_ = result.y;
+    return;
+  }
+  // Neither solved it: the step stays newton's, with the better of the two answers.
+  if (fb.residual < newton_residual) {
+    result.x = fallback_result_.x;
+    result.info.residual = fb.residual;
+  }
+  result.y.setZero();
   result.info.status = fb.status;
-  result.info.iterations = fb.iterations;
-  result.info.residual = fb.residual;
-  result.info.engine = fb.engine;  // names "projection" as the engine that ran
-  if (!fb.diagnosis.empty()) result.info.diagnosis = fb.diagnosis;
-  y_ = result.y;
+  result.info.iterations = newton_iterations + fb.iterations;
+  std::ostringstream text;
+  text.precision(6);
+  text << "; projection, its fallback, then stopped after " << fb.iterations << " iterations with residual "
+       << fb.residual;
+  result.info.diagnosis += text.str();
 }
 
 }  // namespace redres::newton_internal

@@ -26,6 +26,10 @@
 
 namespace redres::newton_internal {
 
+/// The most iterations `projection` spends on a step newton did not settle and whose rows can be met: a failed step
+/// costs at most this on top of newton's own (some 3 ms on a 7-joint arm), not the 20,000 of max_iterations.
+inline constexpr int kFallbackIterations = 2000;
+
 // P_[lo, hi](v) for lo <= hi, as min(max(v, lo), hi): the same value as std::clamp, without branches.
 inline double box(double v, double lo, double hi) { return std::min(std::max(v, lo), hi); }
 
@@ -69,7 +73,10 @@ class Newton final : public LviEngine {
   double exact_step(const QpProblem& qp);
 
   // newton_fallback.cpp
-  void run_fallback(const QpProblem& qp, SolverResult& result);
+  void setup_fallback(int n, int m_e, int m_i);
+  // newton stopped after `iterations` at `x` with `residual` (result.info.diagnosis says why).
+  void run_fallback(const QpProblem& qp, SolverResult& result, int iterations, double residual,
+                    const Eigen::Ref<const Eigen::VectorXd>& x);
 
   // newton_kkt.cpp
   bool general_solve(const QpProblem& qp, SolverResult& result);

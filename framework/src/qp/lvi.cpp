@@ -106,7 +106,7 @@ void LviEngine::run(const QpProblem& qp, SolverResult& result) {
   for (int r = 0; r < m_e_; ++r) capped |= std::abs(result.y(r)) >= cap;
   for (int r = 0; r < m_i_; ++r) capped |= result.z(r) >= cap;
   if (info.status != SolverStatus::kSolved || capped) {
-    diagnose_failure(qp, capped, info);
+    if (diagnoses_) diagnose_failure(qp, capped, info);
     warm_ = false;
     result.y.setZero();
     result.z.setZero();

@@ -109,6 +109,14 @@ class LviEngine {
   [[nodiscard]] const SolverSettings& settings() const noexcept { return settings_; }
   /// Replaces the settings; std::invalid_argument naming the key when they break SolverSettings' schema.
   void set_settings(const SolverSettings& s);
+  /// Whether a failed solve is diagnosed (the default). An engine that runs another as its fallback turns the
+  /// other's off: it diagnoses the step once itself, naming both.
+  void set_diagnoses(bool on) noexcept { diagnoses_ = on; }
+  /// Whether the rows of `qp` cannot be met inside its bounds at the settings' tolerance: the best fit of the rows
+  /// inside the bounds (best_row_fit) misses them by more than the tolerance in 2-norm (the equality rows' misses
+  /// and the inequality rows' excesses), as the LVI residual measures them. The one decision behind every
+  /// `infeasible` status. Allocates; for failed solves only.
+  [[nodiscard]] bool rows_unmeetable(const QpProblem& qp) const;
 
  protected:
   /// Whether `result` holds a previous solution to start from.
@@ -126,6 +134,7 @@ class LviEngine {
 
   SolverSettings settings_;
   bool warm_ = false;
+  bool diagnoses_ = true;
   int n_ = 0, m_e_ = 0, m_i_ = 0;
 };
 

@@ -76,6 +76,11 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet,
     }
   }
   // The diagnosis of a failed run goes to stderr, with --quiet too: a script that checks the exit code sees why.
+  if (o.summary.task_error_exceeded) {
+    std::cerr << o.scenario.name << ": the task was not tracked: max position error " << o.summary.max_position_error
+              << " m > [solver] max_task_error = " << o.summary.max_task_error
+              << " m (summary.json: \"task_error_exceeded\": true)\n";
+  }
   if (o.summary.solver.failures > 0) {
     const SolverStats& st = o.summary.solver;
     std::cerr << o.scenario.name << ": " << st.failures << " failed step" << (st.failures == 1 ? "" : "s")
@@ -126,7 +131,7 @@ int run_scenario(const RunOptions& options) {
     if (!opts->quiet) std::cout << "animation: " << file.string() << "\n";
   }
   if (plotter || animator) record_new_files(opts->out, before);
-  return o.run.failures > 0 ? kExitFailedSteps : kExitOk;
+  return o.run.failures > 0 || o.summary.task_error_exceeded ? kExitFailedSteps : kExitOk;
 }
 
 // `redres validate`: loads a scenario (every check of a run's set-up) and says what it holds.
@@ -168,7 +173,7 @@ int compare_scenarios(const RunOptions& options) {
   for (std::size_t i = 0; i < scenarios.size(); ++i) {
     const std::filesystem::path dir = out / dirs[i];
     const Outcome o = run_one(std::move(scenarios[i]), dir, opts->quiet);
-    failures += o.run.failures;
+    failures += o.run.failures + (o.summary.task_error_exceeded ? 1 : 0);
     md += comparison_markdown_row(o.summary);
     csv += comparison_csv_row(o.summary);
     plot_args.push_back(dir.string());

@@ -18,6 +18,10 @@ struct ObstacleAvoidance::Data : PairData {
   bool placed = false;
   std::vector<Eigen::Isometry3d> poses;
   std::vector<int> candidates;
+  // Shared rows (more pairs than max_rows): the pair each row holds at this contribution (-1: none) and its distance.
+  std::vector<int> row_pair;
+  std::vector<double> row_distance;
+  int used = 0, dropped = 0;
 };
 
 const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
@@ -28,7 +32,10 @@ const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
        field("safety_distance", &C::safety_distance, "m", "d_s: the distance the damper holds"),
        field("xi", &C::xi, "m/s", "damper gain: the largest approach speed, at d_i", greater(0.0)),
        field("broadphase", &C::broadphase, "",
-             "how pairs are found: auto (FCL's AABB tree above 256 pairs), always, never (brute force)")},
+             "how pairs are found: auto (FCL's AABB tree above 256 pairs), always, never (brute force)"),
+       field("max_rows", &C::max_rows, "",
+             "the most inequality rows: with more pairs, those within d_i share them, the nearest first",
+             between<int>(1, 100000))},
       [](const C& c) {
         check_damper(c.influence_distance, c.safety_distance);
         for (std::size_t k = 0; k < c.obstacles.size(); ++k) {
@@ -67,6 +74,14 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
   }
   links_ = static_cast<int>(links.size());
   obstacles_ = static_cast<int>(config_.obstacles.size());
+  const long pairs = static_cast<long>(links_) * obstacles_;
+  if (pairs > kMaxObstaclePairs) {
+    throw FieldError("obstacles", std::to_string(obstacles_) + " obstacles and " + std::to_string(links_) +
+                                      " link shapes make " + std::to_string(pairs) + " pairs; at most " +
+                                      std::to_string(kMaxObstaclePairs) + " are checked");
+  }
+  rows_ = static_cast<int>(std::min<long>(pairs, config_.max_rows));
+  pooled_ = rows_ < pairs;
   (void)DistanceQuery(shapes);  // checks the shapes' sizes now, naming the shape, rather than at the first run
   using B = Config::Broadphase;
   broadphase_ =
@@ -90,10 +105,30 @@ std::unique_ptr<PluginData> ObstacleAvoidance::make_data() const {
     data->poses.resize(static_cast<std::size_t>(obstacles_));
     data->candidates.resize(static_cast<std::size_t>(obstacles_));
   }
+  if (pooled_) {
+    data->row_pair.assign(static_cast<std::size_t>(rows_), -1);
+    data->row_distance.assign(static_cast<std::size_t>(rows_), 0.0);
+  }
   return data;
 }
 
-int ObstacleAvoidance::inequality_rows(const RobotModel& /*robot*/) const { return links_ * obstacles_; }
+int ObstacleAvoidance::inequality_rows(const RobotModel& /*robot*/) const { return rows_; }
+
+int ObstacleAvoidance::claim_row(Data& data, int pair, double distance) const {
+  int row = -1;
+  if (data.used < rows_) {
+    row = data.used++;
+  } else {
+    // Every row holds a pair: this one takes the farthest's row if it is nearer (that pair goes without).
+    ++data.dropped;
+    const auto far = std::max_element(data.row_distance.begin(), data.row_distance.end());
+    if (!(distance < *far)) return -1;
+    row = static_cast<int>(far - data.row_distance.begin());
+  }
+  data.row_pair[static_cast<std::size_t>(row)] = pair;
+  data.row_distance[static_cast<std::size_t>(row)] = distance;
+  return row;
+}
 
 Eigen::Isometry3d ObstacleAvoidance::obstacle_pose(int k, double t) const {
   Eigen::Isometry3d T = start_poses_[static_cast<std::size_t>(k)];
@@ -107,29 +142,37 @@ void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder, PluginDat
   auto A = builder.inequality_matrix();
   auto b = builder.inequality_rhs();
   const auto& links = robot_->link_shapes();
+  if (pooled_) {
+    data.used = data.dropped = 0;
+    std::fill(data.row_pair.begin(), data.row_pair.end(), -1);
+    for (int r = 0; r < rows_; ++r) slack_row(A.row(r), b(r));
+  }
   if (broadphase_) {
     add_near_pairs(data, ctx, builder);
-    return;
-  }
-  for (int o = 0; o < obstacles_; ++o) {
-    const Eigen::Isometry3d To = obstacle_pose(o, ctx.t);
-    for (int l = 0; l < links_; ++l) {
-      const auto& shape = links[static_cast<std::size_t>(l)];
-      pair_row(data, kin, l, kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose, o, To, A, b);
+  } else {
+    for (int o = 0; o < obstacles_; ++o) {
+      const Eigen::Isometry3d To = obstacle_pose(o, ctx.t);
+      for (int l = 0; l < links_; ++l) {
+        const auto& shape = links[static_cast<std::size_t>(l)];
+        pair_row(data, kin, l, kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose, o, To, A, b);
+      }
     }
   }
+  if (data.dropped > 0) ++data.short_of_rows;
 }
 
 void ObstacleAvoidance::pair_row(Data& data, const KinematicsData& kin, int l, const Eigen::Isometry3d& Tl, int o,
                                  const Eigen::Isometry3d& To, Eigen::Block<Eigen::MatrixXd>& A,
                                  Eigen::VectorBlock<Eigen::VectorXd>& b) const {
-  const int row = o * links_ + l;
+  const int pair = o * links_ + l;
   const ShapeDistance d = data.query.distance(l, Tl, links_ + o, To);
   Eigen::Vector3d n;
-  if (!data.distances.take(row, d, planar_, Tl.translation() - To.translation(), n)) {
-    slack_row(A.row(row), b(row));
+  if (!data.distances.take(pair, d, planar_, Tl.translation() - To.translation(), n)) {
+    if (!pooled_) slack_row(A.row(pair), b(pair));  // shared rows start slack
     return;
   }
+  const int row = pooled_ ? claim_row(data, pair, d.distance) : pair;
+  if (row < 0) return;  // every row holds a nearer pair
   point_jacobian(*robot_, kin, robot_->link_shapes()[static_cast<std::size_t>(l)].link, d.point_a, data.jacobian);
   damper_row(data.distances.damper(), d.distance, n, data.jacobian, velocities_[static_cast<std::size_t>(o)],
              A.row(row), b(row));
@@ -151,9 +194,9 @@ void ObstacleAvoidance::add_near_pairs(Data& data, const Context& ctx, QpBuilder
     const Eigen::Isometry3d Tl = kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose;
     // Every pair of this link shape is beyond d_i unless the tree says otherwise.
     for (int o = 0; o < obstacles_; ++o) {
-      const int row = o * links_ + l;
-      data.distances.beyond(row);
-      slack_row(A.row(row), b(row));
+      const int pair = o * links_ + l;
+      data.distances.beyond(pair);
+      if (!pooled_) slack_row(A.row(pair), b(pair));
     }
     const int count = data.query.near(l, Tl, data.distances.damper().influence_distance, data.candidates.data());
     for (int k = 0; k < count; ++k) {
@@ -164,7 +207,15 @@ void ObstacleAvoidance::add_near_pairs(Data& data, const Context& ctx, QpBuilder
 }
 
 std::string ObstacleAvoidance::describe_inequality_row(const PluginData* data, int row) const {
-  if (row < 0 || row >= links_ * obstacles_ || data == nullptr) return {};
+  if (row < 0 || row >= rows_ || data == nullptr) return {};
+  if (!pooled_) return describe_pair(data, row);
+  const int pair = pair_data<Data>(data).row_pair[static_cast<std::size_t>(row)];
+  return pair < 0 ? "a shared row that no pair within d_i held" : describe_pair(data, pair);
+}
+
+std::string ObstacleAvoidance::describe_pair(const PluginData* data, int pair) const {
+  if (pair < 0 || pair >= links_ * obstacles_ || data == nullptr) return {};
+  const int row = pair;
   const int o = row / links_, l = row % links_;
   const auto& shape = robot_->link_shapes()[static_cast<std::size_t>(l)];
   std::ostringstream s;

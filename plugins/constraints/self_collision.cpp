@@ -42,6 +42,11 @@ SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
       }
     }
   }
+  if (pairs_.empty()) {
+    throw FieldError("", "robot '" + robot.name() +
+                             "' has no pair of link shapes to check: every pair is on one link, "
+                             "on neighbouring links or in collision_exclude (docs/collision.md)");
+  }
   (void)DistanceQuery(shapes_);  // checks the shapes' sizes now, naming the shape, rather than at the first run
 }
 

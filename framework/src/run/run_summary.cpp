@@ -99,6 +99,8 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   out.path = s.path->description();
   out.max_position_error = max_err;
   out.final_position_error = tr(rows - 1, c_err);
+  out.max_task_error = s.max_task_error;
+  out.task_error_exceeded = !(max_err <= s.max_task_error);
   out.initial_joint_velocity_norm = joint_velocity_norm(0);
   out.final_joint_velocity_norm = joint_velocity_norm(rows - 1);
   out.manipulability = {tr(0, c_w), tr(rows - 1, c_w), w_min, w_sum / static_cast<double>(rows), w_max};
@@ -208,6 +210,11 @@ const std::vector<SummaryField>& summary_fields() {
        [](const S& s) { return SummaryValue(s.max_position_error); }},
       {"final_position_error", "number", "`position_error` at t = T (m)",
        [](const S& s) { return SummaryValue(s.final_position_error); }},
+      {"max_task_error", "number", "the bound on `max_position_error` ([solver] max_task_error, m)",
+       [](const S& s) { return SummaryValue(s.max_task_error); }},
+      {"task_error_exceeded", "boolean",
+       "`max_position_error` > `max_task_error`: the run is no success (exit code 1) however many steps were solved",
+       [](const S& s) { return SummaryValue(s.task_error_exceeded); }},
       {"initial_joint_velocity_norm", "number", "norm of theta_dot at t = 0 (rad/s)",
        [](const S& s) { return SummaryValue(s.initial_joint_velocity_norm); }},
       {"final_joint_velocity_norm", "number", "norm of theta_dot at t = T (rad/s)",

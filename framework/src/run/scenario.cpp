@@ -28,6 +28,7 @@ auto enum_names(Policy) {
 struct SolverPolicy {
   Policy on_infeasible = Policy::kHold;
   double relax_weight = 1e4;
+  double max_task_error = 0.01;
   static const Schema<SolverPolicy>& schema() {
     using C = SolverPolicy;
     static const Schema<C> s{
@@ -35,7 +36,11 @@ struct SolverPolicy {
                "what a step whose QP is not solved does: hold (theta_dot = 0; `continue` is the same), stop (the run "
                "ends there), relax (solves the elastic QP, rows relaxed, every bound kept)"),
          field("relax_weight", &C::relax_weight, "", "rho of the elastic QP; only with on_infeasible = \"relax\"",
-               rule<double>("a weight in [1, 1e8]", [](double w) { return w >= 1.0 && w <= 1e8; }))},
+               rule<double>("a weight in [1, 1e8]", [](double w) { return w >= 1.0 && w <= 1e8; })),
+         field("max_task_error", &C::max_task_error, "m",
+               "a run whose largest position error exceeds this is not a success (exit code 1, summary.json's "
+               "task_error_exceeded), however many of its steps were solved",
+               greater(0.0))},
         {},
         {}};
     return s;
@@ -258,6 +263,7 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                                    : policy.on_infeasible == Policy::kRelax ? OnInfeasible::kRelax
                                                                             : OnInfeasible::kHold;
                  s.relax_weight = policy.relax_weight;
+                 s.max_task_error = policy.max_task_error;
                  if (solver.has("relax_weight") && s.on_infeasible != OnInfeasible::kRelax) {
                    solver.fail("relax_weight", "is used only with on_infeasible = \"relax\" (on_infeasible is \"" +
                                                    std::string(solver.string("on_infeasible", "hold")) + "\")");

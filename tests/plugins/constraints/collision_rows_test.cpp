@@ -294,7 +294,7 @@ TEST(CollisionRows, TheBroadphaseWritesTheRowsOfBruteForce) {
   std::mt19937 rng(11);
   const std::vector<ShapeSpec> obstacles = clutter(rng, true);
   using B = ObstacleAvoidance::Config::Broadphase;
-  const ObstacleAvoidance::Config base{.obstacles = obstacles, .influence_distance = 0.15};
+  const ObstacleAvoidance::Config base{.obstacles = obstacles, .influence_distance = 0.15, .max_rows = 960};
   ObstacleAvoidance::Config tree_config = base, brute_config = base;
   tree_config.broadphase = B::kAuto;  // 8 link shapes x 120 obstacles > kBroadphasePairs
   brute_config.broadphase = B::kNever;
@@ -317,6 +317,50 @@ TEST(CollisionRows, TheBroadphaseWritesTheRowsOfBruteForce) {
     }
   }
   EXPECT_GT(live, 40);  // pairs within d_i occur, so the comparison covers real rows
+}
+
+// More pairs than max_rows: the pairs within d_i share the rows, the nearest first. Each shared row is the row the
+// pair has when every pair has one, and no pair left without a row is nearer than one that has a row.
+TEST(CollisionRows, SharedRowsHoldTheNearestPairs) {
+  const RobotModel robot = load_robot(source_path("robots/franka_panda.toml"));
+  std::mt19937 rng(13);
+  const std::vector<ShapeSpec> obstacles = clutter(rng, false);
+  const ObstacleAvoidance::Config full_config{.obstacles = obstacles, .influence_distance = 0.3, .max_rows = 960};
+  ObstacleAvoidance::Config shared_config = full_config;
+  shared_config.max_rows = 8;
+  Built full = build(robot, std::make_unique<ObstacleAvoidance>(full_config, robot));
+  Built shared = build(robot, std::make_unique<ObstacleAvoidance>(shared_config, robot));
+  ASSERT_EQ(full.qp.m_in(), 960);
+  ASSERT_EQ(shared.qp.m_in(), 8);
+  KinematicsData kin(robot);
+  int crowded = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Eigen::VectorXd theta = random_inside(robot, rng, 0.1);
+    compute_kinematics(robot, theta, kin, KinematicsLevel::kJacobian);
+    Context ctx{0.0, 20.0, 0.01, &robot, &kin, nullptr, nullptr};
+    full.scheme->build(ctx, full.qp, full.data);
+    shared.scheme->build(ctx, shared.qp, shared.data);
+    // The live rows of the full QP, with their pairs' rates (b).
+    std::vector<std::pair<double, int>> live;  // (b, row): b grows with the distance (the damper's bound, static)
+    for (int r = 0; r < 960; ++r) {
+      if (full.qp.A.row(r).norm() > 0.0 || full.qp.b(r) != 1.0) live.emplace_back(full.qp.b(r), r);  // not slack
+    }
+    std::sort(live.begin(), live.end());
+    crowded += live.size() > 8 ? 1 : 0;
+    int held = 0;
+    for (int r = 0; r < 8; ++r) {
+      if (shared.qp.A.row(r).norm() == 0.0 && shared.qp.b(r) == 1.0) continue;  // slack
+      ++held;
+      // The same row as one of the full QP's, and among the 8 nearest.
+      const auto same = std::find_if(live.begin(), live.end(), [&](const auto& e) {
+        return e.first == shared.qp.b(r) && (full.qp.A.row(e.second) - shared.qp.A.row(r)).norm() == 0.0;
+      });
+      ASSERT_NE(same, live.end()) << "trial " << trial << " shared row " << r;
+      EXPECT_LT(same - live.begin(), 8) << "trial " << trial << ": a farther pair holds a row";
+    }
+    EXPECT_EQ(held, static_cast<int>(std::min<std::size_t>(live.size(), 8))) << "trial " << trial;
+  }
+  EXPECT_GT(crowded, 5) << "more pairs within d_i than rows occur, so the sharing is tested";
 }
 
 TEST(CollisionRows, TheBroadphaseAllocatesNothingPerStepWithStaticObstacles) {

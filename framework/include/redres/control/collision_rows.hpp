@@ -79,7 +79,8 @@ struct PairData : PluginData {
   /// A query over `shapes`, and `pairs` distances held by `damper`.
   PairData(const std::vector<ShapeSpec>& shapes, int pairs, Damper damper) : query(shapes), distances(pairs, damper) {}
   DistanceQuery query;      //!< the shapes of the constraint's pairs
-  PairDistances distances;  //!< one per row
+  PairDistances distances;  //!< one per pair
+  int short_of_rows = 0;    //!< contributions with more pairs within d_i than rows (the farthest went without)
 };
 
 /// The base of a collision constraint with Config C, whose data derives from PairData (filled by the derived
@@ -91,7 +92,11 @@ class PairConstraint : public Configured<Constraint, C> {
   [[nodiscard]] bool violated(const PluginData* data) const override { return pair_data(data).distances.violated(); }
   [[nodiscard]] std::string describe_violation(const PluginData* data) const override {
     return pair_data(data).distances.describe_violation(
-        [this, data](int row) { return this->describe_inequality_row(data, row); });
+        [this, data](int pair) { return this->describe_pair(data, pair); });
+  }
+  /// Names pair `pair` (default: the inequality row of the same index, for a constraint with one row per pair).
+  [[nodiscard]] virtual std::string describe_pair(const PluginData* data, int pair) const {
+    return this->describe_inequality_row(data, pair);
   }
 
  protected:

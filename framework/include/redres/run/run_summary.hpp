@@ -79,6 +79,8 @@ struct RunSummary {
   std::string path;                           //!< the path's description
   double max_position_error = 0.0;            //!< max |r_d - f| over the position rows (m)
   double final_position_error = 0.0;          //!< at t = T (m)
+  double max_task_error = 0.0;                //!< the bound on max_position_error ([solver] max_task_error, m)
+  bool task_error_exceeded = false;           //!< max_position_error > max_task_error: the run is no success
   double initial_joint_velocity_norm = 0.0;   //!< |theta_dot(0)|
   double final_joint_velocity_norm = 0.0;     //!< |theta_dot(T)|
   ManipulabilityStats manipulability;         //!< w = det(JJ')

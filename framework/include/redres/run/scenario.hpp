@@ -56,10 +56,11 @@ struct Scenario {
   /// through over the run, from the orientation it has at t = 0 (Controller::set_orientation_turn); zero: hold it.
   Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();
   OnInfeasible on_infeasible = OnInfeasible::kHold;  //!< [solver] on_infeasible: "hold", "stop" or "relax"
-  double relax_weight = 1e4;  //!< [solver] relax_weight: rho of the elastic QP under "relax" (1 to 1e8)
-  RecordOptions record;       //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
-  bool plots = false;         //!< [output] plots
-  bool animate = false;       //!< [output] animate
+  double relax_weight = 1e4;     //!< [solver] relax_weight: rho of the elastic QP under "relax" (1 to 1e8)
+  double max_task_error = 0.01;  //!< [solver] max_task_error (m): a larger position error makes the run no success
+  RecordOptions record;          //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
+  bool plots = false;            //!< [output] plots
+  bool animate = false;          //!< [output] animate
 
   /// Number of control steps N = round(T / tau); the run records N + 1 rows, t = 0 .. T. Throws
   /// std::invalid_argument when T / tau is not in [1, kMaxSteps].

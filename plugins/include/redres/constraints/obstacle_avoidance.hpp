@@ -38,6 +38,9 @@ struct ObstacleAvoidanceConfig {
   /// How pairs are found: `auto` (the tree above kBroadphasePairs pairs), `always` (the tree), `never` (brute force).
   enum class Broadphase { kAuto, kAlways, kNever };
   Broadphase broadphase = Broadphase::kAuto;  //!< see above
+  /// The most inequality rows: pairs within d_i share them, the nearest first (a scene of 10,000 obstacles needs
+  /// rows for the few pairs near the arm, not for every pair: the QP's size, and the engines' memory, stay bounded).
+  int max_rows = 64;
 
   static const Schema<ObstacleAvoidanceConfig>& schema();
 };
@@ -52,6 +55,9 @@ inline auto enum_names(ObstacleAvoidanceConfig::Broadphase) {
 
 /// Above this many (link shape, obstacle) pairs, `broadphase = "auto"` uses FCL's tree.
 inline constexpr int kBroadphasePairs = 256;
+/// The most (link shape, obstacle) pairs a scene may have, checked at load (each pair keeps its distance, a few
+/// bytes; the rows are bounded by `max_rows`).
+inline constexpr long kMaxObstaclePairs = 10'000'000;
 
 class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig>, public PairOutput {
  public:
@@ -64,6 +70,7 @@ class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig>, 
   [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
   [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
   [[nodiscard]] std::string describe_inequality_row(const PluginData* data, int row) const override;
+  [[nodiscard]] std::string describe_pair(const PluginData* data, int pair) const override;
   /// Its obstacles, as configured (summary.json's `obstacles`).
   void scene_obstacles(std::vector<ShapeSpec>& out) const override;
 
@@ -77,12 +84,16 @@ class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig>, 
   void pair_row(Data& data, const KinematicsData& kin, int l, const Eigen::Isometry3d& Tl, int o,
                 const Eigen::Isometry3d& To, Eigen::Block<Eigen::MatrixXd>& A,
                 Eigen::VectorBlock<Eigen::VectorXd>& b) const;
+  // A shared row for `pair` at `distance` (the farthest pair's when all are taken and this one is nearer), or -1.
+  int claim_row(Data& data, int pair, double distance) const;
   // The broadphase path of add_to(): only the pairs the tree finds near are measured.
   void add_near_pairs(Data& data, const Context& ctx, QpBuilder& builder) const;
 
   const RobotModel* robot_;
   std::vector<ShapeSpec> shapes_;  // the query's shapes: link shapes first, then the obstacles
   int links_ = 0, obstacles_ = 0;
+  int rows_ = 0;         // inequality rows: one per pair, or max_rows shared
+  bool pooled_ = false;  // more pairs than max_rows: the pairs within d_i share the rows
   // Broadphase: whether it is used; whether an obstacle moves; whether the robot is planar.
   bool broadphase_ = false, moving_ = false, planar_ = false;
   // Each obstacle's pose at t = 0 and its velocity (zero when it stands still).

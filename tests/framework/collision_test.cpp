@@ -1,7 +1,13 @@
 // Distances between shapes (FCL, and the analytic penetration of spheres and capsules) against closed forms: the
 // value, its sign when the shapes overlap, and witness points that lie on the surfaces.
 
+#include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -98,5 +104,108 @@ TEST(Collision, ShapesAreCheckedAndDescribed) {
   EXPECT_EQ(sphere(0.25).describe(), "sphere(r = 0.25 m)");
 }
 
+// --- An independent reference: alternating projections ------------------------------------------------------------
+//
+// For two convex sets, p <- P_A(q), q <- P_B(p) converges to a closest pair (Cheney and Goldstein, 1959). Each
+// projection here is exact and closed-form, in the shape's own frame: a box clamps, a sphere scales, a capsule
+// projects on its segment then scales, a cylinder clamps its axial coordinate and its radial distance. Nothing of
+// FCL or of redres's analytic code is used.
+
+Eigen::Vector3d project(const ShapeSpec& s, const Eigen::Isometry3d& T, const Eigen::Vector3d& world) {
+  const Eigen::Vector3d p = T.inverse() * world;
+  Eigen::Vector3d q = p;
+  switch (s.shape) {
+    case ShapeSpec::Kind::kBox: {
+      const Eigen::Vector3d h = 0.5 * Eigen::Vector3d((*s.size)[0], (*s.size)[1], (*s.size)[2]);
+      q = p.cwiseMax(-h).cwiseMin(h);
+      break;
+    }
+    case ShapeSpec::Kind::kSphere:
+    case ShapeSpec::Kind::kCapsule: {
+      const double half = s.shape == ShapeSpec::Kind::kCapsule ? 0.5 * *s.length : 0.0;
+      const Eigen::Vector3d c(0.0, 0.0, std::clamp(p.z(), -half, half));
+      const Eigen::Vector3d d = p - c;
+      q = d.norm() <= *s.radius ? p : Eigen::Vector3d(c + d * (*s.radius / d.norm()));
+      break;
+    }
+    case ShapeSpec::Kind::kCylinder: {
+      const double half = 0.5 * *s.length;
+      q.z() = std::clamp(p.z(), -half, half);
+      const double radial = std::hypot(p.x(), p.y());
+      if (radial > *s.radius) {
+        q.x() = p.x() * *s.radius / radial;
+        q.y() = p.y() * *s.radius / radial;
+      }
+      break;
+    }
+  }
+  return T * q;
+}
+
+double reference_distance(const ShapeSpec& a, const Eigen::Isometry3d& Ta, const ShapeSpec& b,
+                          const Eigen::Isometry3d& Tb) {
+  Eigen::Vector3d p = Ta.translation(), q = Tb.translation();
+  double previous = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 2'000'000; ++k) {
+    p = project(a, Ta, q);
+    q = project(b, Tb, p);
+    const double d = (p - q).norm();
+    if (k > 100 && previous - d < 1e-17) return d;  // the distance decreases monotonically
+    previous = d;
+  }
+  return (p - q).norm();
+}
+
+ShapeSpec cylinder(double r, double l) {
+  ShapeSpec s;
+  s.shape = ShapeSpec::Kind::kCylinder;
+  s.radius = r;
+  s.length = l;
+  return s;
+}
+
+// Every pair of shapes whose distance FCL's GJK computes (a cylinder with anything, box with box), and the analytic
+// ones, at random poses where they are apart: exact to 1e-9 m against the reference.
+TEST(Collision, EveryPairIsExactTo1e9AgainstAnIndependentReference) {
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), size(0.02, 0.3);
+  const auto random_shape = [&](int kind) {
+    switch (kind) {
+      case 0: return sphere(size(rng));
+      case 1: return capsule(size(rng), 2.0 * size(rng));
+      case 2: return cylinder(size(rng), 2.0 * size(rng));
+      default: return box(2.0 * size(rng), 2.0 * size(rng), 2.0 * size(rng));
+    }
+  };
+  const auto random_pose = [&](double spread) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() = spread * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+    T.linear() = Eigen::Quaterniond(unit(rng), unit(rng), unit(rng), unit(rng)).normalized().toRotationMatrix();
+    return T;
+  };
+  double worst = 0.0, worst_cylinder = 0.0;
+  int compared = 0;
+  for (int ka = 0; ka < 4; ++ka) {
+    for (int kb = ka; kb < 4; ++kb) {
+      for (int trial = 0; trial < 25; ++trial) {
+        const ShapeSpec a = random_shape(ka), b = random_shape(kb);
+        const Eigen::Isometry3d Ta = random_pose(0.1), Tb = random_pose(0.8);
+        const DistanceQuery query({a, b});
+        const ShapeDistance d = query.distance(0, Ta, 1, Tb);
+        if (!(d.distance > 1e-3)) continue;  // apart (overlap has its own test)
+        const double want = reference_distance(a, Ta, b, Tb);
+        const double error = std::abs(d.distance - want);
+        worst = std::max(worst, error);
+        if (ka == 2 || kb == 2) worst_cylinder = std::max(worst_cylinder, error);
+        ++compared;
+        EXPECT_LE(error, 1e-9) << a.describe() << " vs " << b.describe() << ": " << d.distance << " against " << want;
+      }
+    }
+  }
+  std::ostringstream text;
+  text << std::scientific << std::setprecision(2) << worst << " (cylinder pairs " << worst_cylinder << ")";
+  RecordProperty("worst_error", text.str());
+  EXPECT_GT(compared, 150);
+}
 }  // namespace
 }  // namespace redres

@@ -1,7 +1,9 @@
 #include "redres/constraints/obstacle_avoidance.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 
@@ -19,7 +21,7 @@ struct ObstacleAvoidance::Data : PairData {
   std::vector<Eigen::Isometry3d> poses;
   std::vector<int> candidates;
   // Shared rows (more pairs than max_rows): the pair each row holds at this contribution (-1: none) and its distance.
-  std::vector<int> row_pair;
+  std::vector<int> row_pair, row_sub;  // row_sub: 0 the witness point's row, 1 to 8 a box corner's
   std::vector<double> row_distance;
   int used = 0, dropped = 0;
 };
@@ -80,8 +82,18 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
                                       " link shapes make " + std::to_string(pairs) + " pairs; at most " +
                                       std::to_string(kMaxObstaclePairs) + " are checked");
   }
-  rows_ = static_cast<int>(std::min<long>(pairs, config_.max_rows));
-  pooled_ = rows_ < pairs;
+  // A box link gets a row for each corner besides its witness point's: with one row per pair, a flat face held at
+  // d_s by its lowest corner could turn the next corner through d_s within a step.
+  long rows = 0;
+  first_row_.assign(static_cast<std::size_t>(pairs) + 1, 0);
+  for (long p = 0; p < pairs; ++p) {
+    first_row_[static_cast<std::size_t>(p)] = static_cast<int>(std::min<long>(rows, INT32_MAX));
+    rows += rows_of_link(static_cast<int>(p % links_));
+  }
+  first_row_.back() = static_cast<int>(std::min<long>(rows, INT32_MAX));
+  rows_ = static_cast<int>(std::min<long>(rows, config_.max_rows));
+  pooled_ = rows_ < rows;
+  if (pooled_) first_row_.clear();
   (void)DistanceQuery(shapes);  // checks the shapes' sizes now, naming the shape, rather than at the first run
   using B = Config::Broadphase;
   broadphase_ =
@@ -107,6 +119,7 @@ std::unique_ptr<PluginData> ObstacleAvoidance::make_data() const {
   }
   if (pooled_) {
     data->row_pair.assign(static_cast<std::size_t>(rows_), -1);
+    data->row_sub.assign(static_cast<std::size_t>(rows_), 0);
     data->row_distance.assign(static_cast<std::size_t>(rows_), 0.0);
   }
   return data;
@@ -114,7 +127,11 @@ std::unique_ptr<PluginData> ObstacleAvoidance::make_data() const {
 
 int ObstacleAvoidance::inequality_rows(const RobotModel& /*robot*/) const { return rows_; }
 
-int ObstacleAvoidance::claim_row(Data& data, int pair, double distance) const {
+int ObstacleAvoidance::rows_of_link(int l) const {
+  return robot_->link_shapes()[static_cast<std::size_t>(l)].spec.shape == ShapeSpec::Kind::kBox ? 9 : 1;
+}
+
+int ObstacleAvoidance::claim_row(Data& data, int pair, int sub, double distance) const {
   int row = -1;
   if (data.used < rows_) {
     row = data.used++;
@@ -126,6 +143,7 @@ int ObstacleAvoidance::claim_row(Data& data, int pair, double distance) const {
     row = static_cast<int>(far - data.row_distance.begin());
   }
   data.row_pair[static_cast<std::size_t>(row)] = pair;
+  data.row_sub[static_cast<std::size_t>(row)] = sub;
   data.row_distance[static_cast<std::size_t>(row)] = distance;
   return row;
 }
@@ -165,17 +183,43 @@ void ObstacleAvoidance::pair_row(Data& data, const KinematicsData& kin, int l, c
                                  const Eigen::Isometry3d& To, Eigen::Block<Eigen::MatrixXd>& A,
                                  Eigen::VectorBlock<Eigen::VectorXd>& b) const {
   const int pair = o * links_ + l;
+  const int first = pooled_ ? -1 : first_row_[static_cast<std::size_t>(pair)];
+  const int count = pooled_ ? 0 : first_row_[static_cast<std::size_t>(pair) + 1] - first;
   const ShapeDistance d = data.query.distance(l, Tl, links_ + o, To);
   Eigen::Vector3d n;
   if (!data.distances.take(pair, d, planar_, Tl.translation() - To.translation(), n)) {
-    if (!pooled_) slack_row(A.row(pair), b(pair));  // shared rows start slack
+    for (int r = first; r < first + count; ++r) slack_row(A.row(r), b(r));  // shared rows start slack
     return;
   }
-  const int row = pooled_ ? claim_row(data, pair, d.distance) : pair;
-  if (row < 0) return;  // every row holds a nearer pair
-  point_jacobian(*robot_, kin, robot_->link_shapes()[static_cast<std::size_t>(l)].link, d.point_a, data.jacobian);
-  damper_row(data.distances.damper(), d.distance, n, data.jacobian, velocities_[static_cast<std::size_t>(o)],
-             A.row(row), b(row));
+  const auto& shape = robot_->link_shapes()[static_cast<std::size_t>(l)];
+  const Damper& damper = data.distances.damper();
+  const Eigen::Vector3d& v = velocities_[static_cast<std::size_t>(o)];
+  const int row = pooled_ ? claim_row(data, pair, 0, d.distance) : first;
+  if (row >= 0) {
+    point_jacobian(*robot_, kin, shape.link, d.point_a, data.jacobian);
+    damper_row(damper, d.distance, n, data.jacobian, v, A.row(row), b(row));
+  }
+  if (shape.spec.shape != ShapeSpec::Kind::kBox) return;
+  // The box's corners within d_i get rows of their own (a corner inside the obstacle is left to the witness row).
+  const std::array<double, 3>& size = *shape.spec.size;
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d local(((c & 1) ? 0.5 : -0.5) * size[0], ((c & 2) ? 0.5 : -0.5) * size[1],
+                                ((c & 4) ? 0.5 : -0.5) * size[2]);
+    const Eigen::Vector3d p = Tl * local;
+    const Eigen::Vector3d q = data.query.nearest_point(links_ + o, To, p);
+    Eigen::Vector3d nc = p - q;
+    if (planar_) nc.z() = 0.0;
+    const double dc = (p - q).norm();
+    int r = pooled_ ? -1 : first + 1 + c;
+    if (!(dc > 0.0 && dc < damper.influence_distance && nc.norm() > 1e-12 * dc)) {
+      if (!pooled_) slack_row(A.row(r), b(r));
+      continue;
+    }
+    if (pooled_ && (r = claim_row(data, pair, c + 1, dc)) < 0) continue;
+    nc.normalize();
+    point_jacobian(*robot_, kin, shape.link, p, data.jacobian);
+    damper_row(damper, dc, nc, data.jacobian, v, A.row(r), b(r));
+  }
 }
 
 void ObstacleAvoidance::add_near_pairs(Data& data, const Context& ctx, QpBuilder& builder) const {
@@ -196,7 +240,9 @@ void ObstacleAvoidance::add_near_pairs(Data& data, const Context& ctx, QpBuilder
     for (int o = 0; o < obstacles_; ++o) {
       const int pair = o * links_ + l;
       data.distances.beyond(pair);
-      if (!pooled_) slack_row(A.row(pair), b(pair));
+      if (pooled_) continue;
+      for (int r = first_row_[static_cast<std::size_t>(pair)]; r < first_row_[static_cast<std::size_t>(pair) + 1]; ++r)
+        slack_row(A.row(r), b(r));
     }
     const int count = data.query.near(l, Tl, data.distances.damper().influence_distance, data.candidates.data());
     for (int k = 0; k < count; ++k) {
@@ -208,9 +254,16 @@ void ObstacleAvoidance::add_near_pairs(Data& data, const Context& ctx, QpBuilder
 
 std::string ObstacleAvoidance::describe_inequality_row(const PluginData* data, int row) const {
   if (row < 0 || row >= rows_ || data == nullptr) return {};
-  if (!pooled_) return describe_pair(data, row);
-  const int pair = pair_data<Data>(data).row_pair[static_cast<std::size_t>(row)];
-  return pair < 0 ? "a shared row that no pair within d_i held" : describe_pair(data, pair);
+  int pair = 0, sub = 0;
+  if (pooled_) {
+    pair = pair_data<Data>(data).row_pair[static_cast<std::size_t>(row)];
+    sub = pair_data<Data>(data).row_sub[static_cast<std::size_t>(row)];
+    if (pair < 0) return "a shared row that no pair within d_i held";
+  } else {
+    pair = static_cast<int>(std::upper_bound(first_row_.begin(), first_row_.end(), row) - first_row_.begin()) - 1;
+    sub = row - first_row_[static_cast<std::size_t>(pair)];
+  }
+  return describe_pair(data, pair) + (sub > 0 ? " (corner " + std::to_string(sub) + " of the link's box)" : "");
 }
 
 std::string ObstacleAvoidance::describe_pair(const PluginData* data, int pair) const {

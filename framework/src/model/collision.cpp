@@ -2,6 +2,8 @@
 
 #include "redres/model/collision.hpp"
 
+#include "redres/common/error.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -454,6 +456,11 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
   out.point_b = r.nearest_points[1];
   impl_->polish(static_cast<std::size_t>(a), Ta, static_cast<std::size_t>(b), Tb, out);
   return out;
+}
+
+Eigen::Vector3d DistanceQuery::nearest_point(int k, const Eigen::Isometry3d& T, const Eigen::Vector3d& w) const {
+  REDRES_REQUIRE(k >= 0 && k < size(), "DistanceQuery::nearest_point", "0 <= shape < size()");
+  return impl_->project(static_cast<std::size_t>(k), T, w);
 }
 
 void DistanceQuery::build_broadphase(int first, int count) {

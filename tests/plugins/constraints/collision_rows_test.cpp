@@ -4,17 +4,21 @@
 // on the kinematics' link frames). Sign, frame and column errors in these rows are the classic bugs; this test
 // catches each of them. Also: the damper's bound, slack rows beyond the influence distance, and 0 allocations.
 
+#include <limits>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
 #include "alloc_counter.hpp"
 #include "redres/constraints/obstacle_avoidance.hpp"
 #include "redres/constraints/self_collision.hpp"
+#include "redres/control/controller.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/control/scheme.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/qp/lvi.hpp"
+#include "redres/run/simulation.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -361,6 +365,65 @@ TEST(CollisionRows, SharedRowsHoldTheNearestPairs) {
     EXPECT_EQ(held, static_cast<int>(std::min<std::size_t>(live.size(), 8))) << "trial " << trial;
   }
   EXPECT_GT(crowded, 5) << "more pairs within d_i than rows occur, so the sharing is tested";
+}
+
+// A box link gets a row for each corner besides its witness point's: each corner row is the rate of that corner's
+// distance to the obstacle (central differences), and a flat face turning over a box obstacle stays at d_s
+// (tests/data/scenarios/box_hand_over_box.toml: with one row per pair, the next corner sank 0.12 mm through d_s
+// there; what remains is the step's second-order motion, some 1e-5 m).
+TEST(CollisionRows, ABoxLinkHoldsEachCornerAtTheSafetyDistance) {
+  Scenario s = load_scenario(data_path("scenarios/box_hand_over_box.toml"));
+  const RobotModel& robot = *s.robot;
+  const auto controller = Controller::from_scenario(s);
+  EXPECT_EQ(controller->qp().m_in(), 3 + 9) << "three capsule links, and the box link's witness and 8 corners";
+  const RunResult run = simulate(s);
+  const std::size_t col = run.trajectory.column("min_obstacle_distance");
+  double lowest = std::numeric_limits<double>::infinity();
+  for (std::size_t r = 0; r < run.trajectory.size(); ++r) lowest = std::min(lowest, run.trajectory(r, col));
+  RecordProperty("lowest_distance", std::to_string(lowest));
+  EXPECT_GE(lowest, 0.02 - 5e-5);
+  // Corner rows at a state of the run where the box is within d_i: rate of the corner's distance.
+  const std::size_t row = run.trajectory.size() / 2;
+  const Eigen::VectorXd theta = recorded_theta(robot, run.trajectory, row);
+  const double t = run.trajectory.at(row, "t");
+  StepOutput out = controller->make_output();
+  controller->step(theta, t, out);
+  const QpProblem& qp = controller->qp();
+  const auto& box = robot.link_shapes()[3];
+  ASSERT_EQ(box.spec.shape, ShapeSpec::Kind::kBox);
+  const auto* avoid = dynamic_cast<const ObstacleAvoidance*>(s.scheme->constraints()[2].get());
+  ASSERT_NE(avoid, nullptr);
+  std::vector<ShapeSpec> obstacles;
+  avoid->scene_obstacles(obstacles);
+  ASSERT_EQ(obstacles.size(), 1u);
+  ShapeSpec ob = obstacles[0];
+  ob.xyz = {0.0, 0.0, 0.0};  // its pose is obstacle_pose()
+  const DistanceQuery query({box.spec, ob});
+  const Eigen::Isometry3d To = avoid->obstacle_pose(0, t);
+  const auto corner_distance = [&](const Eigen::VectorXd& th, int c) {
+    KinematicsData k(robot);
+    compute_kinematics(robot, th, k, KinematicsLevel::kPosition);
+    const Eigen::Isometry3d Tl = k.link_frames[static_cast<std::size_t>(box.link)] * box.pose;
+    const auto& size = *box.spec.size;
+    const Eigen::Vector3d p = Tl * Eigen::Vector3d(((c & 1) ? 0.5 : -0.5) * size[0], ((c & 2) ? 0.5 : -0.5) * size[1],
+                                                   ((c & 4) ? 0.5 : -0.5) * size[2]);
+    return (p - query.nearest_point(1, To, p)).norm();
+  };
+  std::mt19937 rng(17);
+  std::normal_distribution<double> normal;
+  int live = 0;
+  const int first = qp.m_in() - 12 + 3 + 1;  // the box's corner rows follow its witness row (the 4th pair)
+  for (int c = 0; c < 8; ++c) {
+    const int r = first + c;
+    if (qp.A.row(r).norm() == 0.0) continue;  // a corner beyond d_i
+    ++live;
+    Eigen::VectorXd x(robot.dof());
+    for (int j = 0; j < x.size(); ++j) x(j) = normal(rng);
+    const double h = 1e-6;
+    const double rate = (corner_distance(theta + h * x, c) - corner_distance(theta - h * x, c)) / (2 * h);
+    EXPECT_NEAR(-qp.A.row(r).dot(x), rate, 1e-6 * (1.0 + std::abs(rate))) << "corner " << c;
+  }
+  EXPECT_GE(live, 2) << "the face's corners near the obstacle have rows";
 }
 
 TEST(CollisionRows, TheBroadphaseAllocatesNothingPerStepWithStaticObstacles) {

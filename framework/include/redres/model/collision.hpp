@@ -93,6 +93,9 @@ class DistanceQuery {
   /// i.e. owner pose * ShapeSpec::pose()). Allocation-free for sphere and capsule pairs and for any overlap it
   /// measures; pairs apart that involve a box or a cylinder run FCL's GJK, which may allocate.
   [[nodiscard]] ShapeDistance distance(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb) const;
+  /// The point of shape k at world pose T nearest to the world point `w` (w itself when it is inside): exact, in
+  /// closed form, allocation-free.
+  [[nodiscard]] Eigen::Vector3d nearest_point(int k, const Eigen::Isometry3d& T, const Eigen::Vector3d& w) const;
 
   /// Broadphase, for scenes with many pairs: puts shapes [first, first + count) (the "group", e.g. the obstacles)
   /// into FCL's dynamic AABB tree. Call once, then move_group() before the first near().

@@ -85,15 +85,19 @@ class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig>, 
                 const Eigen::Isometry3d& To, Eigen::Block<Eigen::MatrixXd>& A,
                 Eigen::VectorBlock<Eigen::VectorXd>& b) const;
   // A shared row for `pair` at `distance` (the farthest pair's when all are taken and this one is nearer), or -1.
-  int claim_row(Data& data, int pair, double distance) const;
+  // `sub`: 0 for the witness point's row, 1 to 8 for a box corner's.
+  int claim_row(Data& data, int pair, int sub, double distance) const;
+  // The rows of a pair with link shape l: 9 for a box (its witness point and its corners), else 1.
+  [[nodiscard]] int rows_of_link(int l) const;
   // The broadphase path of add_to(): only the pairs the tree finds near are measured.
   void add_near_pairs(Data& data, const Context& ctx, QpBuilder& builder) const;
 
   const RobotModel* robot_;
   std::vector<ShapeSpec> shapes_;  // the query's shapes: link shapes first, then the obstacles
   int links_ = 0, obstacles_ = 0;
-  int rows_ = 0;         // inequality rows: one per pair, or max_rows shared
-  bool pooled_ = false;  // more pairs than max_rows: the pairs within d_i share the rows
+  int rows_ = 0;                // inequality rows: one per pair (nine for a box link), or max_rows shared
+  bool pooled_ = false;         // more rows than max_rows: the pairs within d_i share max_rows rows
+  std::vector<int> first_row_;  // not pooled: pair p's rows are [first_row_[p], first_row_[p + 1])
   // Broadphase: whether it is used; whether an obstacle moves; whether the robot is planar.
   bool broadphase_ = false, moving_ = false, planar_ = false;
   // Each obstacle's pose at t = 0 and its velocity (zero when it stands still).

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Heat map of a redres sweep: one summary figure over two of the sweep's axes, with the variations that did not
-run through (status failed_steps or error) marked.
+run through (any status but ok: failed_steps, task_error_exceeded or error) marked.
 
     plot_sweep.py SWEEP_DIR [--x KEY] [--y KEY] [--value COLUMN] [--out FILE]
 

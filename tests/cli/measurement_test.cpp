@@ -117,5 +117,18 @@ TEST(Measurement, ARunBeyondItsTaskErrorBoundIsNoSuccess) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(Measurement, ASweepVariationBeyondItsTaskErrorBoundIsNotOk) {
+  const auto dir = scratch("sweep_task_error");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "bound.toml") << "name = \"bound\"\nscenario = \""
+                                    << source_path("configs/paper_r_fast.toml").string()
+                                    << "\"\n[[vary]]\nkey = \"solver.max_task_error\"\nvalues = [1e-12, 1.0]\n";
+  const Cli r = redres("sweep '" + (dir / "bound.toml").string() + "' --quiet --out '" + (dir / "out").string() + "'");
+  EXPECT_EQ(r.code, 1) << r.out;
+  const std::string table = read_text(dir / "out" / "sweep.csv");
+  EXPECT_NE(table.find(",task_error_exceeded,max position error "), std::string::npos) << table;
+  EXPECT_NE(table.find(",ok,"), std::string::npos) << table;
+  std::filesystem::remove_all(dir);
+}
 }  // namespace
 }  // namespace redres

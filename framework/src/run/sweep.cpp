@@ -330,8 +330,15 @@ Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesy
     simulate(*s, run, {}, stop);
     const RunSummary summary = summarise(*s, run);
     if (spec.write_runs) write_run(*s->robot, run, summary, out_dir / "runs" / std::to_string(v.index), spec.record);
-    status = run.interrupted ? "interrupted" : run.failures == 0 ? "ok" : "failed_steps";
+    status = run.interrupted               ? "interrupted"
+             : run.failures > 0            ? "failed_steps"
+             : summary.task_error_exceeded ? "task_error_exceeded"
+                                           : "ok";
     diagnosis = run.first_failure;
+    if (run.failures == 0 && summary.task_error_exceeded) {
+      diagnosis = "max position error " + std::to_string(summary.max_position_error) +
+                  " m > [solver] max_task_error = " + std::to_string(summary.max_task_error) + " m";
+    }
     nlohmann::json j = nlohmann::json::parse(to_json(summary));
     // (The run's own "status" is the sweep's status column and solver.stopped.)
     for (const char* skip : {"wall_time_s", "source", "robot", "obstacles", "name", "status"}) j.erase(skip);

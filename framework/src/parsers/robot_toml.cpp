@@ -411,9 +411,7 @@ void read_collision_exclude(const TableReader& r, RobotSpec& spec) {
 const Schema<RobotReading>& RobotReading::schema() {
   using C = RobotReading;
   static const Schema<C> s{{
-      entry<C>("plugins", "array of strings", "", "[]",
-               "plugin libraries to load first (their velocity-limit laws may be named below)",
-               [](const TableReader& r, C&) { load_plugins_from(r); }),
+      plugins_entry<C>("plugin libraries to load first (their velocity-limit laws may be named below)"),
       entry<C>("urdf", "path", "", "none (the chain is [[joints]])",
                "a URDF file whose chain from base_link to tip_link is the robot (docs/robot_format.md)",
                [](const TableReader& r, C& c) {

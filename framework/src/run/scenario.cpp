@@ -145,9 +145,7 @@ struct ScenarioReading {
 const Schema<ScenarioReading>& ScenarioReading::schema() {
   using C = ScenarioReading;
   static const Schema<C> keys{{
-      entry<C>("plugins", "array of strings", "", "[]",
-               "plugin libraries to load first (their plugins may be named below and in the robot file)",
-               [](const TableReader& r, C&) { load_plugins_from(r); }),
+      plugins_entry<C>("plugin libraries to load first (their plugins may be named below and in the robot file)"),
       entry<C>("name", "string", "", "the file's stem", "the scenario's name (in summary.json and comparisons)",
                [](const TableReader& r, C& c) {
                  if (!r.has("name")) return;

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "redres/common/error.hpp"
+#include "redres/config/config.hpp"
 #include "redres/config/toml_reader.hpp"
 
 namespace redres {
@@ -37,6 +38,14 @@ int load_plugin_path();
 /// Reads the optional `plugins` key of a scenario or robot file (an array of library paths, relative to the file)
 /// and loads them.
 void load_plugins_from(const TableReader& root);
+
+/// The `plugins` key of a file's schema (scenario, robot): an array of libraries, loaded (load_plugins_from) when
+/// the key is read, before the keys after it that may name their plugins. `help` says what they may provide.
+template <class C>
+[[nodiscard]] Field<C> plugins_entry(std::string help) {
+  return entry<C>("plugins", "array of strings", "", "[]", std::move(help),
+                  [](const TableReader& r, C& /*c*/) { load_plugins_from(r); });
+}
 
 /// The libraries loaded so far (canonical paths), in load order.
 [[nodiscard]] const std::vector<std::filesystem::path>& loaded_plugin_libraries();

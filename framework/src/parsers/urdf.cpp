@@ -291,6 +291,21 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
   const Namer names{where, outline};
 
   urdf::ModelInterfaceSharedPtr model;
+  // urdfdom's links hold their children by shared_ptr: in a file whose joints form a cycle they hold each other,
+  // and the model would never be freed. The links are unlinked when the reading ends, however it ends (the chain
+  // read from them is a copy).
+  struct Unlink {
+    urdf::ModelInterfaceSharedPtr& model;
+    ~Unlink() {
+      if (!model) return;
+      for (auto& entry : model->links_) {
+        if (!entry.second) continue;
+        entry.second->child_links.clear();
+        entry.second->child_joints.clear();
+        entry.second->parent_joint.reset();
+      }
+    }
+  } const unlink{model};
   std::string messages;
   {
     // console_bridge's handler is process-wide: one reader at a time.

@@ -377,6 +377,15 @@ TEST(UrdfBounds, CyclesSelfParentsAndBadValuesAreRefusedNamingTheElement) {
   const std::string latin = replace(read_text(data_path("urdf/names.urdf")), "red\x1b[31m", "red");
   const std::string what = load_error(f, f.write("latin.urdf", latin), "base", "tip");
   EXPECT_NE(what.find("joint 'latin\\xe9xyz': the name is not UTF-8"), std::string::npos) << what;
+  // A declaration closed by '>' alone (TinyXML accepts it) hides nothing from the checks; an unclosed comment is
+  // malformed XML.
+  std::string open_declaration = read_text(data_path("urdf/own_parent.urdf"));
+  open_declaration.replace(open_declaration.find("?>"), 2, "\x1f>");
+  const std::string hidden = load_error(f, f.write("open.urdf", open_declaration), "base", "tip");
+  EXPECT_NE(hidden.find("joint 'loop' has link 'tip' as both its parent and its child"), std::string::npos) << hidden;
+  const std::string comment =
+      load_error(f, f.write("comment.urdf", "<robot name=\"r\">\n<!-- never closed\n"), "a", "b");
+  EXPECT_NE(comment.find("comment.urdf:2: a comment <!-- is not closed (malformed XML)"), std::string::npos) << comment;
   // Two joints with one child.
   const std::string two =
       generated_urdf(2, 0, "<joint name=\"again\" type=\"fixed\"><parent link=\"l0\"/><child link=\"l2\"/></joint>\n");

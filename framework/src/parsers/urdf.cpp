@@ -37,15 +37,37 @@ class Collect final : public console_bridge::OutputHandler {
 // Where each <link> and <joint> of the file starts, by name (for messages), from the bounded scan below.
 struct XmlOutline {
   std::map<std::string, std::size_t> link_lines, joint_lines;
+  // Each top-level <joint>: its name, its <parent link> and <child link>, and its line (the graph urdfdom will
+  // build, checked before it does: a cycle of its shared_ptr links leaks, and some it reports only by failing).
+  struct Joint {
+    std::string name, parent, child;
+    std::size_t line = 0;
+  };
+  std::vector<Joint> joints;
+  std::size_t links = 0;
 };
+
+// The value of attribute `key` in the text of a tag's attributes ("" when absent).
+std::string attribute(const std::string& attributes, const std::string& key) {
+  for (const char quote : {'"', '\''}) {
+    const std::string q = key + "=" + quote;
+    for (std::size_t a = attributes.find(q); a != std::string::npos; a = attributes.find(q, a + 1)) {
+      if (a > 0 && !std::isspace(static_cast<unsigned char>(attributes[a - 1]))) continue;
+      const std::size_t b = attributes.find(quote, a + q.size());
+      if (b != std::string::npos) return attributes.substr(a + q.size(), b - a - q.size());
+    }
+  }
+  return {};
+}
 
 // A linear scan of the XML before urdfdom sees it: the nesting depth and the element count are bounded (TinyXML
 // parses recursively, so 50,000 nested elements overflow its stack, and 20,000 take seconds), and each top-level
-// <link> and <joint> is found with its line. Comments, CDATA, processing instructions and the DOCTYPE are skipped;
-// what is malformed is left for the parser to report.
+// <link> and <joint> is found with its line, and each joint's parent and child. Comments, CDATA, processing
+// instructions and the DOCTYPE are skipped.
 XmlOutline outline_xml(const std::string& where, const std::string& xml) {
   XmlOutline out;
   std::size_t line = 1, depth = 0, elements = 0;
+  bool in_joint = false;  // inside a top-level <joint>
   const std::size_t n = xml.size();
   // Moves i to just past `end` (counting lines); false if the file ends first.
   const auto skip_to = [&](std::size_t& i, std::string_view end) {
@@ -56,27 +78,29 @@ XmlOutline outline_xml(const std::string& where, const std::string& xml) {
     i = stop;
     return at != std::string::npos;
   };
+  // A construct that the file does not close is malformed XML: refused here, so that nothing the scan did not see
+  // reaches urdfdom (TinyXML is lenient). Declarations and <!...> end at the first '>', as TinyXML ends them.
+  std::size_t opened = 1;  // the line of the construct being read
+  const auto unclosed = [&](const std::string& what) {
+    throw UrdfError(where + ":" + std::to_string(opened) + ": " + what + " is not closed (malformed XML)");
+  };
   for (std::size_t i = 0; i < n;) {
     if (xml[i] != '<') {
       if (xml[i] == '\n') ++line;
       ++i;
       continue;
     }
+    opened = line;
     if (xml.compare(i, 4, "<!--") == 0) {
-      if (!skip_to(i, "-->")) break;
+      if (!skip_to(i, "-->")) unclosed("a comment <!--");
     } else if (xml.compare(i, 9, "<![CDATA[") == 0) {
-      if (!skip_to(i, "]]>")) break;
-    } else if (xml.compare(i, 2, "<?") == 0) {
-      if (!skip_to(i, "?>")) break;
-    } else if (xml.compare(i, 2, "<!") == 0) {  // a DOCTYPE, with its internal subset in [...]
-      const std::size_t open = xml.find_first_of("[>", i);
-      if (open != std::string::npos && xml[open] == '[') {
-        if (!skip_to(i, "]")) break;
-      }
-      if (!skip_to(i, ">")) break;
+      if (!skip_to(i, "]]>")) unclosed("a <![CDATA[ section");
+    } else if (xml.compare(i, 2, "<?") == 0 || xml.compare(i, 2, "<!") == 0) {
+      if (!skip_to(i, ">")) unclosed("a declaration");
     } else if (xml.compare(i, 2, "</") == 0) {
       if (depth > 0) --depth;
-      if (!skip_to(i, ">")) break;
+      if (depth < 2) in_joint = false;
+      if (!skip_to(i, ">")) unclosed("an end tag");
     } else {
       const std::size_t start_line = line;
       std::size_t k = i + 1;
@@ -94,7 +118,7 @@ XmlOutline outline_xml(const std::string& where, const std::string& xml) {
           quote = xml[end];
         }
       }
-      if (end >= n) break;
+      if (end >= n) unclosed("the tag <" + printable(tag));
       const bool empty = xml[end - 1] == '/';
       if (++elements > kMaxUrdfElements) {
         throw UrdfError(where + ":" + std::to_string(start_line) + ": more than " + std::to_string(kMaxUrdfElements) +
@@ -105,16 +129,20 @@ XmlOutline outline_xml(const std::string& where, const std::string& xml) {
                         std::to_string(depth) + " elements deep; a URDF nests at most " +
                         std::to_string(kMaxUrdfDepth));
       }
-      if ((tag == "link" || tag == "joint") && depth <= 2) {
+      const std::size_t level = empty ? depth + 1 : depth;  // the element's own depth (the root's is 1)
+      if ((tag == "link" || tag == "joint") && level == 2) {
         const std::string attributes = xml.substr(k, end - k);
-        for (const char* q : {"name=\"", "name='"}) {
-          const std::size_t a = attributes.find(q);
-          if (a == std::string::npos || (a > 0 && !std::isspace(static_cast<unsigned char>(attributes[a - 1]))))
-            continue;
-          const std::size_t b = attributes.find(q[5], a + 6);
-          if (b != std::string::npos) name = attributes.substr(a + 6, b - a - 6);
-        }
+        name = attribute(attributes, "name");
         (tag == "link" ? out.link_lines : out.joint_lines).emplace(name, start_line);
+        if (tag == "link") {
+          ++out.links;
+        } else {
+          out.joints.push_back({name, "", "", start_line});
+          in_joint = !empty;
+        }
+      } else if (in_joint && level == 3 && (tag == "parent" || tag == "child")) {
+        (tag == "parent" ? out.joints.back().parent : out.joints.back().child) =
+            attribute(xml.substr(k, end - k), "link");
       }
       i = end + 1;
     }
@@ -210,7 +238,11 @@ void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometr
 void add_branch(const Namer& names, const urdf::ModelInterface& model, const urdf::Joint& joint,
                 const Eigen::Isometry3d& at, const std::string& messages, UrdfLink& out) {
   std::vector<std::pair<const urdf::Joint*, Eigen::Isometry3d>> stack{{&joint, at}};
+  std::size_t visited = 0;
   while (!stack.empty()) {
+    if (++visited > model.joints_.size()) {  // the tree checks hold this off; kept so the walk always ends
+      throw UrdfError(names.joint(joint.name) + ": its side branch goes round a cycle of joints");
+    }
     const auto [j, from] = stack.back();
     stack.pop_back();
     const urdf::LinkConstSharedPtr link = model.getLink(j->child_link_name);
@@ -225,45 +257,49 @@ void add_branch(const Namer& names, const urdf::ModelInterface& model, const urd
 }
 
 // The joints form a tree: at most kMaxUrdfLinks links and joints, each link the child of at most one joint, no
-// joint its own link's parent, and no cycle (a link whose parents never reach a root). urdfdom checks only that
-// one link has no parent; a cycle beside it would send the walks below round for ever.
-void check_tree(const Namer& names, const urdf::ModelInterface& model) {
-  if (model.links_.size() > kMaxUrdfLinks || model.joints_.size() > kMaxUrdfLinks) {
-    throw UrdfError(names.where + ": " + std::to_string(model.links_.size()) + " links and " +
-                    std::to_string(model.joints_.size()) + " joints; a URDF has at most " +
+// joint its own link's parent, and no cycle (a link whose parents never reach a root). Checked on the text's
+// outline, before urdfdom builds the graph: urdfdom checks only that one link has no parent, a cycle beside it
+// would send the walks below round for ever, and its links, which hold their children by shared_ptr, would never
+// be freed.
+void check_tree(const Namer& names, const XmlOutline& outline) {
+  if (outline.links > kMaxUrdfLinks || outline.joints.size() > kMaxUrdfLinks) {
+    throw UrdfError(names.where + ": " + std::to_string(outline.links) + " links and " +
+                    std::to_string(outline.joints.size()) + " joints; a URDF has at most " +
                     std::to_string(kMaxUrdfLinks) + " of each");
   }
-  std::unordered_map<std::string, const urdf::Joint*> parent;  // child link -> the joint above it
-  for (const auto& [name, joint] : model.joints_) {
-    if (!joint) continue;
-    if (joint->child_link_name == joint->parent_link_name) {
-      throw UrdfError(names.joint(name) + " has link '" + printable(joint->child_link_name) +
-                      "' as both its parent and its child");
+  const auto at = [&](const XmlOutline::Joint& j) {
+    return names.where + ":" + std::to_string(j.line) + ": joint '" + printable(j.name) + "'";
+  };
+  std::unordered_map<std::string, const XmlOutline::Joint*> parent;  // child link -> the joint above it
+  for (const XmlOutline::Joint& joint : outline.joints) {
+    if (joint.child.empty() || joint.parent.empty()) continue;  // urdfdom reports it
+    if (joint.child == joint.parent) {
+      throw UrdfError(at(joint) + " has link '" + printable(joint.child) + "' as both its parent and its child");
     }
-    const auto [it, fresh] = parent.emplace(joint->child_link_name, joint.get());
+    const auto [it, fresh] = parent.emplace(joint.child, &joint);
     if (!fresh) {
-      throw UrdfError(names.joint(name) + " and joint '" + printable(it->second->name) + "' both have link '" +
-                      printable(joint->child_link_name) + "' as their child; a link has one parent");
+      throw UrdfError(at(joint) + " and joint '" + printable(it->second->name) + "' both have link '" +
+                      printable(joint.child) + "' as their child; a link has one parent");
     }
   }
   // Each link's way up, followed once: 1 while on the current way, 2 when it is known to reach a root.
   std::unordered_map<std::string, int> state;
   std::vector<std::string> way;
-  for (const auto& entry : model.links_) {
-    std::string at = entry.first;
+  for (const auto& entry : parent) {
+    std::string at_link = entry.first;
     way.clear();
-    while (state[at] == 0) {
-      state[at] = 1;
-      way.push_back(at);
-      const auto up = parent.find(at);
+    while (state[at_link] == 0) {
+      state[at_link] = 1;
+      way.push_back(at_link);
+      const auto up = parent.find(at_link);
       if (up == parent.end()) break;
-      at = up->second->parent_link_name;
+      at_link = up->second->parent;
     }
-    if (state[at] == 1 && parent.count(at) != 0) {
+    if (state[at_link] == 1 && parent.count(at_link) != 0) {
       std::string cycle;
-      const auto first = std::find(way.begin(), way.end(), at);
+      const auto first = std::find(way.begin(), way.end(), at_link);
       for (auto it = first; it != way.end(); ++it) cycle += "'" + printable(*it) + "' -> ";
-      throw UrdfError(names.link(at) + " is on a cycle of joints (" + cycle + "'" + printable(at) +
+      throw UrdfError(names.link(at_link) + " is on a cycle of joints (" + cycle + "'" + printable(at_link) +
                       "'): a URDF's joints form a tree");
     }
     for (const std::string& l : way) state[l] = 2;
@@ -289,6 +325,7 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
   }
   const XmlOutline outline = outline_xml(where, xml);
   const Namer names{where, outline};
+  check_tree(names, outline);
 
   urdf::ModelInterfaceSharedPtr model;
   // urdfdom's links hold their children by shared_ptr: in a file whose joints form a cycle they hold each other,
@@ -330,7 +367,6 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
     throw UrdfError(where + ": not a valid URDF (" +
                     (messages.empty() ? std::string("urdfdom gave no reason") : printable(messages)) + ")");
   }
-  check_tree(names, *model);
 
   UrdfChain chain;
   chain.robot_name = model->getName();
@@ -343,6 +379,9 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
   // Walk up from the tip to the base (the tree is checked: this ends); the joints met, reversed, are the chain.
   std::vector<urdf::LinkConstSharedPtr> links{link};
   while (link->name != base_link) {
+    if (links.size() > model->links_.size()) {  // the tree checks hold this off; kept so the walk always ends
+      throw UrdfError(where + ": walking up from link '" + printable(tip_link) + "' goes round a cycle of joints");
+    }
     const urdf::JointConstSharedPtr joint = link->parent_joint;
     if (!joint) {
       throw UrdfError(where + ": link '" + printable(tip_link) + "' (tip_link) is not below link '" +

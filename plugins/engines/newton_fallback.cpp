@@ -56,7 +56,6 @@ void Newton::run_fallback(const QpProblem& qp, SolverResult& result, int newton_
     result.x = fallback_result_.x;
     result.info.residual = fb.residual;
   }
-  result.y.setZero();
   result.info.status = fb.status;
   result.info.iterations = newton_iterations + fb.iterations;
   std::ostringstream text;

@@ -29,6 +29,14 @@ ShapeSpec capsule(double r, double l) {
   s.length = l;
   return s;
 }
+ShapeSpec cylinder(double r, double l) {
+  ShapeSpec s;
+  s.shape = ShapeSpec::Kind::kCylinder;
+  s.radius = r;
+  s.length = l;
+  return s;
+}
+
 ShapeSpec box(double x, double y, double z) {
   ShapeSpec s;
   s.shape = ShapeSpec::Kind::kBox;
@@ -154,14 +162,6 @@ double reference_distance(const ShapeSpec& a, const Eigen::Isometry3d& Ta, const
     previous = d;
   }
   return (p - q).norm();
-}
-
-ShapeSpec cylinder(double r, double l) {
-  ShapeSpec s;
-  s.shape = ShapeSpec::Kind::kCylinder;
-  s.radius = r;
-  s.length = l;
-  return s;
 }
 
 // Every pair of shapes whose distance FCL's GJK computes (a cylinder with anything, box with box), and the analytic

@@ -267,18 +267,16 @@ void check_tree(const Namer& names, const XmlOutline& outline) {
                     std::to_string(outline.joints.size()) + " joints; a URDF has at most " +
                     std::to_string(kMaxUrdfLinks) + " of each");
   }
-  const auto at = [&](const XmlOutline::Joint& j) {
-    return names.where + ":" + std::to_string(j.line) + ": joint '" + printable(j.name) + "'";
-  };
   std::unordered_map<std::string, const XmlOutline::Joint*> parent;  // child link -> the joint above it
   for (const XmlOutline::Joint& joint : outline.joints) {
     if (joint.child.empty() || joint.parent.empty()) continue;  // urdfdom reports it
     if (joint.child == joint.parent) {
-      throw UrdfError(at(joint) + " has link '" + printable(joint.child) + "' as both its parent and its child");
+      throw UrdfError(names.joint(joint.name) + " has link '" + printable(joint.child) +
+                      "' as both its parent and its child");
     }
     const auto [it, fresh] = parent.emplace(joint.child, &joint);
     if (!fresh) {
-      throw UrdfError(at(joint) + " and joint '" + printable(it->second->name) + "' both have link '" +
+      throw UrdfError(names.joint(joint.name) + " and joint '" + printable(it->second->name) + "' both have link '" +
                       printable(joint.child) + "' as their child; a link has one parent");
     }
   }

@@ -24,12 +24,15 @@ std::string joint_label(const QpProblem& qp, int i) {
   return s;
 }
 
-// What the fit misses the rows by, as the LVI residual measures it: the 2-norm of the equality rows' misses and the
-// inequality rows' excesses. An engine stops when ||e(u)||_2 <= tolerance, which needs the rows met to about that,
-// so rows whose best fit misses by more cannot be solved at the tolerance: the rule for `infeasible`.
-double rows_miss(const QpProblem& qp, const Eigen::VectorXd& x) {
-  return std::sqrt((qp.J * x - qp.d).squaredNorm() + (qp.A * x - qp.b).cwiseMax(0.0).squaredNorm());
-}
+// The equality rows' misses J x - d and the inequality rows' excesses max(0, A x - b) at x.
+struct RowMisses {
+  Eigen::VectorXd eq, in;
+  RowMisses(const QpProblem& qp, const Eigen::VectorXd& x) : eq(qp.J * x - qp.d), in((qp.A * x - qp.b).cwiseMax(0.0)) {}
+  // What they come to as the LVI residual measures it, in 2-norm. An engine stops when ||e(u)||_2 <= tolerance,
+  // which needs the rows met to about that, so rows whose best fit misses by more cannot be solved at the
+  // tolerance: the rule for `infeasible`.
+  [[nodiscard]] double norm() const { return std::sqrt(eq.squaredNorm() + in.squaredNorm()); }
+};
 
 // Why the rows cannot be met: the best fit of the rows inside the bounds (best_row_fit), the rows it misses by more
 // than the tolerance, and the joints held at a bound there. Runs only after a failure. *infeasible: the rows miss
@@ -38,14 +41,16 @@ std::string diagnose_rows(const QpProblem& qp, double tolerance, bool* infeasibl
   const int n = qp.n();
   const RowFit fit = best_row_fit(qp);
   const Eigen::VectorXd& x = fit.x;
-  const Eigen::VectorXd eq = qp.J * x - qp.d;
-  const Eigen::VectorXd in = (qp.A * x - qp.b).cwiseMax(0.0);
+  const RowMisses misses(qp, x);
+  const Eigen::VectorXd& eq = misses.eq;
+  const Eigen::VectorXd& in = misses.in;
   const double worst = std::max(fit.equality_miss, fit.inequality_excess);
-  *infeasible = rows_miss(qp, x) > tolerance;
+  const double miss = misses.norm();
+  *infeasible = miss > tolerance;
   std::ostringstream s;
   s.precision(6);
   if (!*infeasible) {
-    s << "the rows can be met inside the bounds (best residual " << worst << ", " << rows_miss(qp, x) << " in 2-norm)";
+    s << "the rows can be met inside the bounds (best residual " << worst << ", " << miss << " in 2-norm)";
     return s.str();
   }
   s << "the constraint rows cannot be met inside the bounds:";
@@ -107,7 +112,7 @@ std::string singular_rows(const QpProblem& qp) {
 }  // namespace
 
 bool LviEngine::rows_unmeetable(const QpProblem& qp) const {
-  return rows_miss(qp, best_row_fit(qp).x) > settings_.tolerance;
+  return RowMisses(qp, best_row_fit(qp).x).norm() > settings_.tolerance;
 }
 
 void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info) const {

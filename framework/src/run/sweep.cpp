@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/input_file.hpp"
+#include "common/text.hpp"
 #include "redres/common/csv.hpp"
 #include "redres/common/error.hpp"
 #include "redres/config/config.hpp"
@@ -336,8 +337,8 @@ Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesy
                                            : "ok";
     diagnosis = run.first_failure;
     if (run.failures == 0 && summary.task_error_exceeded) {
-      diagnosis = "max position error " + std::to_string(summary.max_position_error) +
-                  " m > [solver] max_task_error = " + std::to_string(summary.max_task_error) + " m";
+      diagnosis = "max position error " + num(summary.max_position_error) +
+                  " m > [solver] max_task_error = " + num(summary.max_task_error) + " m";
     }
     nlohmann::json j = nlohmann::json::parse(to_json(summary));
     // (The run's own "status" is the sweep's status column and solver.stopped.)

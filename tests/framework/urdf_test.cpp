@@ -383,6 +383,27 @@ TEST(UrdfBounds, CyclesSelfParentsAndBadValuesAreRefusedNamingTheElement) {
   open_declaration.replace(open_declaration.find("?>"), 2, "\x1f>");
   const std::string hidden = load_error(f, f.write("open.urdf", open_declaration), "base", "tip");
   EXPECT_NE(hidden.find("joint 'loop' has link 'tip' as both its parent and its child"), std::string::npos) << hidden;
+  // The checks read the file as urdfdom does (a fuzz finding, and variants): a second <child> after the first,
+  // which urdfdom ignores, an entity in the name and spaces around '=' hide nothing either.
+  const std::string own = read_text(data_path("urdf/own_parent.urdf"));
+  const std::string self_loop = "<parent link=\"tip\"/><child link=\"tip\"/>";
+  for (const std::string& variant :
+       {std::string("<parent link=\"tip\"/><child link=\"tip\"/>junk\"/><child link=\"base\"/>"),
+        std::string("<parent link=\"tip\"/><child link=\"t&#105;p\"/>"),
+        std::string("<parent link = \"tip\"/><child\n link =\n'tip'/>")}) {
+    SCOPED_TRACE(variant);
+    const std::string text = replace(own, self_loop, variant);
+    ASSERT_NE(text, own);
+    const std::string said = load_error(f, f.write("variant.urdf", text), "base", "tip");
+    EXPECT_NE(said.find("variant.urdf:10: joint 'loop' has link 'tip' as both its parent and its child"),
+              std::string::npos)
+        << said;
+  }
+  // XML that TinyXML cannot read is refused with its line and column.
+  const std::string broken =
+      load_error(f, f.write("broken.urdf", "<robot name=\"r\">\n  <link name=\"a\"></robot>\n"), "a", "b");
+  EXPECT_NE(broken.find("broken.urdf:2:"), std::string::npos) << broken;
+  EXPECT_NE(broken.find("malformed XML ("), std::string::npos) << broken;
   const std::string comment =
       load_error(f, f.write("comment.urdf", "<robot name=\"r\">\n<!-- never closed\n"), "a", "b");
   EXPECT_NE(comment.find("comment.urdf:2: a comment <!-- is not closed (malformed XML)"), std::string::npos) << comment;

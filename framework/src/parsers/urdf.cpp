@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include <console_bridge/console.h>
+#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include "common/input_file.hpp"
@@ -34,10 +35,10 @@ class Collect final : public console_bridge::OutputHandler {
   std::string messages, errors;  // warnings and errors; errors only
 };
 
-// Where each <link> and <joint> of the file starts, by name (for messages), from the bounded scan below.
+// The <robot>'s links and joints as TinyXML reads them (outline_xml): where each starts, by name, for messages.
 struct XmlOutline {
   std::map<std::string, std::size_t> link_lines, joint_lines;
-  // Each top-level <joint>: its name, its <parent link> and <child link>, and its line (the graph urdfdom will
+  // Each <joint>: its name, its <parent link> and <child link>, and its line (the graph urdfdom will
   // build, checked before it does: a cycle of its shared_ptr links leaks, and some it reports only by failing).
   struct Joint {
     std::string name, parent, child;
@@ -47,27 +48,11 @@ struct XmlOutline {
   std::size_t links = 0;
 };
 
-// The value of attribute `key` in the text of a tag's attributes ("" when absent).
-std::string attribute(const std::string& attributes, const std::string& key) {
-  for (const char quote : {'"', '\''}) {
-    const std::string q = key + "=" + quote;
-    for (std::size_t a = attributes.find(q); a != std::string::npos; a = attributes.find(q, a + 1)) {
-      if (a > 0 && !std::isspace(static_cast<unsigned char>(attributes[a - 1]))) continue;
-      const std::size_t b = attributes.find(quote, a + q.size());
-      if (b != std::string::npos) return attributes.substr(a + q.size(), b - a - q.size());
-    }
-  }
-  return {};
-}
-
-// A linear scan of the XML before urdfdom sees it: the nesting depth and the element count are bounded (TinyXML
-// parses recursively, so 50,000 nested elements overflow its stack, and 20,000 take seconds), and each top-level
-// <link> and <joint> is found with its line, and each joint's parent and child. Comments, CDATA, processing
-// instructions and the DOCTYPE are skipped.
-XmlOutline outline_xml(const std::string& where, const std::string& xml) {
-  XmlOutline out;
+// A linear scan of the XML before TinyXML sees it: the nesting depth and the element count are bounded (TinyXML
+// parses recursively, so 50,000 nested elements overflow its stack, and 20,000 take seconds). Comments, CDATA,
+// processing instructions and the DOCTYPE are skipped.
+void bound_xml(const std::string& where, const std::string& xml) {
   std::size_t line = 1, depth = 0, elements = 0;
-  bool in_joint = false;  // inside a top-level <joint>
   const std::size_t n = xml.size();
   // Moves i to just past `end` (counting lines); false if the file ends first.
   const auto skip_to = [&](std::size_t& i, std::string_view end) {
@@ -78,8 +63,9 @@ XmlOutline outline_xml(const std::string& where, const std::string& xml) {
     i = stop;
     return at != std::string::npos;
   };
-  // A construct that the file does not close is malformed XML: refused here, so that nothing the scan did not see
-  // reaches urdfdom (TinyXML is lenient). Declarations and <!...> end at the first '>', as TinyXML ends them.
+  // A construct that the file does not close is malformed XML: refused here, so that the depth counted is the
+  // depth TinyXML will recurse to (it is lenient). Declarations and <!...> end at the first '>', as TinyXML ends
+  // them.
   std::size_t opened = 1;  // the line of the construct being read
   const auto unclosed = [&](const std::string& what) {
     throw UrdfError(where + ":" + std::to_string(opened) + ": " + what + " is not closed (malformed XML)");
@@ -99,7 +85,6 @@ XmlOutline outline_xml(const std::string& where, const std::string& xml) {
       if (!skip_to(i, ">")) unclosed("a declaration");
     } else if (xml.compare(i, 2, "</") == 0) {
       if (depth > 0) --depth;
-      if (depth < 2) in_joint = false;
       if (!skip_to(i, ">")) unclosed("an end tag");
     } else {
       const std::size_t start_line = line;
@@ -107,7 +92,6 @@ XmlOutline outline_xml(const std::string& where, const std::string& xml) {
       while (k < n && !std::isspace(static_cast<unsigned char>(xml[k])) && xml[k] != '>' && xml[k] != '/') ++k;
       const std::string tag = xml.substr(i + 1, k - i - 1);
       // The attributes up to the closing '>' (one outside quotes).
-      std::string name;
       char quote = 0;
       std::size_t end = k;
       for (; end < n && (quote != 0 || xml[end] != '>'); ++end) {
@@ -129,23 +113,37 @@ XmlOutline outline_xml(const std::string& where, const std::string& xml) {
                         std::to_string(depth) + " elements deep; a URDF nests at most " +
                         std::to_string(kMaxUrdfDepth));
       }
-      const std::size_t level = empty ? depth + 1 : depth;  // the element's own depth (the root's is 1)
-      if ((tag == "link" || tag == "joint") && level == 2) {
-        const std::string attributes = xml.substr(k, end - k);
-        name = attribute(attributes, "name");
-        (tag == "link" ? out.link_lines : out.joint_lines).emplace(name, start_line);
-        if (tag == "link") {
-          ++out.links;
-        } else {
-          out.joints.push_back({name, "", "", start_line});
-          in_joint = !empty;
-        }
-      } else if (in_joint && level == 3 && (tag == "parent" || tag == "child")) {
-        (tag == "parent" ? out.joints.back().parent : out.joints.back().child) =
-            attribute(xml.substr(k, end - k), "link");
-      }
       i = end + 1;
     }
+  }
+}
+
+// The <robot>'s links and joints as urdfdom will read them: parsed by the TinyXML that urdfdom itself parses with,
+// and walked as urdfdom walks it (the first <robot>; its <link> and <joint> children; each joint's first <parent>
+// and first <child>, their `link` attribute), so that the tree checked below is the graph urdfdom builds, entities,
+// repeated elements and all. The file's bounds are checked first.
+XmlOutline outline_xml(const std::string& where, const std::string& xml) {
+  bound_xml(where, xml);
+  TiXmlDocument doc;
+  doc.Parse(xml.c_str());
+  if (doc.Error()) {
+    throw UrdfError(where + ":" + std::to_string(doc.ErrorRow()) + ":" + std::to_string(doc.ErrorCol()) +
+                    ": malformed XML (" + printable(doc.ErrorDesc() != nullptr ? doc.ErrorDesc() : "") + ")");
+  }
+  XmlOutline out;
+  const TiXmlElement* robot = doc.FirstChildElement("robot");
+  if (robot == nullptr) return out;  // urdfdom reports it
+  const auto text = [](const char* value) { return value != nullptr ? std::string(value) : std::string(); };
+  for (const TiXmlElement* e = robot->FirstChildElement("link"); e != nullptr; e = e->NextSiblingElement("link")) {
+    out.link_lines.emplace(text(e->Attribute("name")), static_cast<std::size_t>(e->Row()));
+    ++out.links;
+  }
+  for (const TiXmlElement* e = robot->FirstChildElement("joint"); e != nullptr; e = e->NextSiblingElement("joint")) {
+    XmlOutline::Joint joint{text(e->Attribute("name")), "", "", static_cast<std::size_t>(e->Row())};
+    if (const TiXmlElement* p = e->FirstChildElement("parent")) joint.parent = text(p->Attribute("link"));
+    if (const TiXmlElement* c = e->FirstChildElement("child")) joint.child = text(c->Attribute("link"));
+    out.joint_lines.emplace(joint.name, joint.line);
+    out.joints.push_back(std::move(joint));
   }
   return out;
 }

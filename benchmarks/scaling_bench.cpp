@@ -1,7 +1,8 @@
-// Time per control step against the number of joints, for each engine: planar chains of 3 to 48 joints and spatial
+// Time per control step against the number of joints, for each engine: planar chains of 3 to 192 joints and spatial
 // chains of 7 to 28 (an iiwa-like module repeated), with the TVCMM scheme (min velocity norm, det manipulability
 // with p = 1, task tracking with K = 8, joint-angle margin, velocity limits) following a 2 cm circle for 100 steps
-// of 10 ms from a bent configuration. BM_Scaling/<engine>/<planar|spatial>/<n>; per_step is the time per step (s).
+// of 10 ms from a bent configuration. BM_Scaling/<engine>/<planar|spatial>/<n>; per_step is the time per step (s),
+// iterations_per_step the engine's iterations per step.
 
 #include <cmath>
 #include <numbers>
@@ -63,6 +64,7 @@ void BM_Scaling(benchmark::State& state, const char* engine_name, bool planar) {
   const Eigen::VectorXd start = k.f;
   Eigen::VectorXd theta(n), r_d = start, r_d_dot = Eigen::VectorXd::Zero(start.size());
   int failures = 0;
+  long iterations = 0;
   for (auto _ : state) {
     theta = robot.home();
     ctrl.reset();
@@ -74,6 +76,7 @@ void BM_Scaling(benchmark::State& state, const char* engine_name, bool planar) {
       r_d_dot(1) = 0.02 * 2.0 * std::numbers::pi / T * std::cos(a);
       ctrl.step(theta, s * tau, r_d, r_d_dot, out);
       failures += out.info.status == SolverStatus::kSolved ? 0 : 1;
+      iterations += out.info.iterations;
       theta += tau * out.theta_dot;
     }
     benchmark::DoNotOptimize(theta.data());
@@ -81,10 +84,12 @@ void BM_Scaling(benchmark::State& state, const char* engine_name, bool planar) {
   state.counters["per_step"] =
       benchmark::Counter(steps, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["failed_steps"] = failures;
+  state.counters["iterations_per_step"] =
+      benchmark::Counter(static_cast<double>(iterations) / steps, benchmark::Counter::kAvgIterations);
 }
 
 void planar_sizes(benchmark::internal::Benchmark* b) {
-  for (int n : {3, 6, 12, 24, 48}) b->Arg(n);
+  for (int n : {3, 6, 12, 24, 48, 96, 192}) b->Arg(n);
 }
 void spatial_sizes(benchmark::internal::Benchmark* b) {
   for (int n : {7, 14, 28}) b->Arg(n);

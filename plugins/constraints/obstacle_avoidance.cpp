@@ -160,9 +160,13 @@ void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder, PluginDat
   auto A = builder.inequality_matrix();
   auto b = builder.inequality_rhs();
   const auto& links = robot_->link_shapes();
+  data.distances.start();  // every pair beyond d_i until measured: far pairs cost nothing
   if (pooled_) {
     data.used = data.dropped = 0;
     std::fill(data.row_pair.begin(), data.row_pair.end(), -1);
+  }
+  // Rows start slack (at most max_rows: the rows are shared past that); near pairs write theirs below.
+  if (pooled_ || broadphase_) {
     for (int r = 0; r < rows_; ++r) slack_row(A.row(r), b(r));
   }
   if (broadphase_) {
@@ -236,14 +240,7 @@ void ObstacleAvoidance::add_near_pairs(Data& data, const Context& ctx, QpBuilder
   for (int l = 0; l < links_; ++l) {
     const auto& shape = links[static_cast<std::size_t>(l)];
     const Eigen::Isometry3d Tl = kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose;
-    // Every pair of this link shape is beyond d_i unless the tree says otherwise.
-    for (int o = 0; o < obstacles_; ++o) {
-      const int pair = o * links_ + l;
-      data.distances.beyond(pair);
-      if (pooled_) continue;
-      for (int r = first_row_[static_cast<std::size_t>(pair)]; r < first_row_[static_cast<std::size_t>(pair) + 1]; ++r)
-        slack_row(A.row(r), b(r));
-    }
+    // The pairs the tree does not return are beyond d_i: their distance reads +inf and their rows stay slack.
     const int count = data.query.near(l, Tl, data.distances.damper().influence_distance, data.candidates.data());
     for (int k = 0; k < count; ++k) {
       const int o = data.candidates[static_cast<std::size_t>(k)] - links_;

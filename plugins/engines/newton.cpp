@@ -52,7 +52,7 @@ void Newton::do_setup(int n, int m_e, int m_i) {
   inv_w_.setZero(n);
   w_diag_.setZero(n);
   dv_.setZero(n);
-  breaks_.assign(2 * static_cast<std::size_t>(n), 0.0);
+  events_.assign(2 * static_cast<std::size_t>(n), {0.0, 0.0});
   y_.setZero(m_e);
   F_.setZero(m_e);
   delta_.setZero(m_e);
@@ -60,9 +60,14 @@ void Newton::do_setup(int n, int m_e, int m_i) {
   G_.setZero(m_e, m_e);
   L_.setZero(m_e, m_e);
   const int N = n + m_e + m_i;
-  M_.setZero(N, N);
-  K_.setZero(N, N);
-  lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(N);
+  free_x_.assign(static_cast<std::size_t>(n), 0);
+  free_w_.assign(static_cast<std::size_t>(m_e + m_i), 0);
+  bt_.setZero(n, m_e + m_i);
+  yt_.setZero(n, m_e + m_i);
+  wff_.setZero(n, n);
+  s_kkt_.setZero(m_e + m_i, m_e + m_i);
+  w_.setZero(m_e + m_i);
+  h_.setZero(n);
   u_.setZero(N);
   mu_.setZero(N);
   e_.setZero(N);

@@ -16,11 +16,11 @@
 #include <algorithm>
 #include <memory>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <Eigen/LU>
 
 #include "redres/engines/newton.hpp"
 
@@ -68,7 +68,6 @@ class Newton final : public LviEngine {
   Reduced reduced_iterate(const QpProblem& qp, int& k, double& f2);
 
   // newton_line_search.cpp (exact_step instantiated for kRows = 0 and 2)
-  double slope_at(const QpProblem& qp, double s) const;
   template <int kRows>
   double exact_step(const QpProblem& qp);
 
@@ -84,6 +83,7 @@ class Newton final : public LviEngine {
   double target_at(const Eigen::VectorXd& w) const;
   bool exact_step_lands(const QpProblem& qp, double& e2);
   double natural_residual2(const QpProblem& qp, const Eigen::VectorXd& w);
+  void apply_m(const QpProblem& qp, const Eigen::VectorXd& w, Eigen::VectorXd& out) const;
 
   // newton_multipliers.cpp
   double excess(int r, double s) const;
@@ -94,13 +94,16 @@ class Newton final : public LviEngine {
   Eigen::VectorXd v_, x_, y_, F_, delta_, row_scale_, jtd_, dv_, inv_w_, w_diag_, x1_, v1_, F1_;
   bool full_step_ready_ = false;
   std::vector<char> free_;
-  std::vector<double> breaks_;
+  std::vector<std::pair<double, double>> events_;  // the line search's breakpoints: (s, change of slope)
   Eigen::MatrixXd G_, L_;
-  // The general path: u = [x; y; z], M, the Newton matrix K and its LU, the natural map's pieces, Omega's bounds.
-  Eigen::MatrixXd M_, K_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  // The general path: u = [x; y; z], the natural map's pieces (M u + g, e), Omega's bounds, the exact step du and
+  // its right-hand side; the exact step's free joints and free duals by index, B' (free joints x free duals),
+  // W_FF^-1 B', W_FF's factor, the Schur complement S and its unknowns w, and W_FF^-1 r_x.
   Eigen::VectorXd u_, mu_, e_, rhs_, du_, lo_u_, hi_u_;
   Eigen::VectorXd trial_;
+  std::vector<int> free_x_, free_w_;
+  Eigen::MatrixXd bt_, yt_, wff_, s_kkt_;
+  Eigen::VectorXd w_, h_;
   // The method of multipliers: rows C (as C'), their intervals, penalties, multipliers, s = C x + lambda / rho, C dx;
   // x, the gradient, the Newton step and the Hessian of the augmented Lagrangian, and its Cholesky factor.
   Eigen::MatrixXd Ct_;  // the rows c_r as columns

@@ -1,5 +1,6 @@
 /// `newton`'s general path (newton.cpp) on the whole LVI u = [x; y; z]: M and Omega, the natural map's residual,
-/// the exact step through the dense KKT-like system (I - D + D M) du = -e, and the accuracy it is held to.
+/// the exact step (I - D + D M) du = -e through the Schur complement of its live rows, and the accuracy it is held
+/// to.
 
 #include <algorithm>
 #include <cmath>
@@ -28,12 +29,6 @@ namespace redres::newton_internal {
 bool Newton::general_solve(const QpProblem& qp, SolverResult& result) {
   const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
   const double varpi = settings().varpi;
-  // M's blocks that hold data are written here; the zero block [y; z] x [y; z] stays as setup left it.
-  M_.topLeftCorner(n, n) = qp.W;
-  M_.block(0, n, n, me) = -qp.J.transpose();
-  M_.block(0, n + me, n, mi) = qp.A.transpose();
-  M_.block(n, 0, me, n) = qp.J;
-  M_.block(n + me, 0, mi, n) = -qp.A;
   lo_u_.head(n) = qp.lo;
   hi_u_.head(n) = qp.hi;
   lo_u_.segment(n, me).setConstant(-varpi);
@@ -110,24 +105,132 @@ double Newton::target_at(const Eigen::VectorXd& w) const {
   return std::min(settings().tolerance, 1e-12 * (1.0 + terms));
 }
 
-// Step 1 of general_solve() from u_ (natural_residual2(u_) just computed, so mu_ and e_ hold its values): on
-// landing (||e|| <= target_at() there), moves u_ to u_ + du, leaves ||e||^2 in e2 and returns true.
-bool Newton::exact_step_lands(const QpProblem& qp, double& e2) {
-  const Eigen::Index N = u_.size();
-  for (Eigen::Index i = 0; i < N; ++i) {
-    const double v = u_(i) - mu_(i);
-    if (v > lo_u_(i) && v < hi_u_(i)) {
-      K_.row(i) = M_.row(i);
-      rhs_(i) = -mu_(i);
-    } else {
-      K_.row(i).setZero();
-      K_(i, i) = 1.0;
-      rhs_(i) = -e_(i);
+namespace {
+
+// The lower Cholesky factor of the m x m symmetric matrix at `a` (column-major, leading dimension lda; its lower
+// triangle is read and overwritten) in place. False if a pivot is not clearly positive (below 1e-12 of its diagonal
+// entry, or of `scale`): the matrix is singular to working accuracy.
+bool cholesky_in_place(double* a, Eigen::Index lda, Eigen::Index m, double scale) {
+  for (Eigen::Index c = 0; c < m; ++c) {
+    double* col = a + c * lda;
+    const double entry = col[c];
+    double diag = entry;
+    for (Eigen::Index k = 0; k < c; ++k) diag -= a[c + k * lda] * a[c + k * lda];
+    if (!(diag > 1e-12 * std::max(std::abs(entry), scale))) return false;
+    const double l = std::sqrt(diag);
+    col[c] = l;
+    for (Eigen::Index r = c + 1; r < m; ++r) {
+      double t = col[r];
+      for (Eigen::Index k = 0; k < c; ++k) t -= a[r + k * lda] * a[c + k * lda];
+      col[r] = t / l;
     }
   }
-  lu_.compute(K_);
-  if (!(std::abs(lu_.matrixLU().diagonal().prod()) > 0.0)) return false;  // singular: no step
-  du_.noalias() = lu_.solve(rhs_);
+  return true;
+}
+
+// Solves L L' v = v in place with the factor of cholesky_in_place().
+void cholesky_solve(const double* a, Eigen::Index lda, Eigen::Index m, double* v) {
+  for (Eigen::Index r = 0; r < m; ++r) {
+    double t = v[r];
+    for (Eigen::Index k = 0; k < r; ++k) t -= a[r + k * lda] * v[k];
+    v[r] = t / a[r + r * lda];
+  }
+  for (Eigen::Index r = m - 1; r >= 0; --r) {
+    double t = v[r];
+    for (Eigen::Index k = r + 1; k < m; ++k) t -= a[k + r * lda] * v[k];
+    v[r] = t / a[r + r * lda];
+  }
+}
+
+}  // namespace
+
+// Step 1 of general_solve() from u_ (natural_residual2(u_) just computed, so mu_ and e_ hold its values): on
+// landing (||e|| <= target_at() there), moves u_ to u_ + du, leaves ||e||^2 in e2 and returns true.
+//
+// The step solves (I - D + D M) du = -e, where D selects the components of u - (M u + g) strictly inside Omega
+// (free), without forming it: a clamped component moves to its bound (du_c = -e_c), and a free one's row of
+// M du = -(M u + g) holds. With F the free joints and w the free duals (y, and z of the live inequality rows),
+// that is the KKT system
+//   W_FF dx_F - B' w = r_x,   B dx_F = r_w,     B = [J_F; -A_F] (the free duals' rows),
+// whose right-hand sides carry the clamped components' moves. It is solved through the Schur complement in w:
+// S = B W_FF^-1 B', S w = r_w - B W_FF^-1 r_x, dx_F = W_FF^-1 (r_x + B' w). Its size is that of the live rows, not
+// of all of them: slack inequality rows (z = 0 on its bound) never enter it. Storage is sized at setup.
+bool Newton::exact_step_lands(const QpProblem& qp, double& e2) {
+  const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
+  const Eigen::Index N = u_.size();
+  // The clamped components' moves in du_ (zero at the free ones), the free joints and duals by index.
+  int nf = 0, k = 0;
+  for (Eigen::Index i = 0; i < N; ++i) {
+    const double v = u_(i) - mu_(i);
+    const bool is_free = v > lo_u_(i) && v < hi_u_(i);
+    du_(i) = is_free ? 0.0 : -e_(i);
+    if (!is_free) continue;
+    if (i < n) {
+      free_x_[static_cast<std::size_t>(nf++)] = static_cast<int>(i);
+    } else {
+      free_w_[static_cast<std::size_t>(k++)] = static_cast<int>(i - n);
+    }
+  }
+  if (k > nf) return false;  // more live rows than free joints: B has no full row rank
+  // rhs = -(M u + g) - M du_c, read at the free components.
+  apply_m(qp, du_, rhs_);
+  rhs_ = -mu_ - rhs_;
+  const double* __restrict W = qp.W.data();
+  const double* __restrict J = qp.J.data();
+  const double* __restrict A = qp.A.data();
+  // B' in bt_ (nf x k): column c is row free_w_[c] of [J; -A] at the free joints.
+  for (int c = 0; c < k; ++c) {
+    const int r = free_w_[static_cast<std::size_t>(c)];
+    double* col = bt_.data() + static_cast<std::ptrdiff_t>(c) * bt_.rows();
+    for (int f = 0; f < nf; ++f) {
+      const std::ptrdiff_t j = free_x_[static_cast<std::size_t>(f)];
+      col[f] = r < me ? J[r + j * me] : -A[(r - me) + j * mi];
+    }
+  }
+  // Y = W_FF^-1 B' (in yt_) and h = W_FF^-1 r_x (in h_).
+  for (int f = 0; f < nf; ++f) h_(f) = rhs_(free_x_[static_cast<std::size_t>(f)]);
+  if (qp.w_diagonal) {
+    for (int f = 0; f < nf; ++f) {
+      const std::ptrdiff_t j = free_x_[static_cast<std::size_t>(f)];
+      const double iw = 1.0 / W[j * (n + 1)];
+      h_(f) *= iw;
+      for (int c = 0; c < k; ++c) yt_(f, c) = bt_(f, c) * iw;
+    }
+  } else {
+    for (int b = 0; b < nf; ++b) {
+      for (int a = b; a < nf; ++a) {
+        wff_(a, b) = W[free_x_[static_cast<std::size_t>(a)] +
+                       static_cast<std::ptrdiff_t>(free_x_[static_cast<std::size_t>(b)]) * n];
+      }
+    }
+    if (!cholesky_in_place(wff_.data(), wff_.rows(), nf, 0.0)) return false;
+    cholesky_solve(wff_.data(), wff_.rows(), nf, h_.data());
+    for (int c = 0; c < k; ++c) {
+      for (int f = 0; f < nf; ++f) yt_(f, c) = bt_(f, c);
+      cholesky_solve(wff_.data(), wff_.rows(), nf, yt_.data() + static_cast<std::ptrdiff_t>(c) * yt_.rows());
+    }
+  }
+  // S = B Y (lower triangle) and its right-hand side r_w - B h.
+  double scale = 0.0;
+  for (int c = 0; c < k; ++c) {
+    for (int r = c; r < k; ++r) {
+      double t = 0.0;
+      for (int f = 0; f < nf; ++f) t += bt_(f, r) * yt_(f, c);
+      s_kkt_(r, c) = t;
+    }
+    scale = std::max(scale, s_kkt_(c, c));
+    double t = rhs_(n + free_w_[static_cast<std::size_t>(c)]);
+    for (int f = 0; f < nf; ++f) t -= bt_(f, c) * h_(f);
+    w_(c) = t;
+  }
+  if (!cholesky_in_place(s_kkt_.data(), s_kkt_.rows(), k, scale)) return false;  // the live rows are dependent
+  cholesky_solve(s_kkt_.data(), s_kkt_.rows(), k, w_.data());
+  for (int f = 0; f < nf; ++f) {
+    double t = h_(f);
+    for (int c = 0; c < k; ++c) t += yt_(f, c) * w_(c);
+    du_(free_x_[static_cast<std::size_t>(f)]) = t;
+  }
+  for (int c = 0; c < k; ++c) du_(n + free_w_[static_cast<std::size_t>(c)]) = w_(c);
   if (!du_.allFinite()) return false;
   trial_ = u_ + du_;
   const double landed = natural_residual2(qp, trial_);
@@ -137,10 +240,21 @@ bool Newton::exact_step_lands(const QpProblem& qp, double& e2) {
   return true;
 }
 
+// out = M w: [W x - J' y + A' z; J x; -A x] for w = [x; y; z] (no temporaries).
+void Newton::apply_m(const QpProblem& qp, const Eigen::VectorXd& w, Eigen::VectorXd& out) const {
+  const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
+  out.head(n).noalias() = qp.W * w.head(n);
+  out.head(n).noalias() -= qp.J.transpose() * w.segment(n, me);
+  out.head(n).noalias() += qp.A.transpose() * w.tail(mi);
+  out.segment(n, me).noalias() = qp.J * w.head(n);
+  out.tail(mi).noalias() = qp.A * w.head(n);
+  out.tail(mi) = -out.tail(mi);
+}
+
 // ||e(w)||^2 of the natural map at w; leaves M w + g in mu_ and e(w) in e_.
 double Newton::natural_residual2(const QpProblem& qp, const Eigen::VectorXd& w) {
   const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
-  mu_.noalias() = M_ * w;
+  apply_m(qp, w, mu_);
   mu_.head(n) += qp.zeta;
   mu_.segment(n, me) -= qp.d;
   mu_.tail(mi) += qp.b;

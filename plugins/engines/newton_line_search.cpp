@@ -5,20 +5,11 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <utility>
 
 #include "newton_internal.hpp"
 
 namespace redres::newton_internal {
-
-// phi'(s) along y + s delta: -delta . F(y + s delta) = sum_i -(J' delta)_i x_i(s) + delta . d, with
-// x_i(s) = P(v_i + s dv_i); piecewise linear and nonincreasing in s.
-double Newton::slope_at(const QpProblem& qp, double s) const {
-  double out = delta_.dot(qp.d);
-  for (int i = 0; i < qp.n(); ++i) {
-    out -= jtd_(i) * box(v_(i) + s * dv_(i), qp.lo(i), qp.hi(i));
-  }
-  return out;
-}
 
 // The exact maximiser of the concave, piecewise quadratic phi along delta (phi' is piecewise linear between the
 // breakpoints where some v_i crosses a bound). Returns +inf when phi' stays positive for ever: the dual is then
@@ -77,29 +68,48 @@ double Newton::exact_step(const QpProblem& qp) {
     }
     if (g1 <= 0.0) return step;  // the root lies inside [0, 1]
   }
+  // The walk along the breakpoints. Joint i is free (x_i = v_i + s dv_i) on an interval (a_i, b_i) of s, where
+  // it adds -jtd_i dv_i = -jtd_i^2 / W_ii <= 0 to the slope of phi'; elsewhere x_i is constant. So phi' is linear
+  // between breakpoints, with a slope c that changes by that amount where a joint enters or leaves its interval:
+  // the events, in a heap (O(n) to build, O(log n) per event taken, and the walk stops at the root), so that the
+  // search is O(n + k log n) for k events passed, not O(n^2).
   int count = 0;
+  double c = 0.0, c_tail = 0.0;  // the slope just after s = 0; the slope beyond every breakpoint (exact)
+  const auto later = [](const std::pair<double, double>& p, const std::pair<double, double>& q) {
+    return p.first > q.first;
+  };
   for (int i = 0; i < n; ++i) {
-    if (dv_(i) == 0.0) continue;
-    for (const double bound : {qp.lo(i), qp.hi(i)}) {
-      const double s = (bound - v_(i)) / dv_(i);
-      if (std::isfinite(s) && s > 0.0) breaks_[static_cast<std::size_t>(count++)] = s;
+    const double dvi = dv[i];
+    if (dvi == 0.0) continue;
+    const double slope = -jtd_out[i] * dvi;
+    double enter = (lo[i] - v[i]) / dvi, leave = (hi[i] - v[i]) / dvi;
+    if (dvi < 0.0) std::swap(enter, leave);
+    if (!(leave > enter)) continue;  // lo == hi: never free
+    if (enter <= 0.0 && leave > 0.0) c += slope;
+    if (enter > 0.0 && std::isfinite(enter)) events_[static_cast<std::size_t>(count++)] = {enter, slope};
+    if (leave > 0.0 && std::isfinite(leave)) events_[static_cast<std::size_t>(count++)] = {leave, -slope};
+    if (leave == std::numeric_limits<double>::infinity()) c_tail += slope;
+  }
+  const auto first = events_.begin(), last = events_.begin() + count;
+  std::make_heap(first, last, later);
+  double s0 = 0.0, g_prev = g0;
+  for (auto end = last; end != first;) {
+    const std::pair<double, double> event = *first;
+    std::pop_heap(first, end, later);
+    --end;
+    const double s1 = event.first;
+    if (s1 > s0) {
+      const double g_next = g_prev + c * (s1 - s0);
+      if (g_next <= 0.0) return s0 + (s1 - s0) * g_prev / (g_prev - g_next);  // root of the linear piece
+      s0 = s1;
+      g_prev = g_next;
     }
+    c += event.second;
   }
-  std::sort(breaks_.begin(), breaks_.begin() + count);
-  double s0 = 0.0;
-  double g_prev = g0;
-  for (int k = 0; k <= count; ++k) {
-    // Beyond the last breakpoint phi' is linear for ever; probe it one unit further.
-    const double s1 = k < count ? breaks_[static_cast<std::size_t>(k)] : s0 + std::max(1.0, s0);
-    if (s1 <= s0) continue;
-    const double g_next = slope_at(qp, s1);
-    if (g_next <= 0.0) return s0 + (s1 - s0) * g_prev / (g_prev - g_next);  // root of the linear piece
-    if (k == count && !(g_next < g_prev * (1.0 - 1e-12))) return std::numeric_limits<double>::infinity();
-    if (k == count) return s1 + (s1 - s0) * g_next / (g_prev - g_next);
-    s0 = s1;
-    g_prev = g_next;
-  }
-  return s0;
+  // Beyond the last breakpoint phi' is linear for ever with the exact slope c_tail (a sum of terms <= 0, no
+  // cancellation): where it does not fall by more than rounding over max(1, s0), phi grows for ever.
+  if (!(-c_tail * std::max(1.0, s0) > 1e-12 * g_prev)) return std::numeric_limits<double>::infinity();
+  return s0 + g_prev / -c_tail;
 }
 
 template double Newton::exact_step<0>(const QpProblem& qp);

@@ -158,6 +158,41 @@ RC_GTEST_PROP(LviProperty, NewtonSolvesManyInequalityRowsExactly, ()) {
   }
 }
 
+// Long chains (96 and 192 joints, 2 or 6 rows, diagonal W) with zeta large enough that a third to two thirds of the
+// joints end on a bound: newton's reduced path walks many breakpoints in its line search, cold and warm (the next
+// problem's zeta moved, so that tens of joints change side between solves). newton itself meets the KKT conditions
+// to 1e-10 and agrees with projection (eq. 15, an independent iteration; SLSQP stops round-off limited at this size)
+// at every solve.
+TEST(Lvi, NewtonSolvesLongChainsWithManyBoundsActive) {
+  for (const int n : {96, 192}) {
+    for (const int m_e : {2, 6}) {
+      SCOPED_TRACE("n = " + std::to_string(n) + ", m_e = " + std::to_string(m_e));
+      std::mt19937 rng(static_cast<unsigned>(n + m_e));
+      testing::RandomQp rq = random_qp(rng, n, m_e, 0, false);
+      SolverSettings settings;
+      settings.tolerance = 1e-8;
+      const std::unique_ptr<LviEngine> engine = make_engine("newton", settings);
+      SolverResult result;
+      engine->setup(n, m_e, 0, result);
+      std::normal_distribution<double> kick(0.0, 1.0);
+      for (int solve = 0; solve < 6; ++solve) {
+        for (int i = 0; i < n; ++i) rq.qp.zeta(i) = 3.0 * kick(rng);
+        engine->solve(rq.qp, result);
+        ASSERT_EQ(result.info.status, SolverStatus::kSolved) << result.info.diagnosis;
+        EXPECT_EQ(result.info.engine, "newton");
+        EXPECT_LE(kkt_residual(rq.qp, result), 1e-10);
+        int on_bound = 0;
+        for (int i = 0; i < n; ++i) on_bound += result.x(i) <= rq.qp.lo(i) || result.x(i) >= rq.qp.hi(i) ? 1 : 0;
+        EXPECT_GE(on_bound, n / 3) << "the family is meant to have many bounds active";
+        const Solved other =
+            solve_with("projection", rq.qp, SolverSettings{.tolerance = 1e-10, .max_iterations = 1000000});
+        ASSERT_EQ(other.result.info.status, SolverStatus::kSolved) << other.result.info.diagnosis;
+        EXPECT_LE((other.result.x - result.x).cwiseAbs().maxCoeff(), 1e-7);
+      }
+    }
+  }
+}
+
 // A bound's multiplier is not a dual of the LVI (Omega clips x, the multiplier is eliminated), so it may exceed varpi:
 // a joint that no row involves, pushed against its bound by zeta = -3e6 while the rows' duals stay small, is solved
 // by newton itself (a bound multiplier of 3e6 > varpi = 1e6).

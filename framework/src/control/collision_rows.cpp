@@ -23,12 +23,23 @@ void point_jacobian(const RobotModel& robot, const KinematicsData& kin, int link
 }
 
 PairDistances::PairDistances(int pairs, Damper damper)
-    : distance_(static_cast<std::size_t>(pairs), std::numeric_limits<double>::infinity()), damper_(damper) {}
+    : distance_(static_cast<std::size_t>(pairs), std::numeric_limits<double>::infinity()), damper_(damper) {
+  measured_.reserve(static_cast<std::size_t>(pairs));
+}
+
+void PairDistances::start() {
+  for (const int p : measured_) distance_[static_cast<std::size_t>(p)] = std::numeric_limits<double>::infinity();
+  measured_.clear();
+}
 
 bool PairDistances::take(int row, const ShapeDistance& d, bool planar, const Eigen::Vector3d& fallback,
                          Eigen::Vector3d& n) {
   const double distance = d.ok ? d.distance : std::numeric_limits<double>::quiet_NaN();
-  distance_[static_cast<std::size_t>(row)] = distance;
+  double& slot = distance_[static_cast<std::size_t>(row)];
+  // A pair reading +inf is not in the list yet (the list holds each pair once, so it never outgrows its reserve).
+  if (slot == std::numeric_limits<double>::infinity() && measured_.size() < measured_.capacity())
+    measured_.push_back(row);
+  slot = distance;
   failures_ += d.ok ? 0 : 1;  // FCL failed on this pair (rare; near-touching boxes): its row stays slack
   return d.ok && distance <= damper_.influence_distance && witness_normal(d, planar, fallback, n);
 }
@@ -42,7 +53,8 @@ void check_damper(double influence_distance, double safety_distance) {
 }
 
 bool PairDistances::violated() const {
-  for (double d : distance_) {
+  for (const int p : measured_) {
+    const double d = distance_[static_cast<std::size_t>(p)];
     if (d < 0.0 || std::isnan(d)) return true;  // NaN: not measured, so it may overlap
   }
   return false;
@@ -51,27 +63,32 @@ bool PairDistances::violated() const {
 std::string PairDistances::describe_violation(const std::function<std::string(int)>& describe_row) const {
   const int w = worst();
   if (distance_[static_cast<std::size_t>(w)] < 0.0) return "in collision: " + describe_row(w);
-  for (std::size_t r = 0; r < distance_.size(); ++r) {
-    if (std::isnan(distance_[r])) {
-      return "cannot measure the distance (the shapes may overlap; FCL failed on the pair): " +
-             describe_row(static_cast<int>(r));
-    }
+  int failed = -1;
+  for (const int p : measured_) {
+    if (std::isnan(distance_[static_cast<std::size_t>(p)]) && (failed < 0 || p < failed)) failed = p;
+  }
+  if (failed >= 0) {
+    return "cannot measure the distance (the shapes may overlap; FCL failed on the pair): " + describe_row(failed);
   }
   return {};
 }
 
 int PairDistances::worst() const {
-  std::size_t w = 0;
-  for (std::size_t r = 0; r < distance_.size(); ++r) {
-    if (std::isnan(distance_[w]) || distance_[r] < distance_[w]) w = r;  // NaN: an FCL failure
+  int w = -1;
+  for (const int p : measured_) {
+    const double d = distance_[static_cast<std::size_t>(p)];
+    if (std::isnan(d)) continue;  // an FCL failure
+    const double dw = w < 0 ? 0.0 : distance_[static_cast<std::size_t>(w)];
+    if (w < 0 || d < dw || (d == dw && p < w)) w = p;
   }
-  return static_cast<int>(w);
+  return w < 0 ? 0 : w;
 }
 
 void PairDistances::record(double* values) const {
   double low = std::numeric_limits<double>::infinity();
   int active = 0;
-  for (double d : distance_) {
+  for (const int p : measured_) {
+    const double d = distance_[static_cast<std::size_t>(p)];
     if (std::isnan(d)) continue;
     low = std::min(low, d);
     active += d <= damper_.influence_distance ? 1 : 0;

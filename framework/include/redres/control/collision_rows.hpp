@@ -45,22 +45,27 @@ class PairDistances {
   /// `pairs` rows held by `damper`.
   PairDistances(int pairs, Damper damper);
 
+  /// Starts a contribution: every pair reads as beyond d_i (+inf) until it is measured again. Costs the pairs
+  /// measured at the last contribution, not all of them, so that far pairs a broadphase rules out cost nothing.
+  /// (A constraint that measures every pair at every contribution need not call it.)
+  void start();
   /// Records pair `row`'s query (an FCL failure as NaN, counted) and finds its normal (witness_normal(), with
   /// `fallback`). Returns whether the pair gets a damper row: the query worked, the pair is within d_i and the normal
   /// is defined; otherwise the caller writes a slack row.
   bool take(int row, const ShapeDistance& d, bool planar, const Eigen::Vector3d& fallback, Eigen::Vector3d& n);
-  /// Records pair `row` as beyond d_i without measuring it (a broadphase ruled it out): distance +inf.
+  /// Records pair `row` as beyond d_i without measuring it: distance +inf (what start() does for every pair).
   void beyond(int row) { distance_[static_cast<std::size_t>(row)] = std::numeric_limits<double>::infinity(); }
   /// The damper the pairs are held by.
   [[nodiscard]] const Damper& damper() const noexcept { return damper_; }
-  /// Pair `row`'s distance at the last contribution.
+  /// Pair `row`'s distance at the last contribution (+inf: not measured, beyond d_i).
   [[nodiscard]] double operator[](int row) const { return distance_[static_cast<std::size_t>(row)]; }
   /// A pair overlaps, or could not be measured (it may overlap).
   [[nodiscard]] bool violated() const;
   /// "in collision: <the worst pair>", or "cannot measure the distance ...: <the pair>" (describe_row(row) names a
   /// pair); empty when nothing is violated.
   [[nodiscard]] std::string describe_violation(const std::function<std::string(int)>& describe_row) const;
-  /// The pair with the smallest distance (FCL failures skipped).
+  /// The pair with the smallest distance (FCL failures skipped; the lowest index among equals; 0 when none was
+  /// measured).
   [[nodiscard]] int worst() const;
   /// Writes the smallest distance and the number of pairs within d_i (two values).
   void record(double* values) const;
@@ -69,6 +74,8 @@ class PairDistances {
 
  private:
   std::vector<double> distance_;
+  // The pairs whose distance is not +inf (each once; sized for every pair at construction): what the scans read.
+  std::vector<int> measured_;
   Damper damper_;
   int failures_ = 0;
 };

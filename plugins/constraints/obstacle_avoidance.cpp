@@ -34,7 +34,8 @@ const Schema<ObstacleAvoidanceConfig>& ObstacleAvoidanceConfig::schema() {
        field("safety_distance", &C::safety_distance, "m", "d_s: the distance the damper holds"),
        field("xi", &C::xi, "m/s", "damper gain: the largest approach speed, at d_i", greater(0.0)),
        field("broadphase", &C::broadphase, "",
-             "how pairs are found: auto (FCL's AABB tree above 256 pairs), always, never (brute force)"),
+             "how pairs are found: auto (FCL's AABB tree above 256 pairs, a closed-form cull below), always (the "
+             "tree), never (every pair measured)"),
        field("max_rows", &C::max_rows, "",
              "the most inequality rows: with more pairs, those within d_i share them, the nearest first",
              between<int>(1, 100000))},
@@ -172,11 +173,25 @@ void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder, PluginDat
   if (broadphase_) {
     add_near_pairs(data, ctx, builder);
   } else {
+    // Too few pairs for the tree: each pair is culled by its closed-form lower bound (unless broadphase = "never",
+    // which measures every pair); a culled pair is beyond d_i, its distance reads +inf and its rows are slack.
+    const bool cull = config_.broadphase != Config::Broadphase::kNever;
+    const double within = data.distances.damper().influence_distance;
     for (int o = 0; o < obstacles_; ++o) {
       const Eigen::Isometry3d To = obstacle_pose(o, ctx.t);
       for (int l = 0; l < links_; ++l) {
         const auto& shape = links[static_cast<std::size_t>(l)];
-        pair_row(data, kin, l, kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose, o, To, A, b);
+        const Eigen::Isometry3d Tl = kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose;
+        if (cull && data.query.lower_bound(l, Tl, links_ + o, To) > within) {
+          if (!pooled_) {
+            const int pair = o * links_ + l;
+            for (int r = first_row_[static_cast<std::size_t>(pair)]; r < first_row_[static_cast<std::size_t>(pair) + 1];
+                 ++r)
+              slack_row(A.row(r), b(r));
+          }
+          continue;
+        }
+        pair_row(data, kin, l, Tl, o, To, A, b);
       }
     }
   }

@@ -66,13 +66,19 @@ void SelfCollision::add_to(const Context& ctx, QpBuilder& builder, PluginData* p
   auto A = builder.inequality_matrix();
   auto b = builder.inequality_rhs();
   const auto& links = robot_->link_shapes();
+  data.distances.start();  // a pair whose closed-form lower bound exceeds d_i is beyond d_i: not measured, +inf
+  const double within = data.distances.damper().influence_distance;
   for (std::size_t row = 0; row < pairs_.size(); ++row) {
     const auto& sa = links[static_cast<std::size_t>(pairs_[row].first)];
     const auto& sb = links[static_cast<std::size_t>(pairs_[row].second)];
     const Eigen::Isometry3d Ta = kin.link_frames[static_cast<std::size_t>(sa.link)] * sa.pose;
     const Eigen::Isometry3d Tb = kin.link_frames[static_cast<std::size_t>(sb.link)] * sb.pose;
-    const ShapeDistance d = data.query.distance(pairs_[row].first, Ta, pairs_[row].second, Tb);
     const auto r = static_cast<Eigen::Index>(row);
+    if (data.query.lower_bound(pairs_[row].first, Ta, pairs_[row].second, Tb) > within) {
+      slack_row(A.row(r), b(r));
+      continue;
+    }
+    const ShapeDistance d = data.query.distance(pairs_[row].first, Ta, pairs_[row].second, Tb);
     Eigen::Vector3d n;
     if (!data.distances.take(static_cast<int>(row), d, planar, Ta.translation() - Tb.translation(), n)) {
       slack_row(A.row(r), b(r));

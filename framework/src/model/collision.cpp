@@ -5,6 +5,7 @@
 #include "redres/common/error.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -165,51 +166,105 @@ double box_point(const Eigen::Vector3d& q, const Eigen::Vector3d& h, Eigen::Vect
 }
 
 // Signed distance between a sphere or capsule (axis [p0, p1] in the world, radius r) and a box (pose Tb, half sides
-// h): the minimum over the axis of the point-box signed distance, minus r. The signed distance to a box is convex,
-// so that minimum is found by golden-section search. Apart, this is the exact distance. Overlapping, it is the
-// axis-based measure also used for two capsules: exact for a sphere and for a capsule whose axis stays outside the
-// box; when the axis crosses the box it is the depth of the deepest axis point below its nearest face (less than
-// the true penetration), with the normal of that face. Witness points: on the round shape and on the box, with
-// round - box = d u.
+// h): the minimum over the axis of the point-box signed distance, minus r, found exactly. Apart, this is the exact
+// distance. Overlapping, it is the axis-based measure also used for two capsules: exact for a sphere and for a
+// capsule whose axis stays outside the box; when the axis crosses the box it is the depth of the deepest axis point
+// below its nearest face (less than the true penetration), with the normal of that face. Witness points: on the
+// round shape and on the box, with round - box = d u.
+//
+// Along the axis q(s) = q0 + s dq (box frame, s in [0, 1]) the squared distance outside the box is
+// g(s) = sum_k max(0, |q_k(s)| - h_k)^2: convex, and a quadratic between the (at most six) values of s where some
+// q_k(s) crosses +-h_k, so its minimum is the least of the pieces' clamped vertices. Where g reaches 0 the axis
+// touches or enters the box, and the signed distance there is max_k (|q_k(s)| - h_k): the largest of six linear
+// functions, convex, whose minimum lies at an end or where two of them cross (at most fifteen candidates).
 void round_box(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double r, const Eigen::Isometry3d& Tb,
                const Eigen::Vector3d& h, double& d, Eigen::Vector3d& on_round, Eigen::Vector3d& on_box) {
   const Eigen::Isometry3d to_box = Tb.inverse();
-  const Eigen::Vector3d q0 = to_box * p0, q1 = to_box * p1;
-  Eigen::Vector3d c, u;
-  const auto f = [&](double s) { return box_point(q0 + s * (q1 - q0), h, c, u); };
-  double lo = 0.0, hi = 1.0;
-  if ((q1 - q0).squaredNorm() > 0.0) {
-    constexpr double g = 0.6180339887498949;  // (sqrt 5 - 1) / 2
-    double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
-    for (int it = 0; it < 80 && hi - lo > 1e-12; ++it) {
-      if (f1 <= f2) {
-        hi = x2;
-        x2 = x1;
-        f2 = f1;
-        x1 = hi - g * (hi - lo);
-        f1 = f(x1);
-      } else {
-        lo = x1;
-        x1 = x2;
-        f1 = f2;
-        x2 = lo + g * (hi - lo);
-        f2 = f(x2);
+  const Eigen::Vector3d q0 = to_box * p0, dq = to_box * p1 - q0;
+  double best_s = 0.0;
+  if (dq.squaredNorm() > 0.0) {
+    std::array<double, 8> cuts{};
+    int count = 0;
+    cuts[static_cast<std::size_t>(count++)] = 0.0;
+    cuts[static_cast<std::size_t>(count++)] = 1.0;
+    for (int k = 0; k < 3; ++k) {
+      if (dq(k) == 0.0) continue;
+      for (const double side : {-1.0, 1.0}) {
+        const double s = (side * h(k) - q0(k)) / dq(k);
+        if (s > 0.0 && s < 1.0) cuts[static_cast<std::size_t>(count++)] = s;
+      }
+    }
+    for (int i = 1; i < count; ++i) {  // insertion sort of at most 8
+      for (int j = i; j > 0 && cuts[static_cast<std::size_t>(j)] < cuts[static_cast<std::size_t>(j - 1)]; --j)
+        std::swap(cuts[static_cast<std::size_t>(j)], cuts[static_cast<std::size_t>(j - 1)]);
+    }
+    const auto outside2 = [&](double s) {
+      double g = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double e = std::abs(q0(k) + s * dq(k)) - h(k);
+        if (e > 0.0) g += e * e;
+      }
+      return g;
+    };
+    double best_g = outside2(0.0);
+    for (int c = 0; c + 1 < count; ++c) {
+      const double a = cuts[static_cast<std::size_t>(c)], b = cuts[static_cast<std::size_t>(c + 1)];
+      if (!(b > a)) continue;
+      // The piece's quadratic sum_k (c_k + s dq_k)^2 over the axes outside the box at its middle.
+      const double mid = 0.5 * (a + b);
+      double a2 = 0.0, a1 = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double x = q0(k) + mid * dq(k);
+        if (x > h(k) || x < -h(k)) {
+          const double ck = q0(k) - (x > 0.0 ? h(k) : -h(k));
+          a2 += dq(k) * dq(k);
+          a1 += ck * dq(k);
+        }
+      }
+      const double s = a2 > 0.0 ? std::clamp(-a1 / a2, a, b) : b;
+      for (const double t : {s, b}) {
+        const double g = outside2(t);
+        if (g < best_g) {
+          best_g = g;
+          best_s = t;
+        }
+      }
+    }
+    if (!(best_g > 0.0)) {
+      // The axis reaches the box: the deepest point, among the ends and the crossings of the six lines.
+      std::array<double, 6> slope{}, offset{};  // line j: slope s + offset = +-q_k(s) - h_k
+      for (int k = 0; k < 3; ++k) {
+        slope[static_cast<std::size_t>(2 * k)] = dq(k);
+        offset[static_cast<std::size_t>(2 * k)] = q0(k) - h(k);
+        slope[static_cast<std::size_t>(2 * k + 1)] = -dq(k);
+        offset[static_cast<std::size_t>(2 * k + 1)] = -q0(k) - h(k);
+      }
+      const auto inside = [&](double s) {
+        double f = -std::numeric_limits<double>::infinity();
+        for (std::size_t j = 0; j < 6; ++j) f = std::max(f, slope[j] * s + offset[j]);
+        return f;
+      };
+      double best_f = inside(best_s);
+      const auto consider = [&](double s) {
+        if (!(s >= 0.0 && s <= 1.0)) return;
+        const double f = inside(s);
+        if (f < best_f) {
+          best_f = f;
+          best_s = s;
+        }
+      };
+      consider(0.0);
+      consider(1.0);
+      for (std::size_t i = 0; i < 6; ++i) {
+        for (std::size_t j = i + 1; j < 6; ++j) {
+          if (slope[i] != slope[j]) consider((offset[j] - offset[i]) / (slope[i] - slope[j]));
+        }
       }
     }
   }
-  const double s = 0.5 * (lo + hi);
-  // The ends too: the minimum of a convex function on [0, 1] may sit there.
-  double best_s = s, best = f(s);
-  for (const double e : {0.0, 1.0}) {
-    const double v = f(e);
-    if (v < best) {
-      best = v;
-      best_s = e;
-    }
-  }
-  const Eigen::Vector3d q = q0 + best_s * (q1 - q0);
-  best = box_point(q, h, c, u);
-  d = best - r;
+  Eigen::Vector3d c, u;
+  const Eigen::Vector3d q = q0 + best_s * dq;
+  d = box_point(q, h, c, u) - r;
   const Eigen::Vector3d u_world = Tb.linear() * u;
   on_box = Tb * c;
   on_round = Tb * q - r * u_world;
@@ -227,6 +282,7 @@ struct DistanceQuery::Impl {
   std::vector<std::optional<Eigen::Vector3d>> box_half;  // a box's half sides
   std::vector<double> cylinder_radius;                   // a cylinder's radius (0 for other shapes)
   std::vector<double> cylinder_half;                     // a cylinder's half length
+  std::vector<double> bound;                             // the radius of the ball about the centre that holds it
 
   // The point of shape k (at T) nearest to the world point `w`: exact, closed form, in the shape's frame.
   [[nodiscard]] Eigen::Vector3d project(std::size_t k, const Eigen::Isometry3d& T, const Eigen::Vector3d& w) const {
@@ -324,6 +380,10 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
     const bool cyl = s.shape == ShapeSpec::Kind::kCylinder;
     impl_->cylinder_radius.push_back(cyl ? radius : 0.0);
     impl_->cylinder_half.push_back(cyl ? 0.5 * *s.length : 0.0);
+    double bound = radius + impl_->round.back().half_length;  // a sphere or capsule
+    if (impl_->box_half.back()) bound = impl_->box_half.back()->norm();
+    if (cyl) bound = std::hypot(radius, 0.5 * *s.length);
+    impl_->bound.push_back(bound * (1.0 + 1e-12));  // rounding never culls a pair within reach
     std::shared_ptr<fcl::CollisionGeometryd> geometry;
     switch (s.shape) {
       case ShapeSpec::Kind::kSphere: geometry = std::make_shared<fcl::Sphered>(radius); break;
@@ -454,13 +514,22 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
   out.distance = r.min_distance;
   out.point_a = r.nearest_points[0];
   out.point_b = r.nearest_points[1];
-  impl_->polish(static_cast<std::size_t>(a), Ta, static_cast<std::size_t>(b), Tb, out);
+  // Spheres and capsules are measured in closed form by FCL (exact to rounding); GJK's answers are polished.
+  if (!impl_->round[static_cast<std::size_t>(a)].round || !impl_->round[static_cast<std::size_t>(b)].round)
+    impl_->polish(static_cast<std::size_t>(a), Ta, static_cast<std::size_t>(b), Tb, out);
   return out;
 }
 
 Eigen::Vector3d DistanceQuery::nearest_point(int k, const Eigen::Isometry3d& T, const Eigen::Vector3d& w) const {
   REDRES_REQUIRE(k >= 0 && k < size(), "DistanceQuery::nearest_point", "0 <= shape < size()");
   return impl_->project(static_cast<std::size_t>(k), T, w);
+}
+
+double DistanceQuery::lower_bound(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb) const {
+  const auto ka = static_cast<std::size_t>(a), kb = static_cast<std::size_t>(b);
+  const double from_a = (Ta.translation() - impl_->project(kb, Tb, Ta.translation())).norm() - impl_->bound[ka];
+  const double from_b = (Tb.translation() - impl_->project(ka, Ta, Tb.translation())).norm() - impl_->bound[kb];
+  return std::max(from_a, from_b);
 }
 
 void DistanceQuery::build_broadphase(int first, int count) {

@@ -1,0 +1,74 @@
+// The control step of every shipped scenario (configs/*.toml), with its tail: each run steps a Controller made from
+// the scenario through the states of the scenario's own kinematic run, in order (so the warm start sees what it
+// sees in `redres run`), timing each step with steady_clock; after all runs, each step's time is the minimum over
+// the runs (the machine's noise drops out; what is left is the step's own cost), and the counters give
+//   per_step  the mean of those minima (s)     p99_9  their 99.9th percentile (s)     max  their largest (s)
+// BM_ScenarioStep/<scenario> (the paper's configs, the Panda's, the iiwa's, ...). The ratio that issue 24 names:
+// panda_table_pole against panda_helix.
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "redres/control/controller.hpp"
+#include "redres/run/simulation.hpp"
+#include "test_util.hpp"
+
+namespace redres {
+namespace {
+
+void BM_ScenarioStep(benchmark::State& state, const std::string& name) {
+  Scenario s = load_scenario(source_path("configs/" + name + ".toml"));
+  const RunResult run = simulate(s);
+  const std::size_t steps = run.trajectory.size();
+  std::vector<Eigen::VectorXd> thetas;
+  std::vector<double> times;
+  for (std::size_t r = 0; r < steps; ++r) {
+    thetas.push_back(recorded_theta(*s.robot, run.trajectory, r));
+    times.push_back(run.trajectory.at(r, "t"));
+  }
+  const auto controller = Controller::from_scenario(s);
+  StepOutput out = controller->make_output();
+  std::vector<double> best(steps, 1e300);
+  for (auto _ : state) {
+    controller->reset();
+    for (std::size_t r = 0; r < steps; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      controller->step(thetas[r], times[r], out);
+      const auto stop = std::chrono::steady_clock::now();
+      benchmark::DoNotOptimize(out.theta_dot.data());
+      best[r] = std::min(best[r], std::chrono::duration<double>(stop - start).count());
+    }
+  }
+  std::vector<double> sorted = best;
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0.0;
+  for (const double b : sorted) sum += b;
+  const auto at = [&](double q) { return sorted[std::min(steps - 1, static_cast<std::size_t>(q * (steps - 1) + 0.5))]; };
+  state.counters["per_step"] = sum / static_cast<double>(steps);
+  state.counters["p99_9"] = at(0.999);
+  state.counters["max"] = sorted.back();
+  state.counters["steps"] = static_cast<double>(steps);
+}
+
+// Every scenario of configs/ (sorted by name), registered before main() runs.
+const bool registered = [] {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(source_path("configs"))) {
+    if (entry.path().extension() == ".toml") names.push_back(entry.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  for (const std::string& name : names) {
+    benchmark::RegisterBenchmark(("BM_ScenarioStep/" + name).c_str(), BM_ScenarioStep, name)
+        ->Iterations(5)
+        ->Unit(benchmark::kMillisecond);
+  }
+  return true;
+}();
+
+}  // namespace
+}  // namespace redres

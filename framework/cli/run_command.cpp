@@ -66,7 +66,12 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet,
   (void)write_run(*o.scenario.robot, o.run, o.summary, out, record);
   if (!quiet) {
     const RunSummary& s = o.summary;
-    std::cout << std::setprecision(4) << s.name << ": " << s.steps << " steps of " << s.tau << " s, engine "
+    // A run that ended early (stopped at a failed step, or interrupted) says how far it came.
+    const std::size_t rows = o.run.trajectory.size();
+    const long taken = rows > 0 ? static_cast<long>(rows) - 1 : 0;
+    std::cout << std::setprecision(4) << s.name << ": ";
+    if (s.status != "complete") std::cout << s.status << " after " << taken << " of ";
+    std::cout << s.steps << " steps of " << s.tau << " s, engine "
               << s.solver.engine << ", max position error " << s.max_position_error << " m, w "
               << s.manipulability.initial << " -> " << s.manipulability.final << ", " << s.solver.failures
               << " failed steps, " << s.wall_time_s << " s -> " << out.string() << "\n";

@@ -19,6 +19,7 @@
 
 #include "commands.hpp"
 #include "progress.hpp"
+#include "redres/common/output_file.hpp"
 #include "redres/run/run_output.hpp"
 #include "redres/run/sweep.hpp"
 #include "stop_signals.hpp"
@@ -101,6 +102,10 @@ int run(const SweepOptions& o) {
   with_runs.write_runs = spec.write_runs || o.runs;
   const SweepShard shard = shard_of(o);
   prepare_output_dir(o.out);
+  // The table's own names too, before the first variation: a sweep is never run only to be refused at its end.
+  for (const char* ext : {".csv", ".json"}) {
+    require_replaceable(std::filesystem::path(o.out) / (table_name(shard) + ext), "--out: redres cannot write");
+  }
   const auto start = std::chrono::steady_clock::now();
   SweepTable table;
   {

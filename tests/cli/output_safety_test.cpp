@@ -63,6 +63,24 @@ TEST(OutputSafety, ASymbolicLinkWhereARunWritesIsRefusedBeforeTheRunAndItsTarget
   std::filesystem::remove_all(dir);
 }
 
+// A sweep's table names are checked before its first variation runs: a link there costs nothing but the message
+// (the sweep is never run only to be refused at its end).
+TEST(OutputSafety, ASymbolicLinkWhereASweepWritesIsRefusedBeforeItRuns) {
+  const auto dir = scratch("out_sweep_symlink");
+  std::filesystem::create_directories(dir / "out");
+  std::ofstream(dir / "victim.txt") << "keep";
+  for (const char* name : {"sweep.csv", "sweep.json"}) {
+    std::filesystem::create_symlink(dir / "victim.txt", dir / "out" / name);
+    const Cli r = redres("sweep tests/data/sweeps/small.toml --quiet --out '" + (dir / "out").string() + "'");
+    EXPECT_EQ(r.code, 2) << name << ": " << r.out;
+    EXPECT_NE(r.out.find(std::string(name) + " is a symbolic link"), std::string::npos) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "runs")) << "no variation ran";
+    EXPECT_EQ(read_text(dir / "victim.txt"), "keep") << name;
+    std::filesystem::remove(dir / "out" / name);
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(OutputSafety, StagedFilesAreCreatedExclusivelyAndNeverThroughALink) {
   const auto dir = scratch("staged_file");
   std::filesystem::create_directories(dir);
@@ -110,6 +128,44 @@ TEST(OutputSafety, APlantedOrHandWrittenManifestDeletesNothing) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(read_text(dir / "out" / "notes.txt"), "mine");
   EXPECT_EQ(read_text(dir / "out" / "data.csv"), "mine too");
+  std::filesystem::remove_all(dir);
+}
+
+// A manifest that carries the file's own stamp, as anyone who can stat it could write, deletes it only when the
+// manifest is this user's own and no one else can write it: one others may write (or, run as root, one another
+// user owns, as in a sticky shared directory) is not trusted, and a file another user owns is never removed.
+TEST(OutputSafety, AManifestOthersCouldHaveWrittenDeletesNothing) {
+  const auto dir = scratch("out_manifest_owner");
+  const auto out = dir / "out";
+  std::filesystem::create_directories(out);
+  std::ofstream(out / "precious.txt") << "mine";
+  const auto plant = [&] {
+    const auto st = stamp_of(out / "precious.txt");
+    std::filesystem::remove(out / ".redres-outputs");
+    std::ofstream(out / ".redres-outputs") << "precious.txt\t" << st.size << "\t" << st.mtime_ns << "\t" << st.inode
+                                           << "\n";
+  };
+  plant();
+  ASSERT_EQ(::chmod((out / ".redres-outputs").c_str(), 0666), 0);
+  Cli r = redres(fast_run_args(out));
+  EXPECT_EQ(read_text(out / "precious.txt"), "mine") << r.out;
+  if (::geteuid() == 0) {
+    plant();
+    ASSERT_EQ(::chown((out / ".redres-outputs").c_str(), 65534, 65534), 0);
+    r = redres(fast_run_args(out));
+    EXPECT_EQ(read_text(out / "precious.txt"), "mine") << r.out;
+    ASSERT_EQ(::chown((out / "precious.txt").c_str(), 65534, 65534), 0);
+    plant();  // this user's manifest, but the file is another user's
+    r = redres(fast_run_args(out));
+    EXPECT_EQ(read_text(out / "precious.txt"), "mine") << r.out;
+    ASSERT_EQ(::chown((out / "precious.txt").c_str(), 0, 0), 0);
+  }
+  // The same manifest, this user's alone, over this user's file: it names the file as redres's, and the file goes
+  // (what the stamp is for: a stale output of an earlier run).
+  plant();
+  r = redres(fast_run_args(out));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(out / "precious.txt"));
   std::filesystem::remove_all(dir);
 }
 

@@ -86,6 +86,39 @@ TEST(SweepLimits, MoreJobsThanTheSystemGivesThreadsRunOnTheThreadsItGets) {
   std::filesystem::remove_all(dir);
 }
 
+// A variation that runs out of memory (std::bad_alloc, as under ulimit -v with many jobs) is not a row saying so,
+// nor the end of the process: its thread stops taking work and the variation runs again, alone, once the others
+// are done, so the table is the one a sweep with memory to spare writes. One that runs out of memory even alone is
+// an error row that says so. (The test plugin's objective throws on its first N contributions.)
+TEST(SweepLimits, AVariationThatRunsOutOfMemoryRunsAgainAloneAndTheTableIsTheSame) {
+  const auto dir = scratch("sweep_memory");
+  std::filesystem::create_directories(dir);
+  std::string text = read_text(source_path("configs/paper_r_fast.toml"));
+  const std::size_t robot = text.find("\"../robots/");
+  ASSERT_NE(robot, std::string::npos);
+  text.replace(robot, 11, "\"" + source_path("robots").string() + "/");
+  text = "plugins = [\"" + std::string(REDRES_TEST_PLUGIN_MEMORY) + "\"]\n" + text +
+         "\n[[objectives]]\ntype = \"test_out_of_memory\"\n";
+  std::ofstream(dir / "scenario.toml") << text;
+  std::ofstream(dir / "sweep.toml") << "name = \"memory\"\nscenario = \"" << (dir / "scenario.toml").string()
+                                    << "\"\n[[vary]]\nkey = \"path.rotation_deg\"\nvalues = [180, 0, 200, 190, 170, 185]\n";
+  const std::string sweep = "sweep '" + (dir / "sweep.toml").string() + "' --quiet --out '";
+  const Cli want = redres(sweep + (dir / "a").string() + "' --jobs 2");
+  ASSERT_LE(want.code, 1) << want.out;
+  const Cli got = redres_env("REDRES_TEST_OUT_OF_MEMORY=3 ", sweep + (dir / "b").string() + "' --jobs 4");
+  EXPECT_EQ(got.code, want.code) << got.out;
+  EXPECT_EQ(read_text(dir / "b" / "sweep.csv"), read_text(dir / "a" / "sweep.csv"));
+  // Out of memory at every try: every row an error that says so, and the process ends normally (exit 1).
+  const Cli none = redres_env("REDRES_TEST_OUT_OF_MEMORY=1000000 ", sweep + (dir / "c").string() + "' --jobs 4");
+  EXPECT_EQ(none.code, 1) << none.out;
+  const std::string table = read_text(dir / "c" / "sweep.csv");
+  std::size_t rows = 0;
+  for (std::size_t at = table.find("out of memory"); at != std::string::npos; at = table.find("out of memory", at + 1))
+    ++rows;
+  EXPECT_EQ(rows, 6U) << table;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(SweepLimits, MergeRefusesTablesOfDifferentSweeps) {
   const auto dir = scratch("sweep_mix");
   const auto a = sweep_file(dir, "mix", "[[vary]]\nkey = \"objectives.1.p\"\nvalues = [1.0, 2.0]\n");

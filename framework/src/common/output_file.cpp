@@ -156,8 +156,13 @@ FileStamp stamp_of(const std::filesystem::path& file) {
   return s;
 }
 
+bool owned_by_me_alone(const std::filesystem::path& file) {
+  struct stat st {};
+  return ::lstat(file.c_str(), &st) == 0 && st.st_uid == ::geteuid() && (st.st_mode & (S_IWGRP | S_IWOTH)) == 0;
+}
+
 bool remove_if_unchanged(const std::filesystem::path& file, const FileStamp& expected) {
-  if (!expected.exists) return false;
+  if (!expected.exists || !owned_by_me_alone(file)) return false;
   const FileStamp now = stamp_of(file);
   if (!(now == expected)) return false;
   return ::unlink(file.c_str()) == 0;

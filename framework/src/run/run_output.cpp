@@ -122,6 +122,9 @@ std::vector<ManifestEntry> read_manifest(const std::filesystem::path& dir) {
   std::vector<ManifestEntry> entries;
   const std::filesystem::path file = dir / kOutputManifest;
   if (!stamp_of(file).exists) return entries;  // missing, or not a regular file (a link is never followed)
+  // A manifest is trusted only when this user wrote it and no one else can change it: in a directory others may
+  // write to (a sticky /tmp, say), another user could plant one naming this user's files with their stamps.
+  if (!owned_by_me_alone(file)) return entries;
   std::string text;
   try {
     text = read_input_file(file, "output manifest", std::uintmax_t{1} << 20);

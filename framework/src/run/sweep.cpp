@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <new>
 #include <random>
 #include <sstream>
 #include <system_error>
@@ -308,8 +309,8 @@ void flatten(const nlohmann::json& j, const std::string& key, Cells& out) {
   }
 }
 
-Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesystem::path& out_dir,
-                    std::mutex& load_lock, const std::atomic<bool>* stop) {
+// The cells that name variation v: its index, its value on each axis and its theta0.
+Cells variation_cells(const SweepSpec& spec, const Variation& v) {
   Cells cells;
   cells.emplace_back("index", std::to_string(v.index));
   for (std::size_t a = 0; a < spec.axes.size(); ++a) cells.emplace_back(spec.axes[a].key, cell_text(v.values[a]));
@@ -318,6 +319,12 @@ Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesy
       cells.emplace_back("theta0_" + std::to_string(j + 1), shortest((*v.theta0)(j)));
     }
   }
+  return cells;
+}
+
+Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesystem::path& out_dir,
+                    std::mutex& load_lock, const std::atomic<bool>* stop) {
+  Cells cells = variation_cells(spec, v);
   std::string status = "error", diagnosis;
   Cells figures;
   try {
@@ -344,6 +351,8 @@ Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesy
     // (The run's own "status" is the sweep's status column and solver.stopped.)
     for (const char* skip : {"wall_time_s", "source", "robot", "obstacles", "name", "status"}) j.erase(skip);
     flatten(j, "", figures);
+  } catch (const std::bad_alloc&) {
+    throw;  // not the variation's fault: run_sweep runs it again, alone
   } catch (const std::exception& e) {
     diagnosis = e.what();
   }
@@ -526,13 +535,25 @@ SweepTable run_sweep(const SweepSpec& spec, const SweepShard& shard, unsigned jo
   std::atomic<std::size_t> next{0};
   std::size_t done = 0;
   std::mutex load_lock, progress_lock;
+  const auto stopped = [stop] { return stop != nullptr && stop->load(std::memory_order_relaxed); };
+  const auto run_one = [&](std::size_t k) {
+    rows[k] = run_variation(spec, variation(spec, mine[k]), out_dir, load_lock, stop);
+    const std::lock_guard<std::mutex> guard(progress_lock);
+    ++done;
+    if (progress) progress(done, mine.size());
+  };
+  // A thread whose variation runs out of memory stops taking work: its row stays empty, to be run again below,
+  // alone, once the other threads have finished and given their memory back (the sweep runs on the memory it gets,
+  // with the same table).
   const auto work = [&] {
     for (std::size_t k = next++; k < mine.size(); k = next++) {
-      if (stop != nullptr && stop->load(std::memory_order_relaxed)) return;  // the rows not started stay empty
-      rows[k] = run_variation(spec, variation(spec, mine[k]), out_dir, load_lock, stop);
-      const std::lock_guard<std::mutex> guard(progress_lock);
-      ++done;
-      if (progress) progress(done, mine.size());
+      if (stopped()) return;  // the rows not started stay empty
+      try {
+        run_one(k);
+      } catch (const std::bad_alloc&) {
+        rows[k].clear();
+        return;
+      }
     }
   };
   if (jobs == 0) jobs = std::max(1U, std::thread::hardware_concurrency());
@@ -545,6 +566,16 @@ SweepTable run_sweep(const SweepSpec& spec, const SweepShard& shard, unsigned jo
   }
   work();
   for (auto& t : pool) t.join();
+  for (std::size_t k = 0; k < mine.size() && !stopped(); ++k) {
+    if (!rows[k].empty()) continue;
+    try {
+      run_one(k);
+    } catch (const std::bad_alloc&) {
+      rows[k] = variation_cells(spec, variation(spec, mine[k]));
+      rows[k].emplace_back("status", "error");
+      rows[k].emplace_back("diagnosis", "out of memory: the variation could not run even alone (std::bad_alloc)");
+    }
+  }
   rows.erase(std::remove_if(rows.begin(), rows.end(), [](const Cells& c) { return c.empty(); }), rows.end());
   return to_table(rows);
 }

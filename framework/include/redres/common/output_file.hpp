@@ -70,8 +70,13 @@ struct FileStamp {
 };
 [[nodiscard]] FileStamp stamp_of(const std::filesystem::path& file);
 
-/// Removes `file` only when it is a regular file (not a symbolic link) whose stamp is `expected`: a file that was
-/// replaced, edited or planted since redres wrote it stays. Returns whether it was removed.
+/// Whether `file` (not followed if a link) belongs to this process's user and neither its group nor others may
+/// write it.
+[[nodiscard]] bool owned_by_me_alone(const std::filesystem::path& file);
+
+/// Removes `file` only when it is a regular file (not a symbolic link) of this user's, that only this user may
+/// write, whose stamp is `expected`: a file that was replaced, edited or planted since redres wrote it stays.
+/// Returns whether it was removed.
 bool remove_if_unchanged(const std::filesystem::path& file, const FileStamp& expected);
 
 /// A new directory only this user can enter (mode 0700), under the system's temporary directory, named

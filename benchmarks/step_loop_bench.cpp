@@ -84,8 +84,8 @@ void BM_PaperRun_RedresNoRecord(benchmark::State& state) {
 BENCHMARK_CAPTURE(BM_PaperRun_Baseline, in_loop, true)->Name("BM_PaperRun/baseline")->Unit(benchmark::kMillisecond);
 // Whole processes, timed by the wall clock around std::system: the baseline program writing its CSV (t, theta,
 // theta_dot, w) against `redres run` of the same run writing its outputs (trajectory.csv with every column,
-// summary.json, scenario.toml).
-void BM_Process(benchmark::State& state, const char* which) {
+// summary.json, scenario.toml), or `extra` arguments' (the binary trajectory; no trajectory at all).
+void BM_Process(benchmark::State& state, const char* which, const char* extra = "") {
   const std::string dir = "/tmp/redres_bench_process_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
   const std::string cmd =
@@ -93,7 +93,7 @@ void BM_Process(benchmark::State& state, const char* which) {
           ? std::string("'") + REDRES_BASELINE_PROCESS + "' '" + dir + "/baseline.csv' 0.001 > /dev/null"
           : std::string("cd '") + REDRES_SOURCE_DIR + "' && '" + REDRES_CLI +
                 "' run configs/paper_r_tvcmm.toml --set step=0.001 --set solver.engine=newton --out '" + dir +
-                "/run' --quiet";
+                "/run' --quiet " + extra;
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
     const int status = std::system(cmd.c_str());
@@ -104,6 +104,14 @@ void BM_Process(benchmark::State& state, const char* which) {
 }
 BENCHMARK_CAPTURE(BM_Process, baseline, "baseline")->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(BM_Process, redres_run, "redres_run")->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(BM_Process, redres_run_hdf5, "redres_run", "--format hdf5")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+BENCHMARK_CAPTURE(BM_Process, redres_run_record_none, "redres_run", "--record none")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 BENCHMARK_CAPTURE(BM_PaperRun_Baseline, table, false)
     ->Name("BM_PaperRun/baseline_path_table")

@@ -52,9 +52,36 @@ except ImportError as e:
     sys.exit(EXIT_MISSING_LIBRARY)
 
 
+def read_table(run_dir, name):
+    """The run's table `name` ("trajectory" or "frames") as a structured array with named columns: from NAME.csv, or,
+    for a run recorded with --format hdf5, from trajectory.h5's dataset NAME (h5py). None when the run has neither."""
+    csv = os.path.join(run_dir, name + ".csv")
+    if os.path.exists(csv):
+        # deletechars="": keep column names as written ("<plugin>.<column>" for a second plugin recording a quantity).
+        return np.atleast_1d(np.genfromtxt(csv, delimiter=",", names=True, deletechars=""))
+    h5 = os.path.join(run_dir, "trajectory.h5")
+    if not os.path.exists(h5):
+        return None
+    try:
+        import h5py
+    except ImportError:
+        print(f"plot_run.py: {h5} needs h5py for {sys.executable}: apt-get install python3-h5py", file=sys.stderr)
+        sys.exit(EXIT_MISSING_LIBRARY)
+    with h5py.File(h5, "r") as f:
+        if name not in f:
+            return None
+        values = f[name][:]
+        columns = [c.decode() if isinstance(c, bytes) else str(c) for c in f[name].attrs["columns"]]
+    out = np.zeros(values.shape[0], dtype=[(c, "f8") for c in columns])
+    for k, c in enumerate(columns):
+        out[c] = values[:, k]
+    return out
+
+
 def load(run_dir):
-    # deletechars="": keep column names as written ("<plugin>.<column>" for a second plugin recording a quantity).
-    data = np.genfromtxt(os.path.join(run_dir, "trajectory.csv"), delimiter=",", names=True, deletechars="")
+    data = read_table(run_dir, "trajectory")
+    if data is None:
+        raise SystemExit(f"plot_run.py: no trajectory.csv or trajectory.h5 in {run_dir}")
     with open(os.path.join(run_dir, "summary.json")) as f:
         summary = json.load(f)
     return data, summary
@@ -83,10 +110,9 @@ def load_frames(run_dir, summary):
     """frames.csv as (t, points, rotations): points (rows, n + 2, 3) is the base origin (summary.json's
     robot.base_position), the n joint frames' origins and the end effector; rotations (rows, n, 3, 3) the joint
     frames' rotations. None for a run without the file."""
-    path = os.path.join(run_dir, "frames.csv")
-    if not os.path.exists(path):
+    f = read_table(run_dir, "frames")
+    if f is None:
         return None
-    f = np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True, deletechars=""))
     n = sum(1 for c in f.dtype.names if c.startswith("joint_") and c.endswith("_x"))
     rows = len(f)
     points = np.zeros((rows, n + 2, 3))

@@ -38,6 +38,7 @@ struct RunOptions {
   bool animate = false;
   bool no_plots = false;
   std::string record;  // --record; empty: the scenario's [output] record
+  std::string format;  // --format; empty: the scenario's [output] format
 };
 
 struct Outcome {
@@ -109,8 +110,16 @@ int run_scenario(const RunOptions& options) {
   if (!opts->record.empty()) {
     try {
       record = parse_record(opts->record);
+      record.format = scenario.record.format;
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(std::string("--record: ") + e.what());
+    }
+  }
+  if (!opts->format.empty()) {
+    try {
+      record.format = parse_format(opts->format);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(std::string("--format: ") + e.what());
     }
   }
   if (record.none && (opts->plots || opts->animate || scenario.plots || scenario.animate)) {
@@ -128,7 +137,9 @@ int run_scenario(const RunOptions& options) {
   prepare_output_dir(opts->out);  // before the run, so that a bad --out does not cost the run
   const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet, record);
   if (o.run.interrupted || g_stop_requested.load()) return kExitInterrupted;  // no figures: asked to stop
-  const std::string written = "trajectory.csv, frames.csv and summary.json in " + opts->out;
+  const std::string written = std::string(record.format == TrajectoryFormat::kHdf5 ? "trajectory.h5"
+                                                                                   : "trajectory.csv, frames.csv") +
+                              " and summary.json in " + opts->out;
   const Listing before = list_files(opts->out);
   if (plotter) render_plots(*plotter, {opts->out}, opts->quiet, written);
   if (animator) {
@@ -220,6 +231,9 @@ void add_run_commands(CLI::App& app, Action& action) {
   run->add_option("--record", opts->record,
                   "rows of trajectory.csv: all, every=N (every N-th step and the last), or none (summary.json only); "
                   "the summary always uses every step (default: the scenario's [output] record, else all)");
+  run->add_option("--format", opts->format,
+                  "the recorded tables' file: csv (trajectory.csv, frames.csv) or hdf5 (one trajectory.h5, read with "
+                  "h5py; default: the scenario's [output] format, else csv)");
   run->callback([opts, &action] { action = [opts] { return run_scenario(*opts); }; });
 
   CLI::App* validate =

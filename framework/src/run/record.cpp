@@ -34,4 +34,11 @@ RecordOptions read_record(const TableReader& table, std::string_view key, std::s
   }
 }
 
+TrajectoryFormat parse_format(const std::string& text) {
+  for (const auto& [format, name] : enum_names(TrajectoryFormat{})) {
+    if (text == name) return format;
+  }
+  throw std::invalid_argument("expected \"csv\" or \"hdf5\", got \"" + text + "\"");
+}
+
 }  // namespace redres

@@ -16,6 +16,7 @@
 #include "redres/common/error.hpp"
 #include "redres/common/output_file.hpp"
 #include "redres/model/kinematics.hpp"
+#include "run/hdf5_output.hpp"
 
 namespace redres {
 
@@ -225,7 +226,7 @@ void prepare_output_dir(const std::filesystem::path& dir, const std::string& wha
   } catch (const std::exception& e) {
     throw std::runtime_error(where + "cannot write into the directory (" + e.what() + ")");
   }
-  for (const char* name : {"trajectory.csv", "frames.csv", "summary.json", kOutputManifest}) {
+  for (const char* name : {"trajectory.csv", "frames.csv", "trajectory.h5", "summary.json", kOutputManifest}) {
     require_replaceable(dir / name, what + ": redres cannot write");
   }
 }
@@ -239,7 +240,11 @@ std::vector<std::string> write_run(const RobotModel& robot, const RunResult& run
   // the summary comes last: a reader that finds summary.json finds the complete tables of the same run.
   const std::filesystem::path summary_file = dir / "summary.json";
   std::vector<StagedFile> staged;  // installed in this order, summary.json last
-  if (!record.none) {
+  if (!record.none && record.format == TrajectoryFormat::kHdf5) {
+    const Trajectory frames = joint_frames(robot, run.trajectory);
+    write_hdf5({{"trajectory", &run.trajectory, record.every}, {"frames", &frames, 1}},
+               staged.emplace_back(dir / "trajectory.h5"));
+  } else if (!record.none) {
     write_csv(run.trajectory, staged.emplace_back(dir / "trajectory.csv"), record.every);
     write_csv(joint_frames(robot, run.trajectory), staged.emplace_back(dir / "frames.csv"));
   }

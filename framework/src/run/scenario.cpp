@@ -99,6 +99,16 @@ struct OutputTable {
         {entry<C>("record", "\"all\", \"none\" or \"every=N\"", "", "\"all\"",
                   "which steps trajectory.csv has a row for (every=N: every N-th step and the last)",
                   [](const TableReader& r, C& c) { c.record = read_record(r, "record", "all"); }),
+         entry<C>("format", "\"csv\" or \"hdf5\"", "", "\"csv\"",
+                  "the recorded tables' file: trajectory.csv and frames.csv, or one trajectory.h5 (HDF5)",
+                  [](const TableReader& r, C& c) {
+                    if (!r.has("format")) return;
+                    try {
+                      c.record.format = parse_format(r.string("format"));
+                    } catch (const std::invalid_argument& e) {
+                      r.fail("format", e.what());
+                    }
+                  }),
          field("plots", &C::plots, "", "render the figures with tools/plot_run.py after the run"),
          field("animate", &C::animate, "", "render the animation (animation.mp4, or animation.gif without ffmpeg)")}};
     return s;

@@ -73,8 +73,12 @@ double Newton::exact_step(const QpProblem& qp) {
   // between breakpoints, with a slope c that changes by that amount where a joint enters or leaves its interval:
   // the events, in a heap (O(n) to build, O(log n) per event taken, and the walk stops at the root), so that the
   // search is O(n + k log n) for k events passed, not O(n^2).
+  // phi'(1) = g1 is known exactly, so the walk covers one side of s = 1 only: the events in (0, 1) when the root
+  // lies there (g1 <= 0), else those beyond 1, starting from s = 1 with the slope there.
+  const bool before_one = g1 <= 0.0;
+  const double from = before_one ? 0.0 : 1.0, to = before_one ? 1.0 : std::numeric_limits<double>::infinity();
   int count = 0;
-  double c = 0.0, c_tail = 0.0;  // the slope just after s = 0; the slope beyond every breakpoint (exact)
+  double c = 0.0, c_tail = 0.0;  // the slope just after `from`; the slope beyond every breakpoint (exact)
   const auto later = [](const std::pair<double, double>& p, const std::pair<double, double>& q) {
     return p.first > q.first;
   };
@@ -85,14 +89,14 @@ double Newton::exact_step(const QpProblem& qp) {
     double enter = (lo[i] - v[i]) / dvi, leave = (hi[i] - v[i]) / dvi;
     if (dvi < 0.0) std::swap(enter, leave);
     if (!(leave > enter)) continue;  // lo == hi: never free
-    if (enter <= 0.0 && leave > 0.0) c += slope;
-    if (enter > 0.0 && std::isfinite(enter)) events_[static_cast<std::size_t>(count++)] = {enter, slope};
-    if (leave > 0.0 && std::isfinite(leave)) events_[static_cast<std::size_t>(count++)] = {leave, -slope};
+    if (enter <= from && leave > from) c += slope;
+    if (enter > from && enter < to) events_[static_cast<std::size_t>(count++)] = {enter, slope};
+    if (leave > from && leave < to) events_[static_cast<std::size_t>(count++)] = {leave, -slope};
     if (leave == std::numeric_limits<double>::infinity()) c_tail += slope;
   }
   const auto first = events_.begin(), last = events_.begin() + count;
   std::make_heap(first, last, later);
-  double s0 = 0.0, g_prev = g0;
+  double s0 = from, g_prev = before_one ? g0 : g1;
   for (auto end = last; end != first;) {
     const std::pair<double, double> event = *first;
     std::pop_heap(first, end, later);
@@ -106,6 +110,8 @@ double Newton::exact_step(const QpProblem& qp) {
     }
     c += event.second;
   }
+  // The root lies on the last piece before s = 1, where phi'(1) = g1 <= 0.
+  if (before_one) return g_prev > g1 ? s0 + (1.0 - s0) * g_prev / (g_prev - g1) : s0;
   // Beyond the last breakpoint phi' is linear for ever with the exact slope c_tail (a sum of terms <= 0, no
   // cancellation): where it does not fall by more than rounding over max(1, s0), phi grows for ever.
   if (!(-c_tail * std::max(1.0, s0) > 1e-12 * g_prev)) return std::numeric_limits<double>::infinity();

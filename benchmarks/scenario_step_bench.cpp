@@ -48,7 +48,9 @@ void BM_ScenarioStep(benchmark::State& state, const std::string& name) {
   std::sort(sorted.begin(), sorted.end());
   double sum = 0.0;
   for (const double b : sorted) sum += b;
-  const auto at = [&](double q) { return sorted[std::min(steps - 1, static_cast<std::size_t>(q * (steps - 1) + 0.5))]; };
+  const auto at = [&](double q) {
+    return sorted[std::min(steps - 1, static_cast<std::size_t>(q * (steps - 1) + 0.5))];
+  };
   state.counters["per_step"] = sum / static_cast<double>(steps);
   state.counters["p99_9"] = at(0.999);
   state.counters["max"] = sorted.back();

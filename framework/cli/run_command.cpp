@@ -72,10 +72,9 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet,
     const long taken = rows > 0 ? static_cast<long>(rows) - 1 : 0;
     std::cout << std::setprecision(4) << s.name << ": ";
     if (s.status != "complete") std::cout << s.status << " after " << taken << " of ";
-    std::cout << s.steps << " steps of " << s.tau << " s, engine "
-              << s.solver.engine << ", max position error " << s.max_position_error << " m, w "
-              << s.manipulability.initial << " -> " << s.manipulability.final << ", " << s.solver.failures
-              << " failed steps, " << s.wall_time_s << " s -> " << out.string() << "\n";
+    std::cout << s.steps << " steps of " << s.tau << " s, engine " << s.solver.engine << ", max position error "
+              << s.max_position_error << " m, w " << s.manipulability.initial << " -> " << s.manipulability.final
+              << ", " << s.solver.failures << " failed steps, " << s.wall_time_s << " s -> " << out.string() << "\n";
     if (s.solver.relaxed_steps > 0) {
       std::cout << "  " << s.solver.relaxed_steps << " steps relaxed (rows missed by "
                 << s.solver.max_relaxed_task_error << " at most); first: " << s.solver.first_relaxed << "\n";
@@ -137,9 +136,9 @@ int run_scenario(const RunOptions& options) {
   prepare_output_dir(opts->out);  // before the run, so that a bad --out does not cost the run
   const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet, record);
   if (o.run.interrupted || g_stop_requested.load()) return kExitInterrupted;  // no figures: asked to stop
-  const std::string written = std::string(record.format == TrajectoryFormat::kHdf5 ? "trajectory.h5"
-                                                                                   : "trajectory.csv, frames.csv") +
-                              " and summary.json in " + opts->out;
+  const std::string written =
+      std::string(record.format == TrajectoryFormat::kHdf5 ? "trajectory.h5" : "trajectory.csv, frames.csv") +
+      " and summary.json in " + opts->out;
   const Listing before = list_files(opts->out);
   if (plotter) render_plots(*plotter, {opts->out}, opts->quiet, written);
   if (animator) {

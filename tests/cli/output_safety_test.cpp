@@ -142,8 +142,8 @@ TEST(OutputSafety, AManifestOthersCouldHaveWrittenDeletesNothing) {
   const auto plant = [&] {
     const auto st = stamp_of(out / "precious.txt");
     std::filesystem::remove(out / ".redres-outputs");
-    std::ofstream(out / ".redres-outputs") << "precious.txt\t" << st.size << "\t" << st.mtime_ns << "\t" << st.inode
-                                           << "\n";
+    std::ofstream(out / ".redres-outputs")
+        << "precious.txt\t" << st.size << "\t" << st.mtime_ns << "\t" << st.inode << "\n";
   };
   plant();
   ASSERT_EQ(::chmod((out / ".redres-outputs").c_str(), 0666), 0);

@@ -100,8 +100,9 @@ TEST(SweepLimits, AVariationThatRunsOutOfMemoryRunsAgainAloneAndTheTableIsTheSam
   text = "plugins = [\"" + std::string(REDRES_TEST_PLUGIN_MEMORY) + "\"]\n" + text +
          "\n[[objectives]]\ntype = \"test_out_of_memory\"\n";
   std::ofstream(dir / "scenario.toml") << text;
-  std::ofstream(dir / "sweep.toml") << "name = \"memory\"\nscenario = \"" << (dir / "scenario.toml").string()
-                                    << "\"\n[[vary]]\nkey = \"path.rotation_deg\"\nvalues = [180, 0, 200, 190, 170, 185]\n";
+  std::ofstream(dir / "sweep.toml")
+      << "name = \"memory\"\nscenario = \"" << (dir / "scenario.toml").string()
+      << "\"\n[[vary]]\nkey = \"path.rotation_deg\"\nvalues = [180, 0, 200, 190, 170, 185]\n";
   const std::string sweep = "sweep '" + (dir / "sweep.toml").string() + "' --quiet --out '";
   const Cli want = redres(sweep + (dir / "a").string() + "' --jobs 2");
   ASSERT_LE(want.code, 1) << want.out;

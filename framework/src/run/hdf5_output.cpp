@@ -2,9 +2,9 @@
 
 #include <cstdio>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <vector>
-#include <stdexcept>
 
 #include <hdf5.h>
 
@@ -54,10 +54,10 @@ void write_table(hid_t file, const Hdf5Table& t) {
   }
   const hsize_t dims[2] = {count, width};
   const Handle space(check(H5Screate_simple(2, dims, nullptr), "H5Screate_simple"), H5Sclose);
-  const Handle set(check(H5Dcreate2(file, t.name.c_str(), H5T_IEEE_F64LE, space.id(), H5P_DEFAULT, H5P_DEFAULT,
-                                    H5P_DEFAULT),
-                         "H5Dcreate2"),
-                   H5Dclose);
+  const Handle set(
+      check(H5Dcreate2(file, t.name.c_str(), H5T_IEEE_F64LE, space.id(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+            "H5Dcreate2"),
+      H5Dclose);
   if (count > 0 && width > 0) {
     check_status(H5Dwrite(set.id(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "H5Dwrite");
   }

@@ -23,8 +23,8 @@ inline auto enum_names(TrajectoryFormat) {
 
 /// The rows of trajectory.csv that a run writes.
 struct RecordOptions {
-  std::size_t every = 1;                              //!< keep rows 0, N, 2N, ... and the last
-  bool none = false;                                  //!< write summary.json only (no trajectory, no frames)
+  std::size_t every = 1;                             //!< keep rows 0, N, 2N, ... and the last
+  bool none = false;                                 //!< write summary.json only (no trajectory, no frames)
   TrajectoryFormat format = TrajectoryFormat::kCsv;  //!< trajectory.csv + frames.csv, or trajectory.h5
 };
 

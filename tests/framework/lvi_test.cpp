@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlopt.h>
@@ -409,6 +410,41 @@ TEST(LviRealTime, ProjectionAndNewtonSolvesAllocateNothing) {
     }
     EXPECT_EQ(r.info.status, SolverStatus::kSolved);
     EXPECT_EQ(count, 0) << name << " (scheme build + solve)";
+  }
+}
+
+// The fit behind every `infeasible` and every failure's diagnosis (RowFitter) allocates nothing after setup, on QPs
+// whose rows cannot be met (the rows pulled far outside the bounds) and on QPs whose can, with and without
+// inequality rows; and it fits as best_row_fit does.
+TEST(LviRealTime, TheRowFitAllocatesNothing) {
+  if (!testing::allocation_counting_available()) {
+    GTEST_SKIP() << "AddressSanitizer owns malloc here; the release build runs this check";
+  }
+  std::mt19937 rng(17);
+  for (const int m_i : {0, 6}) {
+    std::vector<testing::RandomQp> family;
+    for (int k = 0; k < 8; ++k) {
+      family.push_back(random_qp(rng, 7, 3, m_i, false));
+      if (k % 2 == 0) family.back().qp.d *= 1e3;  // unmeetable inside the bounds
+      if (m_i > 0 && k % 4 == 1) family.back().qp.b.array() -= 10.0;
+    }
+    RowFitter fitter;
+    fitter.setup(7, 3, m_i);
+    (void)fitter.fit(family.front().qp);  // warm-up
+    long count = 0;
+    double worst = 0.0;
+    for (const auto& rq : family) {
+      double miss = 0.0;
+      {
+        const testing::AllocationCounter counter;
+        miss = fitter.fit(rq.qp).miss_norm();
+        count += counter.count();
+      }
+      const RowFit reference = best_row_fit(rq.qp);
+      worst = std::max(worst, std::abs(miss - reference.miss_norm()));
+    }
+    EXPECT_EQ(count, 0) << "m_i = " << m_i;
+    EXPECT_EQ(worst, 0.0) << "the fitter and best_row_fit are one computation";
   }
 }
 

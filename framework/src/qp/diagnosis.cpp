@@ -1,5 +1,5 @@
 /// The diagnosis of a failed solve (LviEngine::diagnose_failure): the status and the text, from the row fit
-/// (best_row_fit) and the equality rows' singular values.
+/// (RowFitter) and the equality rows' singular values.
 
 #include "redres/qp/lvi.hpp"
 
@@ -8,8 +8,6 @@
 #include <cstddef>
 #include <sstream>
 #include <string>
-
-#include <Eigen/SVD>
 
 #include "redres/qp/row_fit.hpp"
 
@@ -24,28 +22,16 @@ std::string joint_label(const QpProblem& qp, int i) {
   return s;
 }
 
-// The equality rows' misses J x - d and the inequality rows' excesses max(0, A x - b) at x.
-struct RowMisses {
-  Eigen::VectorXd eq, in;
-  RowMisses(const QpProblem& qp, const Eigen::VectorXd& x) : eq(qp.J * x - qp.d), in((qp.A * x - qp.b).cwiseMax(0.0)) {}
-  // What they come to as the LVI residual measures it, in 2-norm. An engine stops when ||e(u)||_2 <= tolerance,
-  // which needs the rows met to about that, so rows whose best fit misses by more cannot be solved at the
-  // tolerance: the rule for `infeasible`.
-  [[nodiscard]] double norm() const { return std::sqrt(eq.squaredNorm() + in.squaredNorm()); }
-};
-
-// Why the rows cannot be met: the best fit of the rows inside the bounds (best_row_fit), the rows it misses by more
+// Why the rows cannot be met: the best fit of the rows inside the bounds (RowFitter), the rows it misses by more
 // than the tolerance, and the joints held at a bound there. Runs only after a failure. *infeasible: the rows miss
 // by more than the tolerance at best, in 2-norm (what the fit minimises).
-std::string diagnose_rows(const QpProblem& qp, double tolerance, bool* infeasible) {
+std::string diagnose_rows(const QpProblem& qp, const RowFit& fit, double tolerance, bool* infeasible) {
   const int n = qp.n();
-  const RowFit fit = best_row_fit(qp);
   const Eigen::VectorXd& x = fit.x;
-  const RowMisses misses(qp, x);
-  const Eigen::VectorXd& eq = misses.eq;
-  const Eigen::VectorXd& in = misses.in;
+  const Eigen::VectorXd& eq = fit.misses;
+  const Eigen::VectorXd& in = fit.excesses;
   const double worst = std::max(fit.equality_miss, fit.inequality_excess);
-  const double miss = misses.norm();
+  const double miss = fit.miss_norm();
   *infeasible = miss > tolerance;
   std::ostringstream s;
   s.precision(6);
@@ -90,9 +76,9 @@ std::string diagnose_rows(const QpProblem& qp, double tolerance, bool* infeasibl
 }
 
 // What the equality rows' singular values say, when they say something: "" for well-conditioned rows.
-std::string singular_rows(const QpProblem& qp) {
+std::string singular_rows(const QpProblem& qp, RowFitter& fitter) {
   if (qp.m_eq() == 0) return {};
-  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(qp.J).singularValues();
+  const Eigen::VectorXd& sv = fitter.equality_singular_values(qp);
   const double largest = sv.size() > 0 ? sv(0) : 0.0;
   int rank = 0;
   for (Eigen::Index k = 0; k < sv.size(); ++k) rank += sv(k) > 1e-9 * largest && sv(k) > 0.0;
@@ -111,17 +97,15 @@ std::string singular_rows(const QpProblem& qp) {
 
 }  // namespace
 
-bool LviEngine::rows_unmeetable(const QpProblem& qp) const {
-  return RowMisses(qp, best_row_fit(qp).x).norm() > settings_.tolerance;
-}
+bool LviEngine::rows_unmeetable(const QpProblem& qp) { return fitter_.fit(qp).miss_norm() > settings_.tolerance; }
 
-void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info) const {
+void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info) {
   // One decision gives both the status and the text: the rows are infeasible exactly when the best fit of the rows
-  // inside the bounds misses them (best_row_fit); otherwise the engine failed on a QP that has a solution, and the
+  // inside the bounds misses them (RowFitter); otherwise the engine failed on a QP that has a solution, and the
   // text says how, with the residual compared to the tolerance only in the direction it holds.
   bool unmeetable = false;
-  const std::string rows = diagnose_rows(qp, settings_.tolerance, &unmeetable);
-  const std::string singular = singular_rows(qp);
+  const std::string rows = diagnose_rows(qp, fitter_.fit(qp), settings_.tolerance, &unmeetable);
+  const std::string singular = singular_rows(qp, fitter_);
   std::ostringstream s;
   s.precision(6);
   if (unmeetable) {

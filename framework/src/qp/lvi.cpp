@@ -51,6 +51,7 @@ void LviEngine::setup(int n, int m_e, int m_i, SolverResult& result) {
   result.info = SolverInfo{};
   result.info.diagnosis.reserve(256);
   warm_ = false;
+  fitter_.setup(n, m_e, m_i);
   do_setup(n, m_e, m_i);
 }
 

@@ -115,8 +115,8 @@ class LviEngine {
   /// Whether the rows of `qp` cannot be met inside its bounds at the settings' tolerance: the best fit of the rows
   /// inside the bounds (best_row_fit) misses them by more than the tolerance in 2-norm (the equality rows' misses
   /// and the inequality rows' excesses), as the LVI residual measures them. The one decision behind every
-  /// `infeasible` status. Allocates; for failed solves only.
-  [[nodiscard]] bool rows_unmeetable(const QpProblem& qp) const;
+  /// `infeasible` status. For failed solves only; the fit allocates nothing (a RowFitter sized by setup()).
+  [[nodiscard]] bool rows_unmeetable(const QpProblem& qp);
 
  protected:
   /// Whether `result` holds a previous solution to start from.
@@ -129,13 +129,14 @@ class LviEngine {
   virtual void do_solve(const QpProblem& qp, SolverResult& result) = 0;
   void check_sizes(const QpProblem& qp, const SolverResult& result) const;
   void run(const QpProblem& qp, SolverResult& result);  // solve() after its checks
-  // The status and the diagnosis of a failed solve, from one decision (best_row_fit); runs only after a failure.
-  void diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info) const;
+  // The status and the diagnosis of a failed solve, from one decision (the row fit); runs only after a failure.
+  void diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info);
 
   SolverSettings settings_;
   bool warm_ = false;
   bool diagnoses_ = true;
   int n_ = 0, m_e_ = 0, m_i_ = 0;
+  RowFitter fitter_;  // the best fit of the rows inside the bounds, for failed solves
 };
 
 /// ||e(u)||_2 of the LVI (eq. 14) at u = [x; y; z].

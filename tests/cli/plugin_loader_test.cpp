@@ -147,6 +147,31 @@ TEST(PluginLoader, UnreadableLibrariesAndOpenSearchDirectoriesAreToldApart) {
       << warned.out;
   const Cli relative = redres_env("cd '" + dir.string() + "' && REDRES_PLUGIN_PATH=open ", "plugins");
   EXPECT_NE(relative.out.find("REDRES_PLUGIN_PATH directory 'open' is relative"), std::string::npos) << relative.out;
+  // A closed directory inside one every user can write (no sticky bit): others can put another in its place.
+  std::filesystem::create_directories(dir / "shared" / "mine");
+  std::filesystem::copy_file(kPlugin, dir / "shared" / "mine" / "libmine.so");
+  std::filesystem::permissions(dir / "shared", std::filesystem::perms::all);
+  std::filesystem::permissions(dir / "shared" / "mine",
+                               std::filesystem::perms::owner_all | std::filesystem::perms::group_read |
+                                   std::filesystem::perms::others_read | std::filesystem::perms::group_exec |
+                                   std::filesystem::perms::others_exec);
+  const Cli inside = redres_env("REDRES_PLUGIN_PATH='" + (dir / "shared" / "mine").string() + "' ", "plugins");
+  EXPECT_EQ(inside.code, 0) << inside.out;
+  EXPECT_NE(inside.out.find("' is inside '" + (dir / "shared").string() + "', which every user can write to"),
+            std::string::npos)
+      << inside.out;
+  // A library file every user can write, named by a scenario: warned about, and still loaded.
+  std::filesystem::create_directories(dir / "closed");
+  std::filesystem::copy_file(kPlugin, dir / "closed" / "libopen.so");
+  std::filesystem::permissions(dir / "closed" / "libopen.so",
+                               std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
+                                   std::filesystem::perms::others_write | std::filesystem::perms::group_read |
+                                   std::filesystem::perms::others_read);
+  const Cli open_file = redres("validate '" + write_scenario(dir / "closed", "[\"libopen.so\"]").string() + "'");
+  EXPECT_EQ(open_file.code, 0) << open_file.out;
+  EXPECT_NE(open_file.out.find("libopen.so' is writable by every user: anyone can change the code redres runs"),
+            std::string::npos)
+      << open_file.out;
   std::filesystem::remove_all(dir);
 }
 

@@ -221,6 +221,18 @@ void warn_if_open(const std::filesystem::path& dir) {
     why = "is relative: libraries are loaded from whatever directory redres runs in";
   } else if (::stat(dir.c_str(), &st) == 0 && (st.st_mode & S_IWOTH) != 0) {
     why = "is writable by every user: anyone can put a library there that redres then runs";
+  } else {
+    // A directory others may rename away (a parent every user can write, without the sticky bit) is as open.
+    for (std::filesystem::path p = dir.parent_path(); !p.empty(); p = p.parent_path()) {
+      struct stat up {};
+      if (::stat(p.c_str(), &up) == 0 && (up.st_mode & S_IWOTH) != 0 && (up.st_mode & S_ISVTX) == 0) {
+        why = "is inside '" + printable(p.string()) +
+              "', which every user can write to (without the sticky bit): anyone can put another directory in its "
+              "place";
+        break;
+      }
+      if (p == p.root_path()) break;
+    }
   }
   if (why.empty() || !warned.insert(dir.string()).second) return;
   std::cerr << "redres: warning: REDRES_PLUGIN_PATH directory '" << printable(dir.string()) << "' " << why << "\n";
@@ -252,6 +264,13 @@ void load_plugin_library(const std::filesystem::path& library, const SourceLocat
   if (ec) fail(where, library, "cannot be resolved: " + ec.message());
   if (std::find(loaded().begin(), loaded().end(), canonical) != loaded().end()) return;
 
+  // A library every user may write is code anyone can change: said once per library.
+  static std::set<std::string> open_files;
+  struct stat st {};
+  if (::stat(canonical.c_str(), &st) == 0 && (st.st_mode & S_IWOTH) != 0 && open_files.insert(canonical).second) {
+    std::cerr << "redres: warning: plugin library '" << printable(canonical.string())
+              << "' is writable by every user: anyone can change the code redres runs\n";
+  }
   const Probe probe = probe_library(canonical);
   if (!probe.ok) fail(where, library, probe.why);
 

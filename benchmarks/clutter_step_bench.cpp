@@ -1,6 +1,6 @@
 // The whole control step (the scheme's build and the solve) of the Panda on its helix (configs/panda_helix.toml)
 // among `count` spheres, `near` of which lie within the influence distance of the arm at its home configuration
-// (the rest out of reach, 2 to 4 m away), for newton and projection:
+// (the rest out of reach, 2 to 4 m away), for each engine (newton, projection, nlopt):
 //   BM_ClutterWholeStep/<engine>/<count>/<near>
 // Each iteration is one Controller::step at one of 8 states of the scene-free run (so the warm start sees
 // neighbouring states). `rows` is the QP's inequality rows (shared rows above obstacle_avoidance's max_rows). The
@@ -77,6 +77,9 @@ BENCHMARK_CAPTURE(BM_ClutterWholeStep, newton, "newton")
     ->ArgsProduct({{10, 100, 1000, 10000}, {0, 4}})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ClutterWholeStep, projection, "projection")
+    ->ArgsProduct({{10, 100, 1000, 10000}, {0, 4}})
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ClutterWholeStep, nlopt, "nlopt")
     ->ArgsProduct({{10, 100, 1000, 10000}, {0, 4}})
     ->Unit(benchmark::kMicrosecond);
 

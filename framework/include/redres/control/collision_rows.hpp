@@ -45,16 +45,14 @@ class PairDistances {
   /// `pairs` rows held by `damper`.
   PairDistances(int pairs, Damper damper);
 
-  /// Starts a contribution: every pair reads as beyond d_i (+inf) until it is measured again. Costs the pairs
-  /// measured at the last contribution, not all of them, so that far pairs a broadphase rules out cost nothing.
-  /// (A constraint that measures every pair at every contribution need not call it.)
+  /// Starts a contribution: every pair reads as beyond d_i (+inf) until it is measured again (a pair the broadphase
+  /// or the cull rules out is never measured). Costs the pairs measured at the last contribution, not all of them,
+  /// so that far pairs cost nothing.
   void start();
   /// Records pair `row`'s query (an FCL failure as NaN, counted) and finds its normal (witness_normal(), with
   /// `fallback`). Returns whether the pair gets a damper row: the query worked, the pair is within d_i and the normal
   /// is defined; otherwise the caller writes a slack row.
   bool take(int row, const ShapeDistance& d, bool planar, const Eigen::Vector3d& fallback, Eigen::Vector3d& n);
-  /// Records pair `row` as beyond d_i without measuring it: distance +inf (what start() does for every pair).
-  void beyond(int row) { distance_[static_cast<std::size_t>(row)] = std::numeric_limits<double>::infinity(); }
   /// The damper the pairs are held by.
   [[nodiscard]] const Damper& damper() const noexcept { return damper_; }
   /// Pair `row`'s distance at the last contribution (+inf: not measured, beyond d_i).

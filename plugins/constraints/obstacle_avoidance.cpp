@@ -167,9 +167,7 @@ void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder, PluginDat
     std::fill(data.row_pair.begin(), data.row_pair.end(), -1);
   }
   // Rows start slack (at most max_rows: the rows are shared past that); near pairs write theirs below.
-  if (pooled_ || broadphase_) {
-    for (int r = 0; r < rows_; ++r) slack_row(A.row(r), b(r));
-  }
+  for (int r = 0; r < rows_; ++r) slack_row(A.row(r), b(r));
   if (broadphase_) {
     add_near_pairs(data, ctx, builder);
   } else {
@@ -182,15 +180,7 @@ void ObstacleAvoidance::add_to(const Context& ctx, QpBuilder& builder, PluginDat
       for (int l = 0; l < links_; ++l) {
         const auto& shape = links[static_cast<std::size_t>(l)];
         const Eigen::Isometry3d Tl = kin.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose;
-        if (cull && data.query.lower_bound(l, Tl, links_ + o, To) > within) {
-          if (!pooled_) {
-            const int pair = o * links_ + l;
-            for (int r = first_row_[static_cast<std::size_t>(pair)]; r < first_row_[static_cast<std::size_t>(pair) + 1];
-                 ++r)
-              slack_row(A.row(r), b(r));
-          }
-          continue;
-        }
+        if (cull && data.query.lower_bound(l, Tl, links_ + o, To) > within) continue;
         pair_row(data, kin, l, Tl, o, To, A, b);
       }
     }

@@ -8,6 +8,8 @@
 
 #include <hdf5.h>
 
+#include "redres/run/record.hpp"
+
 namespace redres {
 
 namespace {
@@ -40,14 +42,12 @@ void check_status(herr_t status, const char* call) {
 void write_table(hid_t file, const Hdf5Table& t) {
   const Trajectory& table = *t.table;
   const std::size_t width = table.width(), rows = table.size();
-  const std::size_t every = t.every == 0 ? 1 : t.every;
   std::vector<double> kept;  // the rows kept, when not every row is
   const double* data = table.values().data();
   std::size_t count = rows;
-  if (every > 1) {
+  if (t.every > 1) {
     for (std::size_t r = 0; r < rows; ++r) {
-      if (r % every != 0 && r + 1 != rows) continue;
-      kept.insert(kept.end(), table.row(r), table.row(r) + width);
+      if (recorded_row(r, rows, t.every)) kept.insert(kept.end(), table.row(r), table.row(r) + width);
     }
     data = kept.data();
     count = width == 0 ? 0 : kept.size() / width;

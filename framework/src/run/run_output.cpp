@@ -34,7 +34,7 @@ void write_csv(const Trajectory& table, StagedFile& file, std::size_t every = 1)
   out += '\n';
   char number[64];
   for (std::size_t r = 0; r < table.size(); ++r) {
-    if (r % every != 0 && r + 1 != table.size()) continue;  // every N-th row, and the last
+    if (!recorded_row(r, table.size(), every)) continue;
     const double* row = table.row(r);
     for (std::size_t c = 0; c < table.width(); ++c) {
       if (c != 0) out += ',';

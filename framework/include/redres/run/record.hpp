@@ -28,6 +28,12 @@ struct RecordOptions {
   TrajectoryFormat format = TrajectoryFormat::kCsv;  //!< trajectory.csv + frames.csv, or trajectory.h5
 };
 
+/// Whether row r of a table of `rows` rows is recorded with RecordOptions::every = `every`: rows 0, N, 2N, ... and
+/// the last (the one rule of trajectory.csv and trajectory.h5).
+[[nodiscard]] inline bool recorded_row(std::size_t r, std::size_t rows, std::size_t every) {
+  return every <= 1 || r % every == 0 || r + 1 == rows;
+}
+
 /// Parses "csv" or "hdf5"; std::invalid_argument saying what is expected otherwise.
 [[nodiscard]] TrajectoryFormat parse_format(const std::string& text);
 

@@ -153,6 +153,9 @@ def link_shape_poses(summary, rotations_k, points_k):
 
 def bounding_radius(shape):
     kind = shape["shape"]
+    if kind in ("points", "octree"):
+        cells = np.array(shape.get("cells", [[0.0, 0.0, 0.0, 0.0]]), dtype=float).reshape(-1, 4)
+        return float(np.max(np.linalg.norm(cells[:, :3], axis=1) + cells[:, 3])) + shape.get("radius", 0.0)
     if kind == "sphere":
         return shape["radius"]
     if kind == "capsule":
@@ -220,8 +223,25 @@ def surface(shape, p, R):
     return world[..., 0], world[..., 1], world[..., 2]
 
 
+def is_cloud(shape):
+    return shape["shape"] in ("points", "octree")
+
+
+def cloud_cells(shape, p, R):
+    """A cloud obstacle's occupied cells (as summary.json lists them, at most a few thousand): world centres, edges."""
+    cells = np.array(shape.get("cells", []), dtype=float).reshape(-1, 4)
+    return cells[:, :3] @ R.T + p, cells[:, 3]
+
+
 def draw_section(ax, shape, p, R, **style):
     """The shape's z = 0 section as a filled patch on 2-D axes; the patch, or None when it misses the plane."""
+    if is_cloud(shape):
+        centres, edges = cloud_cells(shape, p, R)
+        near = np.abs(centres[:, 2]) <= 0.5 * edges + shape.get("radius", 0.0)
+        if not near.any():
+            return None
+        return ax.scatter(centres[near, 0], centres[near, 1], s=2, marker="s", color=style.get("facecolor", "grey"),
+                          label=style.get("label"))
     poly = plane_section(shape, p, R)
     if poly is None:
         return None
@@ -232,6 +252,10 @@ def draw_section(ax, shape, p, R, **style):
 
 def draw_solid(ax, shape, p, R, color, alpha):
     """The shape on 3-D axes; the artists drawn."""
+    if is_cloud(shape):
+        centres, _ = cloud_cells(shape, p, R)
+        return [ax.scatter(centres[:, 0], centres[:, 1], centres[:, 2], s=1, color=color, alpha=max(alpha, 0.3),
+                           depthshade=False)]
     mesh = surface(shape, p, R)
     if isinstance(mesh, list):
         faces = Poly3DCollection(mesh, facecolor=color, edgecolor=color, alpha=alpha, linewidth=0.5)
@@ -277,10 +301,13 @@ def scene_points(summary, frames, duration):
     """Points that the scene covers over the run (arm, obstacles' extents), for fixed 3-D limits."""
     pts = [frames[1].reshape(-1, 3)]
     for o in obstacles(summary):
-        r = bounding_radius(o)
         for t in (0.0, duration):
-            p, _ = obstacle_pose(o, t)
-            pts.append(np.array([p - r, p + r]))
+            p, R = obstacle_pose(o, t)
+            if is_cloud(o):
+                pts.append(cloud_cells(o, p, R)[0])
+            else:
+                r = bounding_radius(o)
+                pts.append(np.array([p - r, p + r]))
     return np.vstack(pts)
 
 
@@ -330,16 +357,25 @@ def zoom_closest(ax, summary, frames, closest):
     links = link_shape_poses(summary, rots[k], pts[k])
     link_radius = max([sh["radius"] for sh, _, _ in links if "radius" in sh] or [0.0])
 
-    def gap(o):  # centre of the obstacle to the nearest joint segment
-        p, _ = obstacle_pose(o, t_f[k])
+    def anchors(o):  # the obstacle's centre, or a cloud's cell centres (world)
+        p, R = obstacle_pose(o, t_f[k])
+        return cloud_cells(o, p, R)[0] if is_cloud(o) else p[None, :]
+
+    def gaps(o):  # each anchor's distance to the nearest joint segment
+        q = anchors(o)
         a, b = pts[k, :-1], pts[k, 1:]
         ab = b - a
-        s = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-18), 0.0, 1.0)
-        return float(np.min(np.linalg.norm(a + s[:, None] * ab - p, axis=1)))
+        s = np.clip(np.einsum("mij,ij->mi", q[:, None, :] - a[None], ab) / np.maximum(np.einsum("ij,ij->i", ab, ab),
+                                                                                     1e-18), 0.0, 1.0)
+        return np.min(np.linalg.norm(a[None] + s[..., None] * ab[None] - q[:, None, :], axis=2), axis=1)
 
-    nearest = min(obstacles(summary), key=gap)
-    centre, _ = obstacle_pose(nearest, t_f[k])
-    half = 1.5 * (bounding_radius(nearest) + link_radius + max(d, 0.0)) + 0.01
+    nearest = min(obstacles(summary), key=lambda o: float(np.min(gaps(o))))
+    if is_cloud(nearest):  # zoom on the cell nearest the arm
+        centre = anchors(nearest)[int(np.argmin(gaps(nearest)))]
+        half = 1.5 * (0.05 + link_radius + max(d, 0.0)) + 0.01
+    else:
+        centre, _ = obstacle_pose(nearest, t_f[k])
+        half = 1.5 * (bounding_radius(nearest) + link_radius + max(d, 0.0)) + 0.01
     for o in obstacles(summary):
         draw_section(ax, o, *obstacle_pose(o, t_f[k]), facecolor=OBSTACLE_COLOUR, edgecolor="k", lw=0.8, alpha=0.8)
     for shape, p, R in links:

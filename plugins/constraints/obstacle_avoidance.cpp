@@ -67,8 +67,16 @@ ObstacleAvoidance::ObstacleAvoidance(const Config& config, const RobotModel& rob
   std::vector<ShapeSpec>& shapes = shapes_;
   for (const auto& l : links) shapes.push_back(l.spec);
   for (std::size_t k = 0; k < config_.obstacles.size(); ++k) {
-    const ShapeSpec& o = config_.obstacles[k];
-    if (planar && (o.pose().translation().z() != 0.0 || (o.velocity && (*o.velocity)[2] != 0.0))) {
+    ShapeSpec& o = config_.obstacles[k];
+    if (o.is_cloud()) {
+      // Read once here; every controller's query shares the cells.
+      try {
+        load_cloud(o);
+      } catch (const std::invalid_argument& e) {
+        throw FieldError("obstacles", "obstacle " + std::to_string(k + 1) + " (" +
+                                          std::string(config_io::enum_name(o.shape)) + "): " + e.what());
+      }
+    } else if (planar && (o.pose().translation().z() != 0.0 || (o.velocity && (*o.velocity)[2] != 0.0))) {
       throw FieldError("obstacles", "obstacle " + std::to_string(k + 1) +
                                         ": a planar robot moves in the plane z = 0; centre its obstacles there (and "
                                         "keep their velocity in it)");
@@ -194,7 +202,7 @@ void ObstacleAvoidance::pair_row(Data& data, const KinematicsData& kin, int l, c
   const int pair = o * links_ + l;
   const int first = pooled_ ? -1 : first_row_[static_cast<std::size_t>(pair)];
   const int count = pooled_ ? 0 : first_row_[static_cast<std::size_t>(pair) + 1] - first;
-  const ShapeDistance d = data.query.distance(l, Tl, links_ + o, To);
+  const ShapeDistance d = data.query.distance(l, Tl, links_ + o, To, data.distances.damper().influence_distance);
   Eigen::Vector3d n;
   if (!data.distances.take(pair, d, planar_, Tl.translation() - To.translation(), n)) {
     for (int r = first; r < first + count; ++r) slack_row(A.row(r), b(r));  // shared rows start slack

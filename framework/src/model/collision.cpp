@@ -4,6 +4,8 @@
 
 #include "redres/common/error.hpp"
 
+#include "model/occupancy.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -43,10 +45,38 @@ const Schema<ShapeSpec>& ShapeSpec::schema() {
        field("rpy", &S::rpy, "rad", "roll, pitch, yaw in the owner's frame"),
        field("from", &S::from, "m", "capsule: one end of the axis (instead of xyz, rpy and length)"),
        field("to", &S::to, "m", "capsule: the other end of the axis"),
-       field("velocity", &S::velocity, "m/s", "obstacles only: constant linear velocity")},
+       field("velocity", &S::velocity, "m/s", "obstacles only: constant linear velocity"),
+       field("file", &S::file, "",
+             "octree: an OctoMap .bt or .ot file; points: a .ply, .pcd or .xyz point cloud (relative to this file)"),
+       field("resolution", &S::resolution, "m", "points: the edge of the cubic cells the points are put into")},
       [](const S& spec) {
-        const bool round = spec.shape != Kind::kBox;
         const std::string name(config_io::enum_name(spec.shape));
+        if (spec.is_cloud()) {
+          if (spec.file.empty()) throw FieldError("file", "is required for " + name + " (the file to read)");
+          if (spec.radius && !(std::isfinite(*spec.radius) && *spec.radius >= 0.0)) {
+            throw FieldError("radius", "expected a radius >= 0 m (how far the occupied cells are grown)");
+          }
+          if (spec.shape == Kind::kPoints && !spec.resolution) {
+            throw FieldError("resolution", "is required for points (the cell edge, m; e.g. 0.01)");
+          }
+          if (spec.resolution && !(positive(*spec.resolution) && *spec.resolution >= 1e-4)) {
+            throw FieldError("resolution", "expected a cell edge >= 1e-4 m");
+          }
+          if (spec.shape == Kind::kOctree && spec.resolution) {
+            throw FieldError("resolution", "is not used by an octree (its cells come from the file)");
+          }
+          if (spec.size || spec.length || spec.from || spec.to) {
+            throw FieldError(spec.size     ? "size"
+                             : spec.length ? "length"
+                             : spec.from   ? "from"
+                                           : "to",
+                             "is not used by " + name + " (its shape comes from the file)");
+          }
+          return;
+        }
+        if (!spec.file.empty()) throw FieldError("file", "is only used by an octree or points obstacle");
+        if (spec.resolution) throw FieldError("resolution", "is only used by a points obstacle");
+        const bool round = spec.shape != Kind::kBox;
         if (round && !spec.radius) throw FieldError("radius", "is required for a " + name);
         if (round && !positive(*spec.radius)) throw FieldError("radius", "expected a radius > 0 m");
         if (!round && spec.radius) throw FieldError("radius", "is not used by a box (give `size`)");
@@ -104,6 +134,16 @@ std::string ShapeSpec::describe() const {
     case Kind::kCapsule:
     case Kind::kCylinder: s << "r = " << radius.value_or(0.0) << " m, l = " << axis_length() << " m"; break;
     case Kind::kBox: s << "size = " << (*size)[0] << " x " << (*size)[1] << " x " << (*size)[2] << " m"; break;
+    case Kind::kOctree:
+    case Kind::kPoints:
+      s << file.filename().string();
+      if (cloud) {
+        const OccupancyInfo info = occupancy_info(*cloud);
+        if (shape == Kind::kPoints) s << ": " << info.points << " points";
+        s << (shape == Kind::kPoints ? " in " : ": ") << info.cells << " cells of " << info.resolution << " m";
+      }
+      if (radius.value_or(0.0) > 0.0) s << ", r = " << *radius << " m";
+      break;
   }
   s << ")";
   return s.str();
@@ -230,7 +270,10 @@ void round_box(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double r, c
         }
       }
     }
-    if (!(best_g > 0.0)) {
+    // Where the axis enters the box, g is zero only in exact arithmetic (a rounding residue of 1e-34 was seen): the
+    // axis reaches the box when g is below the square of a rounding-sized distance.
+    const double touch = 1e-12 * (h.maxCoeff() + dq.norm());
+    if (!(best_g > touch * touch)) {
       // The axis reaches the box: the deepest point, among the ends and the crossings of the six lines.
       std::array<double, 6> slope{}, offset{};  // line j: slope s + offset = +-q_k(s) - h_k
       for (int k = 0; k < 3; ++k) {
@@ -270,6 +313,28 @@ void round_box(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double r, c
   on_round = Tb * q - r * u_world;
 }
 
+// A sphere or capsule (axis [p0, p1], radius r, in the cloud's frame) against a cloud's cells grown by g, exactly (the
+// cell is a box: round_box).
+struct RoundMetric final : OccupancyMap::Metric {
+  RoundMetric(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double radius, double grow)
+      : p0(from), p1(to), r(radius), g(grow) {}
+  Eigen::Vector3d p0, p1;
+  double r, g;
+  [[nodiscard]] double bound(const Eigen::Vector3d& c, double h) const override {
+    Eigen::Vector3d a, b;
+    return cell(c, h, a, b);  // the exact distance to a cube is a lower bound for the cells inside it
+  }
+  double cell(const Eigen::Vector3d& c, double h, Eigen::Vector3d& on_query, Eigen::Vector3d& on_cloud) const override {
+    Eigen::Isometry3d Tc = Eigen::Isometry3d::Identity();
+    Tc.translation() = c;
+    double d = 0.0;
+    round_box(p0, p1, r, Tc, Eigen::Vector3d::Constant(h), d, on_query, on_cloud);
+    // on_query - on_cloud = d u, with u the cube's outward normal at the witness: the grown cube's point is g further.
+    if (g > 0.0 && d != 0.0) on_cloud += (g / d) * (on_query - on_cloud);
+    return d - g;
+  }
+};
+
 }  // namespace
 
 struct DistanceQuery::Impl {
@@ -283,12 +348,74 @@ struct DistanceQuery::Impl {
   std::vector<double> cylinder_radius;                   // a cylinder's radius (0 for other shapes)
   std::vector<double> cylinder_half;                     // a cylinder's half length
   std::vector<double> bound;                             // the radius of the ball about the centre that holds it
+  // Clouds (octree, points): the occupied cells, and the bounding box of the grown cells in the cloud's frame.
+  std::vector<std::shared_ptr<const OccupancyMap>> cloud;
+  std::vector<Eigen::Vector3d> cloud_lo, cloud_hi;
+  std::vector<Eigen::Isometry3d> object_offset;  // the FCL object's pose in the shape's frame (a cloud's box)
+
+  // A box or cylinder (shape k at T, in the cloud's frame) against a cloud's cells: each cell as its bounding ball
+  // (grown by g), measured to the shape's nearest point in closed form (project).
+  struct BallMetric final : OccupancyMap::Metric {
+    BallMetric(const Impl& owner, std::size_t shape, const Eigen::Isometry3d& pose, double grow)
+        : impl(owner), k(shape), T(pose), g(grow) {}
+    const Impl& impl;
+    std::size_t k;
+    Eigen::Isometry3d T;
+    double g;
+    [[nodiscard]] double bound(const Eigen::Vector3d& c, double h) const override {
+      return (c - impl.project(k, T, c)).norm() - std::sqrt(3.0) * h - g;
+    }
+    double cell(const Eigen::Vector3d& c, double h, Eigen::Vector3d& on_query,
+                Eigen::Vector3d& on_cloud) const override {
+      on_query = impl.project(k, T, c);
+      const Eigen::Vector3d v = on_query - c;
+      const double n = v.norm(), R = std::sqrt(3.0) * h + g;
+      on_cloud = n > 0.0 ? Eigen::Vector3d(c + v * (R / n)) : c;
+      return n - R;
+    }
+  };
+  // A pair with a cloud (see DistanceQuery::distance).
+  [[nodiscard]] ShapeDistance cloud_distance(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb,
+                                             double within) const {
+    ShapeDistance out;
+    const bool a_cloud = cloud[static_cast<std::size_t>(a)] != nullptr;
+    const int k = a_cloud ? b : a;
+    const auto ks = static_cast<std::size_t>(k);
+    if (cloud[ks]) {
+      out.error = "two clouds are not measured against each other";
+      return out;
+    }
+    const OccupancyMap& map = *cloud[static_cast<std::size_t>(a_cloud ? a : b)];
+    const Eigen::Isometry3d& Tc = a_cloud ? Ta : Tb;
+    const Eigen::Isometry3d local = Tc.inverse() * (a_cloud ? Tb : Ta);  // the shape in the cloud's frame
+    Eigen::Vector3d on_shape = Eigen::Vector3d::Zero(), on_cloud = Eigen::Vector3d::Zero();
+    double d = 0.0;
+    if (round[ks].round) {
+      const Eigen::Vector3d z = local.linear().col(2) * round[ks].half_length;
+      const RoundMetric m(local.translation() - z, local.translation() + z, round[ks].radius, map.grow());
+      d = map.nearest(m, within, on_shape, on_cloud);
+    } else {
+      const BallMetric m(*this, ks, local, map.grow());
+      d = map.nearest(m, within, on_shape, on_cloud);
+    }
+    out.ok = true;
+    out.distance = d;
+    if (std::isfinite(d)) {
+      on_shape = Tc * on_shape;
+      on_cloud = Tc * on_cloud;
+    }
+    out.point_a = a_cloud ? on_cloud : on_shape;
+    out.point_b = a_cloud ? on_shape : on_cloud;
+    return out;
+  }
 
   // The point of shape k (at T) nearest to the world point `w`: exact, closed form, in the shape's frame.
   [[nodiscard]] Eigen::Vector3d project(std::size_t k, const Eigen::Isometry3d& T, const Eigen::Vector3d& w) const {
     const Eigen::Vector3d p = T.linear().transpose() * (w - T.translation());
     Eigen::Vector3d q = p;
-    if (box_half[k]) {
+    if (cloud[k]) {
+      q = p.cwiseMax(cloud_lo[k]).cwiseMin(cloud_hi[k]);  // the bounding box: for lower bounds only
+    } else if (box_half[k]) {
       q = p.cwiseMax(-*box_half[k]).cwiseMin(*box_half[k]);
     } else if (cylinder_radius[k] > 0.0) {
       q.z() = std::clamp(p.z(), -cylinder_half[k], cylinder_half[k]);
@@ -373,6 +500,36 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
     }
     const bool round = s.shape == ShapeSpec::Kind::kSphere || s.shape == ShapeSpec::Kind::kCapsule;
     const double radius = s.radius.value_or(0.0);
+    impl_->object_offset.push_back(Eigen::Isometry3d::Identity());
+    if (s.is_cloud()) {
+      std::shared_ptr<const OccupancyMap> cloud = s.cloud;
+      if (!cloud) {
+        ShapeSpec copy = s;
+        load_cloud(copy);
+        cloud = copy.cloud;
+      }
+      const OccupancyInfo& info = cloud->info();
+      const Eigen::Vector3d grow = Eigen::Vector3d::Constant(cloud->grow());
+      impl_->cloud.push_back(cloud);
+      impl_->cloud_lo.push_back(info.min - grow);
+      impl_->cloud_hi.push_back(info.max + grow);
+      impl_->round.push_back({});
+      impl_->box_half.push_back(std::nullopt);
+      impl_->cylinder_radius.push_back(0.0);
+      impl_->cylinder_half.push_back(0.0);
+      impl_->bound.push_back(
+          std::max(impl_->cloud_lo.back().cwiseAbs().norm(), impl_->cloud_hi.back().cwiseAbs().norm()) * (1.0 + 1e-12) +
+          (impl_->cloud_hi.back() - impl_->cloud_lo.back()).norm());
+      // In the broadphase a cloud is the box of its grown cells.
+      const Eigen::Vector3d side = impl_->cloud_hi.back() - impl_->cloud_lo.back();
+      impl_->object_offset.back().translation() = 0.5 * (impl_->cloud_lo.back() + impl_->cloud_hi.back());
+      impl_->objects.push_back(
+          std::make_unique<fcl::CollisionObjectd>(std::make_shared<fcl::Boxd>(side.x(), side.y(), side.z())));
+      continue;
+    }
+    impl_->cloud.push_back(nullptr);
+    impl_->cloud_lo.emplace_back(Eigen::Vector3d::Zero());
+    impl_->cloud_hi.emplace_back(Eigen::Vector3d::Zero());
     impl_->round.push_back(
         {round, round ? radius : 0.0, s.shape == ShapeSpec::Kind::kCapsule ? 0.5 * s.axis_length() : 0.0});
     impl_->box_half.push_back(s.shape == ShapeSpec::Kind::kBox ? std::optional<Eigen::Vector3d>(0.5 * vec(*s.size))
@@ -399,6 +556,8 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
       case ShapeSpec::Kind::kBox:
         geometry = std::make_shared<fcl::Boxd>((*s.size)[0], (*s.size)[1], (*s.size)[2]);
         break;
+      case ShapeSpec::Kind::kOctree:
+      case ShapeSpec::Kind::kPoints: break;  // above
     }
     impl_->objects.push_back(std::make_unique<fcl::CollisionObjectd>(geometry));  // it keeps the geometry
   }
@@ -440,12 +599,16 @@ DistanceQuery::~DistanceQuery() = default;
 
 int DistanceQuery::size() const noexcept { return static_cast<int>(impl_->objects.size()); }
 
-ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb) const {
+ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb,
+                                      double within) const {
   ShapeDistance out;
   const int n = size();
   if (a < 0 || a >= n || b < 0 || b >= n) {
     out.error = "shape index out of range";
     return out;
+  }
+  if (impl_->cloud[static_cast<std::size_t>(a)] || impl_->cloud[static_cast<std::size_t>(b)]) {
+    return impl_->cloud_distance(a, Ta, b, Tb, within);
   }
   {
     const Impl::Round& ra = impl_->round[static_cast<std::size_t>(a)];
@@ -522,6 +685,13 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
 
 Eigen::Vector3d DistanceQuery::nearest_point(int k, const Eigen::Isometry3d& T, const Eigen::Vector3d& w) const {
   REDRES_REQUIRE(k >= 0 && k < size(), "DistanceQuery::nearest_point", "0 <= shape < size()");
+  if (const auto& cloud = impl_->cloud[static_cast<std::size_t>(k)]) {
+    const Eigen::Vector3d local = T.inverse() * w;
+    const RoundMetric m(local, local, 0.0, cloud->grow());
+    Eigen::Vector3d on_query, on_cloud;
+    if (!std::isfinite(cloud->nearest(m, std::numeric_limits<double>::infinity(), on_query, on_cloud))) return w;
+    return T * on_cloud;
+  }
   return impl_->project(static_cast<std::size_t>(k), T, w);
 }
 
@@ -556,7 +726,8 @@ void DistanceQuery::move_group(const Eigen::Isometry3d* poses) {
   if (!impl_->tree) return;
   for (int k = 0; k < impl_->group_count; ++k) {
     fcl::CollisionObjectd* o = impl_->objects[static_cast<std::size_t>(impl_->group_first + k)].get();
-    o->setTransform(fcl::Transform3d(poses[k].matrix()));
+    const Eigen::Isometry3d T = poses[k] * impl_->object_offset[static_cast<std::size_t>(impl_->group_first + k)];
+    o->setTransform(fcl::Transform3d(T.matrix()));
     o->computeAABB();
   }
   impl_->tree->update();

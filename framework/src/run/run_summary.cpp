@@ -167,6 +167,21 @@ nlohmann::json shape_json(const ShapeSpec& shape) {
       j["length"] = shape.axis_length();
       break;
     case ShapeSpec::Kind::kBox: j["size"] = shape.size.value_or(std::array<double, 3>{0.0, 0.0, 0.0}); break;
+    case ShapeSpec::Kind::kOctree:
+    case ShapeSpec::Kind::kPoints: {
+      // The file, and its occupied cells (centre, edge; cloud frame): every k-th of them past 3,000, for plots.
+      j["file"] = shape.file.string();
+      j["radius"] = shape.radius.value_or(0.0);
+      if (shape.cloud) {
+        const auto cells = occupied_cells(*shape.cloud);
+        const std::size_t step = cells.size() / 3000 + 1;
+        nlohmann::json list = nlohmann::json::array();
+        for (std::size_t i = 0; i < cells.size(); i += step) list.push_back(cells[i]);
+        j["cells"] = std::move(list);
+        j["cells_total"] = cells.size();
+      }
+      break;
+    }
   }
   j["position"] = vector_json(T.translation());
   j["rotation"] = {vector_json(R.row(0).transpose()), vector_json(R.row(1).transpose()),

@@ -16,6 +16,8 @@
 /// - FCL throws std::logic_error from GJK in rare near-touching box configurations: caught, reported as a status.
 
 #include <array>
+#include <cstddef>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -28,11 +30,18 @@
 
 namespace redres {
 
+class OccupancyMap;
+
 /// A primitive shape with a pose in its owner's frame (a link's frame, or the world for an obstacle). Capsules and
 /// cylinders have their axis along the local z axis, centred on the pose's origin; a capsule may instead be given
 /// by the two end points of its axis (`from`, `to`).
+///
+/// Obstacles may also be occupied space read from a file (docs/collision.md, "Point clouds and octrees"): an OctoMap
+/// octree (`octree`, `.bt` or `.ot`) or a point cloud (`points`, `.ply`, `.pcd` or `.xyz`) put into cubic cells of
+/// edge `resolution`. The obstacle is the union of the occupied cells grown by `radius` (0 for an octree unless
+/// given), placed by xyz/rpy. The file is read once (cloud(), load_cloud()) and shared by every copy of the spec.
 struct ShapeSpec {
-  enum class Kind { kSphere, kCapsule, kCylinder, kBox };
+  enum class Kind { kSphere, kCapsule, kCylinder, kBox, kOctree, kPoints };
   Kind shape = Kind::kCapsule;                      //!< which primitive
   std::optional<double> radius{};                   //!< sphere, capsule, cylinder (m)
   std::optional<double> length{};                   //!< capsule, cylinder: axis length (m)
@@ -42,6 +51,10 @@ struct ShapeSpec {
   std::optional<std::array<double, 3>> from{};      //!< capsule: one end of the axis (m)
   std::optional<std::array<double, 3>> to{};        //!< capsule: the other end of the axis (m)
   std::optional<std::array<double, 3>> velocity{};  //!< obstacles: constant linear velocity (m/s)
+  std::filesystem::path file{};                     //!< octree, points: the file (relative to the file naming it)
+  std::optional<double> resolution{};               //!< points: the cell edge the points are put into (m)
+  /// octree, points: the occupied cells, once read (load_cloud()); shared by the spec's copies.
+  std::shared_ptr<const OccupancyMap> cloud{};
 
   static const Schema<ShapeSpec>& schema();
 
@@ -52,9 +65,32 @@ struct ShapeSpec {
   [[nodiscard]] ShapeSpec placed(const Eigen::Isometry3d& at) const;
   /// The capsule's axis length (from `length`, or |to - from|).
   [[nodiscard]] double axis_length() const;
-  /// One line, e.g. "capsule(r = 0.05 m, l = 0.3 m)".
+  /// One line, e.g. "capsule(r = 0.05 m, l = 0.3 m)" or "points(cloud.ply: 100000 points in 5310 cells of 0.01 m,
+  /// r = 0.005 m)".
   [[nodiscard]] std::string describe() const;
+  /// An octree or a point cloud (occupied space read from a file), not a primitive.
+  [[nodiscard]] bool is_cloud() const noexcept { return shape == Kind::kOctree || shape == Kind::kPoints; }
 };
+
+/// What a cloud obstacle's file held, once read.
+struct OccupancyInfo {
+  std::size_t points = 0;                         //!< points read (points), or occupied leaves (octree)
+  std::size_t cells = 0;                          //!< occupied leaf cells of the tree (after merging)
+  double resolution = 0.0;                        //!< the smallest cell's edge (m)
+  std::size_t memory_bytes = 0;                   //!< the tree's memory (OctoMap's own count)
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();  //!< the occupied cells' bounding box, in the cloud's frame (m)
+  Eigen::Vector3d max = Eigen::Vector3d::Zero();
+};
+
+/// Reads an octree or point cloud obstacle's file into spec.cloud (if not read yet). Throws std::invalid_argument
+/// naming the file, and the line or byte where it went wrong.
+void load_cloud(ShapeSpec& spec);
+/// The statistics of a loaded cloud.
+[[nodiscard]] OccupancyInfo occupancy_info(const OccupancyMap& cloud);
+/// The centres and edges of the occupied leaf cells, in the cloud's frame (for plots and tests): [x, y, z, edge].
+[[nodiscard]] std::vector<std::array<double, 4>> occupied_cells(const OccupancyMap& cloud);
+/// The points a `points` file holds, as read (for tests: brute-force distances); throws as load_cloud().
+[[nodiscard]] std::vector<Eigen::Vector3d> read_points(const std::filesystem::path& file);
 
 /// R = Rz(yaw) Ry(pitch) Rx(roll) from {roll, pitch, yaw} (rad): ShapeSpec's and URDF's convention.
 [[nodiscard]] Eigen::Matrix3d rpy_matrix(const std::array<double, 3>& rpy);
@@ -64,9 +100,10 @@ struct ShapeSpec {
 
 inline auto enum_names(ShapeSpec::Kind) {
   using K = ShapeSpec::Kind;
-  return std::array{std::pair{K::kSphere, std::string_view("sphere")},
-                    std::pair{K::kCapsule, std::string_view("capsule")},
-                    std::pair{K::kCylinder, std::string_view("cylinder")}, std::pair{K::kBox, std::string_view("box")}};
+  return std::array{
+      std::pair{K::kSphere, std::string_view("sphere")},     std::pair{K::kCapsule, std::string_view("capsule")},
+      std::pair{K::kCylinder, std::string_view("cylinder")}, std::pair{K::kBox, std::string_view("box")},
+      std::pair{K::kOctree, std::string_view("octree")},     std::pair{K::kPoints, std::string_view("points")}};
 }
 
 /// The outcome of one distance query.
@@ -81,7 +118,8 @@ struct ShapeDistance {
 /// Distances between a fixed set of shapes. Not thread-safe (FCL's objects are not): one per controller.
 class DistanceQuery {
  public:
-  /// Builds one FCL geometry per shape (sizes checked: std::invalid_argument naming the shape).
+  /// Builds one FCL geometry per shape (sizes checked: std::invalid_argument naming the shape). A cloud shape (octree,
+  /// points) is read from its file unless its spec holds it already (load_cloud()).
   explicit DistanceQuery(const std::vector<ShapeSpec>& shapes);
   ~DistanceQuery();
   DistanceQuery(const DistanceQuery&) = delete;
@@ -92,14 +130,21 @@ class DistanceQuery {
   /// Signed distance between shape a at world pose Ta and shape b at world pose Tb (each pose is the shape's own,
   /// i.e. owner pose * ShapeSpec::pose()). Allocation-free for sphere and capsule pairs and for any overlap it
   /// measures; pairs apart that involve a box or a cylinder run FCL's GJK, which may allocate.
-  [[nodiscard]] ShapeDistance distance(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb) const;
+  ///
+  /// A pair with a cloud (b, or a) is measured by a depth-first search of its octree, nearest cell first, with every
+  /// cell's distance in closed form (allocation-free): exact for a sphere or capsule against the grown cells; a box or
+  /// cylinder is measured to each cell's bounding ball, which errs on the near side by at most 0.37 of the cell's edge.
+  /// Cells farther than `within` are not searched: a pair with no cell within it reads +inf.
+  [[nodiscard]] ShapeDistance distance(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb,
+                                       double within = std::numeric_limits<double>::infinity()) const;
   /// The point of shape k at world pose T nearest to the world point `w` (w itself when it is inside): exact, in
-  /// closed form, allocation-free.
+  /// closed form, allocation-free (a cloud: by the search distance() makes, to its grown cells).
   [[nodiscard]] Eigen::Vector3d nearest_point(int k, const Eigen::Isometry3d& T, const Eigen::Vector3d& w) const;
   /// A lower bound on the distance between shape a at Ta and shape b at Tb, in closed form and a few dozen flops:
   /// the larger of dist(centre of a, b) - R_a and dist(centre of b, a) - R_b, with R the radius of the ball about
-  /// the shape's centre that holds it. A pair whose bound exceeds the influence distance needs no query (the
-  /// collision constraints' cull for scenes too small for the AABB tree).
+  /// the shape's centre that holds it (a cloud counts as the bounding box of its grown cells). A pair whose bound
+  /// exceeds the influence distance needs no query (the collision constraints' cull for scenes too small for the AABB
+  /// tree).
   [[nodiscard]] double lower_bound(int a, const Eigen::Isometry3d& Ta, int b, const Eigen::Isometry3d& Tb) const;
 
   /// Broadphase, for scenes with many pairs: puts shapes [first, first + count) (the "group", e.g. the obstacles)

@@ -1,0 +1,451 @@
+// Cloud obstacles: reading octrees (OctoMap's .bt and .ot) and point clouds (.ply through Assimp, .pcd, .xyz) into
+// OctoMap's octree, and the nearest-cell search on it.
+
+#include "model/occupancy.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <assimp/scene.h>
+#include <assimp/Importer.hpp>
+
+#include "common/input_file.hpp"
+#include "redres/common/error.hpp"
+
+namespace redres {
+
+namespace {
+
+// Cloud files may be large (a depth camera's frame is some 10 MB as text): read whole, up to 1 GiB.
+constexpr std::uintmax_t kMaxCloudBytes = std::uintmax_t{1} << 30;
+
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
+  throw std::invalid_argument(file.string() + ": " + what);
+}
+[[noreturn]] void fail_line(const std::filesystem::path& file, std::size_t line, const std::string& what) {
+  throw std::invalid_argument(file.string() + ":" + std::to_string(line) + ": " + what);
+}
+
+std::string lower_extension(const std::filesystem::path& file) {
+  std::string e = file.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return e;
+}
+
+std::string read_cloud_file(const std::filesystem::path& file) {
+  try {
+    return read_input_file(file, "cloud file", kMaxCloudBytes);
+  } catch (const ConfigError& e) {
+    fail(file, e.detail());
+  }
+}
+
+// Splits a line into tokens at blanks and commas.
+int split(std::string_view line, std::string_view* out, int max) {
+  int n = 0;
+  std::size_t i = 0;
+  while (i < line.size() && n < max) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == ',' || line[i] == '\r')) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !(line[i] == ' ' || line[i] == '\t' || line[i] == ',' || line[i] == '\r')) ++i;
+    if (i > start) out[n++] = line.substr(start, i - start);
+  }
+  return n;
+}
+
+bool number(std::string_view token, double& v) {
+  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
+  return ec == std::errc() && end == token.data() + token.size();
+}
+
+// Text lines: (line number, content), with '#' comments and blank lines left out when `comments`.
+template <class F>
+void for_each_line(std::string_view text, F&& f) {
+  std::size_t line = 0, pos = 0;
+  while (pos < text.size()) {
+    ++line;
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    if (!f(line, text.substr(pos, end - pos))) return;
+    pos = end + 1;
+  }
+}
+
+// .xyz: one point a line, x y z first (further columns, such as normals or colours, are ignored), separated by blanks
+// or commas; '#' starts a comment.
+std::vector<Eigen::Vector3d> read_xyz(const std::filesystem::path& file, const std::string& text) {
+  std::vector<Eigen::Vector3d> points;
+  for_each_line(text, [&](std::size_t line, std::string_view s) {
+    if (const auto hash = s.find('#'); hash != std::string_view::npos) s = s.substr(0, hash);
+    std::array<std::string_view, 3> tok;
+    const int n = split(s, tok.data(), 3);
+    if (n == 0) return true;
+    Eigen::Vector3d p;
+    for (int k = 0; k < 3; ++k) {
+      if (k >= n || !number(tok[static_cast<std::size_t>(k)], p(k))) {
+        fail_line(file, line, "expected the numbers x y z, saw '" + std::string(s.substr(0, 60)) + "'");
+      }
+    }
+    if (!p.allFinite()) fail_line(file, line, "a coordinate is not finite");
+    points.push_back(p);
+    return true;
+  });
+  return points;
+}
+
+// .pcd (the Point Cloud Library's format, version 0.7): a text header, then the points as ascii or binary. Fields x, y
+// and z must be floating point (F, 4 or 8 bytes); other fields are skipped. Points with a NaN coordinate are PCL's
+// "no return" and are left out. binary_compressed (LZF) is not read.
+std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& file, const std::string& text) {
+  std::vector<std::string> fields;
+  std::vector<int> sizes, counts;
+  std::vector<char> types;
+  long points_declared = -1;
+  std::string data;
+  std::size_t pos = 0, line = 0;
+  while (data.empty()) {
+    if (pos >= text.size()) fail(file, "the header ends before its DATA line");
+    ++line;
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    std::string_view s(text.data() + pos, end - pos);
+    pos = end + 1;
+    if (const auto hash = s.find('#'); hash != std::string_view::npos) s = s.substr(0, hash);
+    std::array<std::string_view, 64> tok;
+    const int n = split(s, tok.data(), 64);
+    if (n == 0) continue;
+    const std::string key(tok[0]);
+    std::vector<std::string> values;
+    for (int k = 1; k < n; ++k) values.emplace_back(tok[static_cast<std::size_t>(k)]);
+    const auto integers = [&](std::vector<int>& out) {
+      for (const std::string& v : values) {
+        int x = 0;
+        const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+        if (ec != std::errc() || p != v.data() + v.size() || x <= 0) {
+          fail_line(file, line, key + ": expected positive integers, saw '" + v + "'");
+        }
+        out.push_back(x);
+      }
+    };
+    if (key == "FIELDS") {
+      fields = values;
+    } else if (key == "SIZE") {
+      integers(sizes);
+    } else if (key == "COUNT") {
+      integers(counts);
+    } else if (key == "TYPE") {
+      for (const std::string& v : values) types.push_back(v.empty() ? '?' : v[0]);
+    } else if (key == "POINTS") {
+      std::vector<int> p;
+      integers(p);
+      if (p.size() != 1) fail_line(file, line, "POINTS: expected one count");
+      points_declared = p[0];
+    } else if (key == "DATA") {
+      if (values.size() != 1) fail_line(file, line, "DATA: expected ascii, binary or binary_compressed");
+      data = values[0];
+      if (data == "binary_compressed") {
+        fail_line(file, line,
+                  "DATA binary_compressed (LZF) is not read: save the cloud as `binary` or `ascii` (PCL's "
+                  "pcl_convert_pcd_ascii_binary does)");
+      }
+      if (data != "ascii" && data != "binary") fail_line(file, line, "DATA: expected ascii or binary, saw " + data);
+    }
+  }
+  if (fields.empty()) fail(file, "the header has no FIELDS line");
+  if (counts.empty()) counts.assign(fields.size(), 1);
+  if (sizes.size() != fields.size() || types.size() != fields.size() || counts.size() != fields.size()) {
+    fail(file, "FIELDS, SIZE, TYPE and COUNT must list as many entries (" + std::to_string(fields.size()) + " fields)");
+  }
+  if (points_declared < 0) fail(file, "the header has no POINTS line");
+  // Each field's first value: its column (ascii) and byte offset (binary).
+  std::array<int, 3> column{-1, -1, -1}, offset{-1, -1, -1}, size{0, 0, 0};
+  int columns = 0, bytes = 0;
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    const int axis = fields[f] == "x" ? 0 : fields[f] == "y" ? 1 : fields[f] == "z" ? 2 : -1;
+    if (axis >= 0) {
+      if (types[f] != 'F' || (sizes[f] != 4 && sizes[f] != 8)) {
+        fail(file, "field " + fields[f] + " must be floating point (TYPE F, SIZE 4 or 8)");
+      }
+      column[static_cast<std::size_t>(axis)] = columns;
+      offset[static_cast<std::size_t>(axis)] = bytes;
+      size[static_cast<std::size_t>(axis)] = sizes[f];
+    }
+    columns += counts[f];
+    bytes += sizes[f] * counts[f];
+  }
+  if (column[0] < 0 || column[1] < 0 || column[2] < 0) fail(file, "FIELDS must include x, y and z");
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(static_cast<std::size_t>(points_declared));
+  if (data == "binary") {
+    const std::size_t need = static_cast<std::size_t>(points_declared) * static_cast<std::size_t>(bytes);
+    if (text.size() - pos < need) {
+      fail(file, "the binary data holds " + std::to_string(text.size() - pos) + " bytes; POINTS " +
+                     std::to_string(points_declared) + " of " + std::to_string(bytes) + " bytes need " +
+                     std::to_string(need));
+    }
+    for (long i = 0; i < points_declared; ++i) {
+      const char* record = text.data() + pos + static_cast<std::size_t>(i) * static_cast<std::size_t>(bytes);
+      Eigen::Vector3d p;
+      for (std::size_t k = 0; k < 3; ++k) {
+        if (size[k] == 4) {
+          float v = 0.0F;
+          std::memcpy(&v, record + offset[k], 4);
+          p(static_cast<Eigen::Index>(k)) = v;
+        } else {
+          std::memcpy(&p(static_cast<Eigen::Index>(k)), record + offset[k], 8);
+        }
+      }
+      if (p.hasNaN()) continue;
+      if (!p.allFinite()) fail(file, "point " + std::to_string(i + 1) + " has an infinite coordinate");
+      points.push_back(p);
+    }
+    return points;
+  }
+  long read = 0;
+  const std::size_t header_lines = line;
+  for_each_line(std::string_view(text).substr(std::min(pos, text.size())), [&](std::size_t l, std::string_view s) {
+    std::vector<std::string_view> tok(static_cast<std::size_t>(columns) + 1);
+    const int n = split(s, tok.data(), columns + 1);
+    if (n == 0) return true;
+    if (n != columns) {
+      fail_line(file, header_lines + l,
+                "expected " + std::to_string(columns) + " values (FIELDS and COUNT), saw " + std::to_string(n));
+    }
+    Eigen::Vector3d p;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::string_view t = tok[static_cast<std::size_t>(column[k])];
+      if (t == "nan" || t == "NaN" || t == "-nan") {
+        p(static_cast<Eigen::Index>(k)) = std::nan("");
+      } else if (!number(t, p(static_cast<Eigen::Index>(k)))) {
+        fail_line(file, header_lines + l, "expected a number, saw '" + std::string(t) + "'");
+      }
+    }
+    ++read;
+    if (p.hasNaN()) return true;
+    if (!p.allFinite()) fail_line(file, header_lines + l, "a coordinate is infinite");
+    points.push_back(p);
+    return true;
+  });
+  if (read != points_declared) {
+    fail(file, "POINTS says " + std::to_string(points_declared) + " points, the data holds " + std::to_string(read));
+  }
+  return points;
+}
+
+// .ply through Assimp (ascii and binary, either byte order). Assimp fills a missing coordinate with 0, so the header
+// is checked first: its vertex element must have x, y and z properties.
+std::vector<Eigen::Vector3d> read_ply(const std::filesystem::path& file, const std::string& text) {
+  const std::size_t end = text.find("end_header");
+  if (text.rfind("ply", 0) != 0 || end == std::string::npos) fail(file, "not a PLY file (no `ply` ... `end_header`)");
+  bool in_vertex = false;
+  std::array<bool, 3> has{false, false, false};
+  for_each_line(std::string_view(text).substr(0, end), [&](std::size_t, std::string_view s) {
+    std::array<std::string_view, 8> tok;
+    const int n = split(s, tok.data(), 8);
+    if (n >= 2 && tok[0] == "element") in_vertex = tok[1] == "vertex";
+    if (in_vertex && n >= 3 && tok[0] == "property") {
+      const std::string_view name = tok[static_cast<std::size_t>(n - 1)];
+      if (name.size() == 1 && name[0] >= 'x' && name[0] <= 'z') has[static_cast<std::size_t>(name[0] - 'x')] = true;
+    }
+    return true;
+  });
+  if (!has[0] || !has[1] || !has[2]) fail(file, "the PLY header's `element vertex` needs properties x, y and z");
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFileFromMemory(text.data(), text.size(), 0, "ply");
+  if (scene == nullptr) fail(file, std::string("Assimp could not read it: ") + importer.GetErrorString());
+  std::vector<Eigen::Vector3d> points;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* mesh = scene->mMeshes[m];
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D& a = mesh->mVertices[v];
+      const Eigen::Vector3d p(a.x, a.y, a.z);
+      if (!p.allFinite()) fail(file, "vertex " + std::to_string(v + 1) + " has a coordinate that is not finite");
+      points.push_back(p);
+    }
+  }
+  return points;
+}
+
+}  // namespace
+
+OccupancyMap::OccupancyMap(std::unique_ptr<octomap::OcTree> tree, double grow, std::size_t points)
+    : tree_(std::move(tree)), grow_(grow) {
+  tree_->updateInnerOccupancy();
+  root_half_ = tree_->getResolution() * static_cast<double>(1U << (tree_->getTreeDepth() - 1));
+  info_.points = points;
+  info_.resolution = tree_->getResolution();
+  info_.memory_bytes = tree_->memoryUsage();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
+    if (!tree_->isNodeOccupied(*it)) continue;
+    ++info_.cells;
+    const octomap::OcTreeKey key = it.getKey();
+    const unsigned depth = it.getDepth();
+    const double h = 0.5 * it.getSize();
+    const Eigen::Vector3d centre(tree_->keyToCoord(key[0], depth), tree_->keyToCoord(key[1], depth),
+                                 tree_->keyToCoord(key[2], depth));
+    lo = lo.cwiseMin(centre - Eigen::Vector3d::Constant(h));
+    hi = hi.cwiseMax(centre + Eigen::Vector3d::Constant(h));
+  }
+  if (info_.points == 0) info_.points = info_.cells;
+  if (info_.cells > 0) {
+    info_.min = lo;
+    info_.max = hi;
+  }
+}
+
+namespace {
+struct Search {
+  const octomap::OcTree& tree;
+  const OccupancyMap::Metric& metric;
+  double best;
+  Eigen::Vector3d on_query = Eigen::Vector3d::Zero(), on_cloud = Eigen::Vector3d::Zero();
+
+  void visit(const octomap::OcTreeNode* node, const Eigen::Vector3d& c, double h) {
+    if (!tree.isNodeOccupied(node)) return;  // an inner node holds its children's largest occupancy
+    if (!tree.nodeHasChildren(node)) {
+      Eigen::Vector3d a, b;
+      const double d = metric.cell(c, h, a, b);
+      if (d < best) {
+        best = d;
+        on_query = a;
+        on_cloud = b;
+      }
+      return;
+    }
+    std::array<std::pair<double, unsigned>, 8> kids{};
+    int n = 0;
+    const double hc = 0.5 * h;
+    const auto centre = [&](unsigned i) {
+      return Eigen::Vector3d(c.x() + ((i & 1U) ? hc : -hc), c.y() + ((i & 2U) ? hc : -hc),
+                             c.z() + ((i & 4U) ? hc : -hc));
+    };
+    for (unsigned i = 0; i < 8; ++i) {
+      if (!tree.nodeChildExists(node, i)) continue;
+      const double bound = metric.bound(centre(i), hc);
+      if (bound < best) kids[static_cast<std::size_t>(n++)] = {bound, i};
+    }
+    std::sort(kids.begin(), kids.begin() + n);
+    for (int k = 0; k < n; ++k) {
+      const auto [bound, i] = kids[static_cast<std::size_t>(k)];
+      if (!(bound < best)) break;
+      visit(tree.getNodeChild(node, i), centre(i), hc);
+    }
+  }
+};
+}  // namespace
+
+double OccupancyMap::nearest(const Metric& m, double within, Eigen::Vector3d& on_query,
+                             Eigen::Vector3d& on_cloud) const {
+  const octomap::OcTreeNode* root = tree_->getRoot();
+  if (root == nullptr || empty()) return std::numeric_limits<double>::infinity();
+  Search s{*tree_, m, within};
+  if (m.bound(Eigen::Vector3d::Zero(), root_half_) < within) s.visit(root, Eigen::Vector3d::Zero(), root_half_);
+  if (!(s.best < within)) return std::numeric_limits<double>::infinity();
+  on_query = s.on_query;
+  on_cloud = s.on_cloud;
+  return s.best;
+}
+
+std::vector<Eigen::Vector3d> read_points(const std::filesystem::path& file) {
+  const std::string ext = lower_extension(file);
+  if (ext != ".ply" && ext != ".pcd" && ext != ".xyz") {
+    fail(file, "a point cloud is read from a .ply, .pcd or .xyz file (saw '" + ext + "')");
+  }
+  const std::string text = read_cloud_file(file);
+  if (ext == ".ply") return read_ply(file, text);
+  if (ext == ".pcd") return read_pcd(file, text);
+  return read_xyz(file, text);
+}
+
+void load_cloud(ShapeSpec& spec) {
+  if (spec.cloud || !spec.is_cloud()) return;
+  const std::filesystem::path& file = spec.file;
+  if (file.empty()) throw std::invalid_argument("a cloud obstacle needs `file`");
+  const double grow = spec.radius.value_or(0.0);
+  if (spec.shape == ShapeSpec::Kind::kOctree) {
+    const std::string ext = lower_extension(file);
+    if (ext != ".bt" && ext != ".ot")
+      fail(file, "an octree is read from an OctoMap .bt or .ot file (saw '" + ext + "')");
+    std::istringstream in(read_cloud_file(file));
+    std::unique_ptr<octomap::OcTree> tree;
+    // Debian's OctoMap reports on std::cerr as it reads ("Reading binary octree type OcTree"): the report is held
+    // back, and its errors go into the message when the file cannot be read.
+    static std::mutex cerr_mutex;
+    std::ostringstream said;
+    {
+      const std::lock_guard<std::mutex> lock(cerr_mutex);
+      std::streambuf* const old = std::cerr.rdbuf(said.rdbuf());
+      try {
+        if (ext == ".bt") {
+          tree = std::make_unique<octomap::OcTree>(0.1);
+          if (!tree->readBinary(in)) tree.reset();
+        } else {
+          std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(in));
+          if (auto* occupancy = dynamic_cast<octomap::OcTree*>(any.get())) {
+            any.release();
+            tree.reset(occupancy);
+          }
+        }
+      } catch (...) {
+        std::cerr.rdbuf(old);
+        throw;
+      }
+      std::cerr.rdbuf(old);
+    }
+    if (!tree) {
+      std::string why = said.str();
+      if (const auto e = why.find("ERROR: "); e != std::string::npos) why = why.substr(e + 7);
+      while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
+      fail(file, std::string("OctoMap could not read it as ") +
+                     (ext == ".bt" ? "a binary occupancy octree (.bt)" : "an occupancy octree (OcTree, .ot)") +
+                     (why.empty() ? "" : ": " + why.substr(0, 200)));
+    }
+    spec.cloud = std::make_shared<const OccupancyMap>(std::move(tree), grow, 0);
+  } else {
+    const std::vector<Eigen::Vector3d> points = read_points(file);
+    if (points.empty()) fail(file, "holds no points");
+    auto tree = std::make_unique<octomap::OcTree>(*spec.resolution);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3d& p = points[i];
+      octomap::OcTreeKey key;
+      if (!tree->coordToKeyChecked(
+              octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())), key)) {
+        std::ostringstream s;
+        s << "point " << i + 1 << " (" << p.transpose() << ") is outside the octree's reach: at resolution "
+          << *spec.resolution << " m it spans +-" << *spec.resolution * 32768.0 << " m";
+        fail(file, s.str());
+      }
+      tree->updateNode(key, true, true);
+    }
+    spec.cloud = std::make_shared<const OccupancyMap>(std::move(tree), grow, points.size());
+  }
+  if (spec.cloud->empty()) fail(file, "has no occupied cell");
+}
+
+OccupancyInfo occupancy_info(const OccupancyMap& cloud) { return cloud.info(); }
+
+std::vector<std::array<double, 4>> occupied_cells(const OccupancyMap& cloud) {
+  std::vector<std::array<double, 4>> out;
+  const octomap::OcTree& t = cloud.tree();
+  for (auto it = t.begin_leafs(), end = t.end_leafs(); it != end; ++it) {
+    if (!t.isNodeOccupied(*it)) continue;
+    // The centre in double (getCoordinate() rounds it to float).
+    const octomap::OcTreeKey key = it.getKey();
+    const unsigned depth = it.getDepth();
+    out.push_back(
+        {t.keyToCoord(key[0], depth), t.keyToCoord(key[1], depth), t.keyToCoord(key[2], depth), it.getSize()});
+  }
+  return out;
+}
+
+}  // namespace redres

@@ -262,31 +262,50 @@ void ObstacleAvoidance::add_near_pairs(Data& data, const Context& ctx, QpBuilder
   }
 }
 
-std::string ObstacleAvoidance::describe_inequality_row(const PluginData* data, int row) const {
-  if (row < 0 || row >= rows_ || data == nullptr) return {};
+void ObstacleAvoidance::describe_inequality_row_to(const PluginData* data, int row, TextSink& s) const {
+  if (row < 0 || row >= rows_ || data == nullptr) return;
   int pair = 0, sub = 0;
   if (pooled_) {
     pair = pair_data<Data>(data).row_pair[static_cast<std::size_t>(row)];
     sub = pair_data<Data>(data).row_sub[static_cast<std::size_t>(row)];
-    if (pair < 0) return "a shared row that no pair within d_i held";
+    if (pair < 0) {
+      s << "a shared row that no pair within d_i held";
+      return;
+    }
   } else {
     pair = static_cast<int>(std::upper_bound(first_row_.begin(), first_row_.end(), row) - first_row_.begin()) - 1;
     sub = row - first_row_[static_cast<std::size_t>(pair)];
   }
-  return describe_pair(data, pair) + (sub > 0 ? " (corner " + std::to_string(sub) + " of the link's box)" : "");
+  describe_pair_to(data, pair, s);
+  if (sub > 0) s << " (corner " << sub << " of the link's box)";
+}
+
+std::string ObstacleAvoidance::describe_inequality_row(const PluginData* data, int row) const {
+  std::string out;
+  out.reserve(kDiagnosisCapacity);
+  TextSink s(out);
+  describe_inequality_row_to(data, row, s);
+  return out;
+}
+
+void ObstacleAvoidance::describe_pair_to(const PluginData* data, int pair, TextSink& s) const {
+  if (pair < 0 || pair >= links_ * obstacles_ || data == nullptr) return;
+  const int o = pair / links_, l = pair % links_;
+  const auto& shape = robot_->link_shapes()[static_cast<std::size_t>(l)];
+  s << "link '" << robot_->joint(shape.link).name << "' ";
+  shape.spec.describe(s);
+  s << " vs obstacle " << o + 1 << " ";
+  config_.obstacles[static_cast<std::size_t>(o)].describe(s);
+  s.precision(4);
+  s << " at distance " << pair_data(data).distances[pair] << " m";
 }
 
 std::string ObstacleAvoidance::describe_pair(const PluginData* data, int pair) const {
-  if (pair < 0 || pair >= links_ * obstacles_ || data == nullptr) return {};
-  const int row = pair;
-  const int o = row / links_, l = row % links_;
-  const auto& shape = robot_->link_shapes()[static_cast<std::size_t>(l)];
-  std::ostringstream s;
-  s.precision(4);
-  s << "link '" << robot_->joint(shape.link).name << "' " << shape.spec.describe() << " vs obstacle " << o + 1 << " "
-    << config_.obstacles[static_cast<std::size_t>(o)].describe() << " at distance " << pair_data(data).distances[row]
-    << " m";
-  return s.str();
+  std::string out;
+  out.reserve(kDiagnosisCapacity);
+  TextSink s(out);
+  describe_pair_to(data, pair, s);
+  return out;
 }
 
 void ObstacleAvoidance::scene_obstacles(std::vector<ShapeSpec>& out) const {

@@ -91,17 +91,25 @@ void SelfCollision::add_to(const Context& ctx, QpBuilder& builder, PluginData* p
   }
 }
 
-std::string SelfCollision::describe_inequality_row(const PluginData* data, int row) const {
-  if (row < 0 || row >= static_cast<int>(pairs_.size()) || data == nullptr) return {};
+void SelfCollision::describe_inequality_row_to(const PluginData* data, int row, TextSink& s) const {
+  if (row < 0 || row >= static_cast<int>(pairs_.size()) || data == nullptr) return;
   const auto& links = robot_->link_shapes();
   const auto& sa = links[static_cast<std::size_t>(pairs_[static_cast<std::size_t>(row)].first)];
   const auto& sb = links[static_cast<std::size_t>(pairs_[static_cast<std::size_t>(row)].second)];
-  std::ostringstream s;
+  s << "link '" << robot_->joint(sa.link).name << "' ";
+  sa.spec.describe(s);
+  s << " vs link '" << robot_->joint(sb.link).name << "' ";
+  sb.spec.describe(s);
   s.precision(4);
-  s << "link '" << robot_->joint(sa.link).name << "' " << sa.spec.describe() << " vs link '"
-    << robot_->joint(sb.link).name << "' " << sb.spec.describe() << " at distance " << pair_data(data).distances[row]
-    << " m";
-  return s.str();
+  s << " at distance " << pair_data(data).distances[row] << " m";
+}
+
+std::string SelfCollision::describe_inequality_row(const PluginData* data, int row) const {
+  std::string out;
+  out.reserve(kDiagnosisCapacity);
+  TextSink s(out);
+  describe_inequality_row_to(data, row, s);
+  return out;
 }
 
 namespace {

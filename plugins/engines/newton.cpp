@@ -150,8 +150,9 @@ void Newton::run(const QpProblem& qp, SolverResult& result) {
     case Reduced::kConverged: finish(result, SolverStatus::kSolved, k, f2); return;
     case Reduced::kInfeasible: finish(result, SolverStatus::kInfeasible, k, f2); return;
     case Reduced::kStalled:
-      result.info.diagnosis = "newton did not converge in " + std::to_string(k) + " iterations (residual " +
-                              std::to_string(std::sqrt(f2)) + ")";
+      result.info.diagnosis.clear();
+      TextSink(result.info.diagnosis) << "newton did not converge in " << k << " iterations (residual " << std::sqrt(f2)
+                                      << ")";
       run_fallback(qp, result, k, std::sqrt(f2), x_);
       return;
   }

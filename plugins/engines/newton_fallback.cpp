@@ -58,11 +58,8 @@ void Newton::run_fallback(const QpProblem& qp, SolverResult& result, int newton_
   }
   result.info.status = fb.status;
   result.info.iterations = newton_iterations + fb.iterations;
-  std::ostringstream text;
-  text.precision(6);
-  text << "; projection, its fallback, then stopped after " << fb.iterations << " iterations with residual "
-       << fb.residual;
-  result.info.diagnosis += text.str();
+  TextSink(result.info.diagnosis) << "; projection, its fallback, then stopped after " << fb.iterations
+                                  << " iterations with residual " << fb.residual;
 }
 
 }  // namespace redres::newton_internal

@@ -71,7 +71,8 @@ class Projection final : public LviEngine {
     const double tol2 = settings().tolerance * settings().tolerance;
     if (out.broke_down) {
       info.status = SolverStatus::kNumericalError;
-      info.diagnosis = "eq. 15 broke down: ||phi|| = 0 with ||e|| = " + std::to_string(info.residual);
+      info.diagnosis.clear();
+      TextSink(info.diagnosis) << "eq. 15 broke down: ||phi|| = 0 with ||e|| = " << info.residual;
     } else {
       info.status = out.e2 <= tol2 ? SolverStatus::kSolved : SolverStatus::kMaxIterations;
     }

@@ -17,6 +17,7 @@
 #include "redres/paths/circle.hpp"
 #include "redres/paths/helix.hpp"
 #include "redres/paths/letter_r.hpp"
+#include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
 #include "test_util.hpp"
 
@@ -99,6 +100,65 @@ TEST(ControllerRealTime, ThousandStepsWithEveryPerStepPluginAllocateNothing) {
     EXPECT_EQ(allocations, 0);
     EXPECT_EQ(solved, 1000) << "last: " << to_string(out.info.status) << ": " << out.info.diagnosis;
     EXPECT_EQ(out.info.engine, c.engine == std::string("newton") ? "newton" : "projection");
+  }
+}
+
+// Steps that fail allocate nothing either, diagnosis included: for each engine with a real-time path and each policy
+// (hold: theta_dot = 0; relax: the elastic QP), on scenes whose steps fail for different reasons: a sphere on the
+// Panda's hand path (the task rows against collision rows), the same sphere beside the point-cloud scenario's cloud,
+// and the paper's arm asked for a path 50 times faster than its joints can follow (the task rows against the
+// velocity bounds). The first failed step is counted too: the texts are written into storage sized at setup.
+TEST(ControllerRealTime, FailedStepsAllocateNothingWhateverTheEngineAndPolicy) {
+  if (!testing::allocation_counting_available()) {
+    GTEST_SKIP() << "AddressSanitizer owns malloc here; the release build runs this check";
+  }
+  struct Scene {
+    const char* config;
+    std::vector<std::string> overrides;
+  };
+  const std::string sphere =
+      "{ shape = \"sphere\", radius = 0.03, xyz = [0.607, 0.0, 0.59] }";  // on the circle of the hand
+  const std::vector<Scene> scenes = {
+      {"configs/panda_table_pole.toml", {"constraints.3.obstacles=[" + sphere + "]"}},
+      {"configs/panda_point_cloud.toml",
+       {"constraints.3.obstacles=[{ shape = \"points\", file = \"clouds/panda_workcell.ply\", resolution = 0.01, "
+        "radius = 0.005 }, " +
+        sphere + "]"}},
+      {"configs/paper_r_tvcmm.toml", {"duration=0.8"}},
+  };
+  for (const Scene& scene : scenes) {
+    for (const char* engine : {"newton", "projection"}) {
+      for (const bool relax : {false, true}) {
+        SCOPED_TRACE(std::string(scene.config) + ", " + engine + (relax ? ", relax" : ", hold"));
+        std::vector<std::string> o = scene.overrides;
+        o.push_back(std::string("solver.engine=") + engine);
+        if (relax) o.emplace_back("solver.on_infeasible=relax");
+        Scenario s = load_scenario(source_path(scene.config), o);
+        const auto ctrl = Controller::from_scenario(s);
+        StepOutput out = ctrl->make_output();
+        Eigen::VectorXd theta = s.theta0;
+        ctrl->step(theta, 0.0, out);
+        theta += s.tau * out.theta_dot;
+        const int steps = static_cast<int>(std::lround(s.duration / s.tau));
+        long allocations = 0;
+        int failed = 0;
+        std::string last;
+        for (int k = 1; k < steps && failed < 20; ++k) {  // 20 failed steps make the case
+          {
+            const testing::AllocationCounter counter;
+            ctrl->step(theta, k * s.tau, out);
+            allocations += counter.count();
+          }
+          if (out.info.status != SolverStatus::kSolved) {
+            ++failed;
+            last = out.info.diagnosis;
+          }
+          theta += s.tau * out.theta_dot;
+        }
+        EXPECT_GE(failed, 3) << "the scene makes steps fail";
+        EXPECT_EQ(allocations, 0) << failed << " failed steps; the last: " << last;
+      }
+    }
   }
 }
 

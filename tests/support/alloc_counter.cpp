@@ -1,6 +1,8 @@
 #include "alloc_counter.hpp"
 
+#include <execinfo.h>
 #include <atomic>
+#include <cstdlib>
 
 #if defined(__SANITIZE_ADDRESS__)
 #define REDRES_COUNT_ALLOCATIONS 0
@@ -17,7 +19,17 @@ namespace {
 std::atomic<bool> g_counting{false};
 std::atomic<long> g_allocations{0};
 inline void note() {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (g_counting.load(std::memory_order_relaxed)) {
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
+    // REDRES_DEBUG_ALLOC=1: each counted allocation's call stack on stderr (pipe through c++filt), to find it.
+    if (std::getenv("REDRES_DEBUG_ALLOC") != nullptr) {
+      g_counting.store(false);
+      void* frames[40];
+      const int n = backtrace(frames, 40);
+      backtrace_symbols_fd(frames, n, 2);
+      g_counting.store(true);
+    }
+  }
 }
 }  // namespace
 

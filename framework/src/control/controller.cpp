@@ -47,7 +47,7 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
 StepOutput Controller::make_output() const {
   StepOutput out;
   out.theta_dot = Eigen::VectorXd::Zero(robot_->dof());
-  out.info.diagnosis.reserve(256);
+  out.info.diagnosis.reserve(kDiagnosisCapacity);  // a failed step's text is written here without allocating
   return out;
 }
 
@@ -136,6 +136,8 @@ void Controller::set_relaxation(double weight) {
     relax_engine_ = make_engine(std::string(engine_->name()), engine_->settings());
     relaxed_.setup(qp_);
     relax_engine_->setup(qp_.n(), 0, qp_.m_in(), relaxed_result_);
+    note_.reserve(kDiagnosisCapacity);
+    row_miss_.resize(qp_.m_eq());
   }
 }
 
@@ -145,22 +147,23 @@ void Controller::relax(StepOutput& out) {
   relaxed_.build(qp_, rho);
   relax_engine_->solve_valid(relaxed_.problem(), relaxed_result_);
   const SolverInfo& r = relaxed_result_.info;
-  std::ostringstream s;
-  s.precision(6);
   if (r.status != SolverStatus::kSolved) {
-    s << "; the elastic QP (rows relaxed with weight " << rho << ") failed too: " << to_string(r.status) << ": "
-      << r.diagnosis;
-    out.info.diagnosis += s.str();
+    TextSink(out.info.diagnosis).precision(6) << "; the elastic QP (rows relaxed with weight " << rho
+                                              << ") failed too: " << to_string(r.status) << ": " << r.diagnosis;
     return;
   }
   out.theta_dot = relaxed_result_.x;
-  out.task_row_error = qp_.m_eq() > 0 ? (qp_.J * out.theta_dot - qp_.d).cwiseAbs().maxCoeff() : 0.0;
-  s << "rows relaxed (weight " << rho << "), missed by " << out.task_row_error << " at most, after "
-    << to_string(out.info.status) << ": " << out.info.diagnosis;
+  row_miss_.noalias() = qp_.J * out.theta_dot;  // sized at set_relaxation(): no temporary
+  row_miss_ -= qp_.d;
+  out.task_row_error = qp_.m_eq() > 0 ? row_miss_.cwiseAbs().maxCoeff() : 0.0;
+  // The failed solve's text goes after the relaxation's: kept aside in note_ (both reserved, so no allocation).
+  note_.swap(out.info.diagnosis);
+  out.info.diagnosis.clear();
+  TextSink(out.info.diagnosis).precision(6) << "rows relaxed (weight " << rho << "), missed by " << out.task_row_error
+                                            << " at most, after " << to_string(out.info.status) << ": " << note_;
   out.info.status = SolverStatus::kRelaxed;
   out.info.iterations += r.iterations;
   out.info.residual = r.residual;
-  out.info.diagnosis = s.str();
 }
 
 }  // namespace redres

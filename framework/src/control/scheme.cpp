@@ -84,13 +84,13 @@ void Scheme::setup(QpProblem& qp, const SchemeData& data) const {
   const int base = static_cast<int>(objectives_.size());
   // The constraints' data, by the vector's storage: it stays where it is when the SchemeData itself is moved.
   const std::unique_ptr<PluginData>* own = data.constraints.data();
-  qp.in_row_description = [this, own](int row) -> std::string {
+  qp.in_row_description = [this, own](int row, TextSink& out) {
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
       if (row >= in_offset_[k] && row < in_offset_[k] + in_rows_[k]) {
-        return constraints_[k]->describe_inequality_row(own[k].get(), row - in_offset_[k]);
+        constraints_[k]->describe_inequality_row_to(own[k].get(), row - in_offset_[k], out);
+        return;
       }
     }
-    return {};
   };
   for (std::size_t k = 0; k < constraints_.size(); ++k) {
     for (int r = 0; r < eq_rows_[k]; ++r)

@@ -125,8 +125,7 @@ double ShapeSpec::axis_length() const {
   return length.value_or(0.0);
 }
 
-std::string ShapeSpec::describe() const {
-  std::ostringstream s;
+void ShapeSpec::describe(TextSink& s) const {
   s.precision(4);
   s << config_io::enum_name(shape) << "(";
   switch (shape) {
@@ -135,10 +134,13 @@ std::string ShapeSpec::describe() const {
     case Kind::kCylinder: s << "r = " << radius.value_or(0.0) << " m, l = " << axis_length() << " m"; break;
     case Kind::kBox: s << "size = " << (*size)[0] << " x " << (*size)[1] << " x " << (*size)[2] << " m"; break;
     case Kind::kOctree:
-    case Kind::kPoints:
-      s << file.filename().string();
+    case Kind::kPoints: {
+      const std::string_view whole = file.native();  // its last component, without making a path
+      const std::size_t slash = whole.find_last_of('/');
+      s << (slash == std::string_view::npos ? whole : whole.substr(slash + 1));
+    }
       if (cloud) {
-        const OccupancyInfo info = occupancy_info(*cloud);
+        const OccupancyInfo& info = cloud->info();
         if (shape == Kind::kPoints) s << ": " << info.points << " points";
         s << (shape == Kind::kPoints ? " in " : ": ") << info.cells << " cells of " << info.resolution << " m";
       }
@@ -146,7 +148,14 @@ std::string ShapeSpec::describe() const {
       break;
   }
   s << ")";
-  return s.str();
+}
+
+std::string ShapeSpec::describe() const {
+  std::string out;
+  out.reserve(512);
+  TextSink s(out);
+  describe(s);
+  return out;
 }
 
 namespace {

@@ -334,7 +334,10 @@ struct Search {
       const double bound = metric.bound(centre(i), hc);
       if (bound < best) kids[static_cast<std::size_t>(n++)] = {bound, i};
     }
-    std::sort(kids.begin(), kids.begin() + n);
+    for (int i = 1; i < n; ++i) {  // insertion sort of at most 8, nearest first
+      for (int j = i; j > 0 && kids[static_cast<std::size_t>(j)] < kids[static_cast<std::size_t>(j - 1)]; --j)
+        std::swap(kids[static_cast<std::size_t>(j)], kids[static_cast<std::size_t>(j - 1)]);
+    }
     for (int k = 0; k < n; ++k) {
       const auto [bound, i] = kids[static_cast<std::size_t>(k)];
       if (!(bound < best)) break;

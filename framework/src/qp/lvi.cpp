@@ -49,7 +49,8 @@ void LviEngine::setup(int n, int m_e, int m_i, SolverResult& result) {
   result.y = Eigen::VectorXd::Zero(m_e);
   result.z = Eigen::VectorXd::Zero(m_i);
   result.info = SolverInfo{};
-  result.info.diagnosis.reserve(256);
+  result.info.diagnosis.reserve(kDiagnosisCapacity);
+  note_.reserve(kDiagnosisCapacity);
   warm_ = false;
   fitter_.setup(n, m_e, m_i);
   do_setup(n, m_e, m_i);
@@ -91,7 +92,9 @@ void LviEngine::run(const QpProblem& qp, SolverResult& result) {
     double gap = 0.0;
     for (int i = 0; i < n_; ++i) gap = std::max(gap, lo[i] - hi[i]);
     info.residual = std::isfinite(gap) ? gap : std::numeric_limits<double>::max();
-    info.diagnosis = "bounds conflict at " + describe(conflict, qp.variable_names);
+    TextSink text(info.diagnosis);
+    text << "bounds conflict at ";
+    describe(conflict, qp.variable_names, text);
     result.x.setZero();  // a definite value; callers must check the status
     result.y.setZero();
     result.z.setZero();

@@ -103,21 +103,31 @@ BoundConflict find_bound_conflict(const QpProblem& qp) {
   return c;
 }
 
-std::string source_name(const QpProblem& qp, int s) {
-  return s >= 0 && s < static_cast<int>(qp.source_names.size()) ? qp.source_names[static_cast<std::size_t>(s)]
-                                                                : std::string("(none)");
+std::string_view source_name(const QpProblem& qp, int s) {
+  return s >= 0 && s < static_cast<int>(qp.source_names.size())
+             ? std::string_view(qp.source_names[static_cast<std::size_t>(s)])
+             : std::string_view("(none)");
 }
 
-std::string describe(const BoundConflict& c, const std::vector<std::string>& joint_names) {
-  if (c.joint < 0) return "no bound conflict";
-  std::ostringstream s;
+void describe(const BoundConflict& c, const std::vector<std::string>& joint_names, TextSink& s) {
+  if (c.joint < 0) {
+    s << "no bound conflict";
+    return;
+  }
   s.precision(9);
   s << "joint " << c.joint + 1;
   if (c.joint < static_cast<int>(joint_names.size()))
     s << " ('" << joint_names[static_cast<std::size_t>(c.joint)] << "')";
   s << ": lower bound " << c.lo << " (from '" << c.lo_source << "') > upper bound " << c.hi << " (from '" << c.hi_source
     << "')";
-  return s.str();
+}
+
+std::string describe(const BoundConflict& c, const std::vector<std::string>& joint_names) {
+  std::string out;
+  out.reserve(kDiagnosisCapacity);
+  TextSink s(out);
+  describe(c, joint_names, s);
+  return out;
 }
 
 }  // namespace redres

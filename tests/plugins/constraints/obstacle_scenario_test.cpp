@@ -5,6 +5,7 @@
 // a failed step that names the pair and its distance. Distances are recomputed here, independently, from the
 // recorded angles and time (a moving obstacle is at p0 + v t).
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -125,8 +126,50 @@ TEST_P(ObstacleScenarios, LinksKeepTheSafetyDistanceAndTheTaskIsMet) {
 INSTANTIATE_TEST_SUITE_P(Configs, ObstacleScenarios,
                          ::testing::Values(ObstacleCase{"paper_r_obstacle", 1e-5},
                                            ObstacleCase{"paper_r_moving_obstacle", 1e-5},
-                                           ObstacleCase{"panda_table_pole", 1e-4}),
+                                           ObstacleCase{"panda_table_pole", 1e-4},
+                                           ObstacleCase{"panda_point_cloud", 1e-4}),
                          [](const ::testing::TestParamInfo<ObstacleCase>& c) { return std::string(c.param.config); });
+
+// The point-cloud scenario against the points themselves, by brute force (every 10th recorded row, every capsule or
+// sphere link, all 100,000 points): the grown cells hold each point's ball of the obstacle's radius, so every link
+// keeps the safety distance from those balls too, and the closest approach to them is within a cell's diagonal of the
+// one the run reports.
+TEST(ObstacleScenario, ThePointCloudRunKeepsItsLinksOffThePointsThemselves) {
+  Scenario s = load_scenario(source_path("configs/panda_point_cloud.toml"));
+  const auto& config = plugin_of(s).settings();
+  ASSERT_EQ(config.obstacles.size(), 1U);
+  const ShapeSpec& cloud = config.obstacles[0];
+  const std::vector<Eigen::Vector3d> points = read_points(source_path("configs/clouds/panda_workcell.ply"));
+  ASSERT_EQ(points.size(), 100000U);
+  const RunResult run = simulate(s);
+  const RobotModel& robot = *s.robot;
+  KinematicsData k(robot);
+  double low = 1e9;
+  int links = 0;
+  for (std::size_t r = 0; r < run.trajectory.size(); r += 10) {
+    compute_kinematics(robot, recorded_theta(robot, run.trajectory, r), k, KinematicsLevel::kPosition);
+    links = 0;
+    for (const auto& shape : robot.link_shapes()) {
+      if (shape.spec.shape != ShapeSpec::Kind::kCapsule && shape.spec.shape != ShapeSpec::Kind::kSphere) continue;
+      ++links;
+      const Eigen::Isometry3d T =
+          cloud.pose().inverse() * k.link_frames[static_cast<std::size_t>(shape.link)] * shape.pose;
+      const double h = shape.spec.shape == ShapeSpec::Kind::kCapsule ? 0.5 * shape.spec.axis_length() : 0.0;
+      const Eigen::Vector3d a = T * Eigen::Vector3d(0, 0, -h), b = T * Eigen::Vector3d(0, 0, h);
+      const Eigen::Vector3d ab = b - a;
+      for (const Eigen::Vector3d& p : points) {
+        const double u = h > 0.0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+        low = std::min(low, (a + u * ab - p).norm() - *shape.spec.radius - *cloud.radius);
+      }
+    }
+  }
+  EXPECT_GE(links, 6) << "most of the Panda's links are capsules";
+  EXPECT_GE(low, config.safety_distance - 1e-4);
+  const double reported = summarise(s, run).metric("obstacle_avoidance", "min_obstacle_distance")->values.at(0);
+  EXPECT_LE(reported, low + 1e-9);
+  EXPECT_GE(reported, low - std::sqrt(3.0) * *cloud.resolution - 0.01) << "sampled every 10th row";
+  RecordProperty("min_distance_to_points", std::to_string(low));
+}
 
 // The moving-sphere run is solved by newton itself on every step (its rows live on about half of them), and the
 // closest approach happens while the sphere passes the elbow, not at the start or the end of the run.

@@ -119,6 +119,8 @@ class Controller {
   KinematicsLevel level_ = KinematicsLevel::kPosition;
   Context ctx_;
   double relax_weight_ = 0.0;                // set_relaxation(); 0: hold
+  std::string note_;                         // a failed step's text while relax() writes its own before it
+  Eigen::VectorXd row_miss_;                 // J x - d of a relaxed step
   std::unique_ptr<LviEngine> relax_engine_;  // an engine like *engine_ for the elastic QP
   ElasticQp relaxed_;                        // the elastic QP (no equality rows)
   SolverResult relaxed_result_;

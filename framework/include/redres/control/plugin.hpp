@@ -29,6 +29,7 @@
 
 #include <Eigen/Core>
 
+#include "redres/common/text_sink.hpp"
 #include "redres/config/config.hpp"
 #include "redres/config/registry.hpp"
 #include "redres/control/context.hpp"
@@ -165,6 +166,12 @@ class Constraint : public Plugin {
     (void)data;
     (void)row;
     return {};
+  }
+  /// The same, written into a failed step's diagnosis: what the diagnosis calls. Default: writes
+  /// describe_inequality_row(), whose string allocates; a plugin that writes its text here with `out << ...`
+  /// (TextSink: strings and numbers, no allocation) keeps its failed steps allocation-free.
+  virtual void describe_inequality_row_to(const PluginData* data, int row, TextSink& out) const {
+    out << describe_inequality_row(data, row);
   }
 
  protected:

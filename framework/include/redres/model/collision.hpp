@@ -26,6 +26,7 @@
 
 #include <Eigen/Geometry>
 
+#include "redres/common/text_sink.hpp"
 #include "redres/config/config.hpp"
 
 namespace redres {
@@ -68,6 +69,8 @@ struct ShapeSpec {
   /// One line, e.g. "capsule(r = 0.05 m, l = 0.3 m)" or "points(cloud.ply: 100000 points in 5310 cells of 0.01 m,
   /// r = 0.005 m)".
   [[nodiscard]] std::string describe() const;
+  /// The same, written into `out` (allocation-free, for a failed step's diagnosis).
+  void describe(TextSink& out) const;
   /// An octree or a point cloud (occupied space read from a file), not a primitive.
   [[nodiscard]] bool is_cloud() const noexcept { return shape == Kind::kOctree || shape == Kind::kPoints; }
 };

@@ -137,6 +137,7 @@ class LviEngine {
   bool diagnoses_ = true;
   int n_ = 0, m_e_ = 0, m_i_ = 0;
   RowFitter fitter_;  // the best fit of the rows inside the bounds, for failed solves
+  std::string note_;  // a failed solve's own note, while the diagnosis is written around it (reserved at setup)
 };
 
 /// ||e(u)||_2 of the LVI (eq. 14) at u = [x; y; z].

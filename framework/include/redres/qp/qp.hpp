@@ -13,11 +13,13 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "redres/common/error.hpp"
+#include "redres/common/text_sink.hpp"
 
 namespace redres {
 
@@ -45,9 +47,9 @@ struct QpProblem {
   std::vector<int> in_source;               //!< source of each inequality row
   Eigen::VectorXd scratch;                  //!< n-vector a plugin may use as workspace while it contributes
   Eigen::VectorXd scratch2;                 //!< a second one (e.g. upper bounds beside lower ones in scratch)
-  /// What inequality row r stands for at the last build (e.g. "link 'j3' shape 1 vs obstacle 2 at 0.012 m"), for
-  /// diagnoses; may be empty. Called only when a solve fails.
-  std::function<std::string(int)> in_row_description;
+  /// Writes what inequality row r stands for at the last build (e.g. "link 'j3' shape 1 vs obstacle 2 at 0.012 m"),
+  /// for diagnoses; may write nothing. Called only when a solve fails, into the diagnosis's reserved storage.
+  std::function<void(int, TextSink&)> in_row_description;
 
   /// Sizes every buffer: n variables, m_e equality rows, m_i inequality rows.
   void resize(int n, int m_e, int m_i);
@@ -65,11 +67,11 @@ struct QpProblem {
 
 /// The conflict lo_i > hi_i of the first such joint, or index -1 when the box is consistent.
 struct BoundConflict {
-  int joint = -1;         //!< 0-based joint index, -1 if none
-  double lo = 0.0;        //!< the merged lower bound
-  double hi = 0.0;        //!< the merged upper bound
-  std::string lo_source;  //!< plugin that set lo
-  std::string hi_source;  //!< plugin that set hi
+  int joint = -1;              //!< 0-based joint index, -1 if none
+  double lo = 0.0;             //!< the merged lower bound
+  double hi = 0.0;             //!< the merged upper bound
+  std::string_view lo_source;  //!< plugin that set lo (a name held by the QP)
+  std::string_view hi_source;  //!< plugin that set hi (a name held by the QP)
 };
 
 /// Finds the first joint whose merged bounds conflict (lo_i > hi_i).
@@ -78,8 +80,10 @@ struct BoundConflict {
 /// "joint 3 ('j3'): lower bound 0.2 (from 'joint_angle_margin') > upper bound 0.1 (from
 /// 'joint_velocity_limits')".
 [[nodiscard]] std::string describe(const BoundConflict& conflict, const std::vector<std::string>& joint_names = {});
+/// The same, written into `out` (allocation-free).
+void describe(const BoundConflict& conflict, const std::vector<std::string>& joint_names, TextSink& out);
 
 /// The name of source `s` of `qp` ("(none)" when unset).
-[[nodiscard]] std::string source_name(const QpProblem& qp, int s);
+[[nodiscard]] std::string_view source_name(const QpProblem& qp, int s);
 
 }  // namespace redres

@@ -70,6 +70,7 @@ class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig>, 
   [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
   [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
   [[nodiscard]] std::string describe_inequality_row(const PluginData* data, int row) const override;
+  void describe_inequality_row_to(const PluginData* data, int row, TextSink& out) const override;
   [[nodiscard]] std::string describe_pair(const PluginData* data, int pair) const override;
   /// Its obstacles, as configured (summary.json's `obstacles`).
   void scene_obstacles(std::vector<ShapeSpec>& out) const override;
@@ -78,6 +79,8 @@ class ObstacleAvoidance final : public PairConstraint<ObstacleAvoidanceConfig>, 
   [[nodiscard]] Eigen::Isometry3d obstacle_pose(int k, double t) const;
 
  private:
+  // Writes pair `pair` (link, obstacle, distance) into `out`.
+  void describe_pair_to(const PluginData* data, int pair, TextSink& out) const;
   struct Data;
   void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
   // The row of link shape l (at Tl) against obstacle o (at To): measured, then a damper or a slack row.

@@ -38,6 +38,7 @@ class SelfCollision final : public PairConstraint<SelfCollisionConfig>, public P
   [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
   [[nodiscard]] int inequality_rows(const RobotModel& robot) const override;
   [[nodiscard]] std::string describe_inequality_row(const PluginData* data, int row) const override;
+  void describe_inequality_row_to(const PluginData* data, int row, TextSink& out) const override;
   /// The checked pairs (indices into RobotModel::link_shapes()).
   [[nodiscard]] const std::vector<std::pair<int, int>>& pairs() const noexcept { return pairs_; }
 

@@ -4,8 +4,10 @@
 // of 10 ms from a bent configuration. BM_Scaling/<engine>/<planar|spatial>/<n>; per_step is the time per step (s),
 // iterations_per_step the engine's iterations per step.
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
@@ -42,13 +44,13 @@ RobotModel chain(bool planar, int n) {
   return RobotModel(std::move(spec));
 }
 
-void BM_Scaling(benchmark::State& state, const char* engine_name, bool planar) {
+void BM_Scaling(benchmark::State& state, const char* engine_name, bool planar, double p = 1.0) {
   const int n = static_cast<int>(state.range(0));
   const RobotModel robot = chain(planar, n);
   std::vector<std::unique_ptr<Objective>> objectives;
   objectives.push_back(std::make_unique<MinVelocityNorm>(MinVelocityNorm::Config{}, robot));
   objectives.push_back(std::make_unique<Manipulability>(
-      Manipulability::Config{.p = 1.0, .schedule = Manipulability::Schedule::kConstant}, robot));
+      Manipulability::Config{.p = p, .schedule = Manipulability::Schedule::kConstant}, robot));
   std::vector<std::unique_ptr<Constraint>> constraints;
   constraints.push_back(std::make_unique<TaskTracking>(TaskTracking::Config{}, robot));
   constraints.push_back(std::make_unique<JointAngleMargin>(JointAngleMargin::Config{}, robot));
@@ -64,10 +66,12 @@ void BM_Scaling(benchmark::State& state, const char* engine_name, bool planar) {
   const Eigen::VectorXd start = k.f;
   Eigen::VectorXd theta(n), r_d = start, r_d_dot = Eigen::VectorXd::Zero(start.size());
   int failures = 0;
-  long iterations = 0;
+  long iterations = 0, at_bound = 0, flips = 0;
+  std::vector<int> side(static_cast<std::size_t>(n), 0), last(static_cast<std::size_t>(n), 0);
   for (auto _ : state) {
     theta = robot.home();
     ctrl.reset();
+    std::fill(last.begin(), last.end(), 0);
     for (int s = 0; s < steps; ++s) {
       const double a = 2.0 * std::numbers::pi * s / steps;
       r_d(0) = start(0) + 0.02 * (std::cos(a) - 1.0);
@@ -77,6 +81,14 @@ void BM_Scaling(benchmark::State& state, const char* engine_name, bool planar) {
       ctrl.step(theta, s * tau, r_d, r_d_dot, out);
       failures += out.info.status == SolverStatus::kSolved ? 0 : 1;
       iterations += out.info.iterations;
+      // Which joints run at their velocity limit (2 rad/s), and how many changed that from the step before.
+      for (int j = 0; j < n; ++j) {
+        const double v = out.theta_dot(j);
+        side[static_cast<std::size_t>(j)] = v >= 2.0 - 1e-9 ? 1 : (v <= -2.0 + 1e-9 ? -1 : 0);
+        at_bound += side[static_cast<std::size_t>(j)] != 0;
+        flips += s > 0 && side[static_cast<std::size_t>(j)] != last[static_cast<std::size_t>(j)];
+      }
+      last.swap(side);
       theta += tau * out.theta_dot;
     }
     benchmark::DoNotOptimize(theta.data());
@@ -86,6 +98,10 @@ void BM_Scaling(benchmark::State& state, const char* engine_name, bool planar) {
   state.counters["failed_steps"] = failures;
   state.counters["iterations_per_step"] =
       benchmark::Counter(static_cast<double>(iterations) / steps, benchmark::Counter::kAvgIterations);
+  state.counters["at_velocity_bound"] =
+      benchmark::Counter(static_cast<double>(at_bound) / steps, benchmark::Counter::kAvgIterations);
+  state.counters["bound_changes"] =
+      benchmark::Counter(static_cast<double>(flips) / steps, benchmark::Counter::kAvgIterations);
 }
 
 void planar_sizes(benchmark::internal::Benchmark* b) {
@@ -100,6 +116,11 @@ BENCHMARK_CAPTURE(BM_Scaling, projection_planar, "projection", true)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Scaling, newton_planar, "newton", true)->Apply(planar_sizes)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Scaling, nlopt_planar, "nlopt", true)->Apply(planar_sizes)->Unit(benchmark::kMicrosecond);
+// The same chains with p = 0.1: below the p at which the long chains' manipulability ascent overshoots within a step
+// (with p = 1, past 48 joints a third of the joints swap velocity bounds every step; see docs/performance.md).
+BENCHMARK_CAPTURE(BM_Scaling, newton_planar_p0_1, "newton", true, 0.1)
+    ->Apply(planar_sizes)
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Scaling, projection_spatial, "projection", false)
     ->Apply(spatial_sizes)
     ->Unit(benchmark::kMicrosecond);

@@ -37,8 +37,10 @@ Eigen::Vector3d vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]};
 const Schema<ShapeSpec>& ShapeSpec::schema() {
   using S = ShapeSpec;
   static const Schema<S> s{
-      {field("shape", &S::shape, "", "the primitive"),
-       field("radius", &S::radius, "m", "sphere, capsule, cylinder: radius"),
+      {field("shape", &S::shape, "",
+             "the primitive, or occupied space read from a file (octree, points: obstacles only)"),
+       field("radius", &S::radius, "m",
+             "sphere, capsule, cylinder: radius; octree, points: how far the occupied cells are grown (default 0)"),
        field("length", &S::length, "m", "capsule, cylinder: axis length (along the local z axis)"),
        field("size", &S::size, "m", "box: full side lengths [x, y, z]"),
        field("xyz", &S::xyz, "m", "position in the owner's frame"),
@@ -52,7 +54,8 @@ const Schema<ShapeSpec>& ShapeSpec::schema() {
       [](const S& spec) {
         const std::string name(config_io::enum_name(spec.shape));
         if (spec.is_cloud()) {
-          if (spec.file.empty()) throw FieldError("file", "is required for " + name + " (the file to read)");
+          if (!spec.file || spec.file->empty())
+            throw FieldError("file", "is required for " + name + " (the file to read)");
           if (spec.radius && !(std::isfinite(*spec.radius) && *spec.radius >= 0.0)) {
             throw FieldError("radius", "expected a radius >= 0 m (how far the occupied cells are grown)");
           }
@@ -74,7 +77,7 @@ const Schema<ShapeSpec>& ShapeSpec::schema() {
           }
           return;
         }
-        if (!spec.file.empty()) throw FieldError("file", "is only used by an octree or points obstacle");
+        if (spec.file) throw FieldError("file", "is only used by an octree or points obstacle");
         if (spec.resolution) throw FieldError("resolution", "is only used by a points obstacle");
         const bool round = spec.shape != Kind::kBox;
         if (round && !spec.radius) throw FieldError("radius", "is required for a " + name);
@@ -135,7 +138,8 @@ void ShapeSpec::describe(TextSink& s) const {
     case Kind::kBox: s << "size = " << (*size)[0] << " x " << (*size)[1] << " x " << (*size)[2] << " m"; break;
     case Kind::kOctree:
     case Kind::kPoints: {
-      const std::string_view whole = file.native();  // its last component, without making a path
+      const std::string_view whole =
+          file ? std::string_view(file->native()) : std::string_view();  // its last component, without making a path
       const std::size_t slash = whole.find_last_of('/');
       s << (slash == std::string_view::npos ? whole : whole.substr(slash + 1));
     }

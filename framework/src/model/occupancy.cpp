@@ -372,8 +372,8 @@ std::vector<Eigen::Vector3d> read_points(const std::filesystem::path& file) {
 
 void load_cloud(ShapeSpec& spec) {
   if (spec.cloud || !spec.is_cloud()) return;
-  const std::filesystem::path& file = spec.file;
-  if (file.empty()) throw std::invalid_argument("a cloud obstacle needs `file`");
+  if (!spec.file || spec.file->empty()) throw std::invalid_argument("a cloud obstacle needs `file`");
+  const std::filesystem::path& file = *spec.file;
   const double grow = spec.radius.value_or(0.0);
   if (spec.shape == ShapeSpec::Kind::kOctree) {
     const std::string ext = lower_extension(file);

@@ -170,7 +170,7 @@ nlohmann::json shape_json(const ShapeSpec& shape) {
     case ShapeSpec::Kind::kOctree:
     case ShapeSpec::Kind::kPoints: {
       // The file, and its occupied cells (centre, edge; cloud frame): every k-th of them past 3,000, for plots.
-      j["file"] = shape.file.string();
+      j["file"] = shape.file.value_or("").string();
       j["radius"] = shape.radius.value_or(0.0);
       if (shape.cloud) {
         const auto cells = occupied_cells(*shape.cloud);

@@ -52,7 +52,7 @@ struct ShapeSpec {
   std::optional<std::array<double, 3>> from{};      //!< capsule: one end of the axis (m)
   std::optional<std::array<double, 3>> to{};        //!< capsule: the other end of the axis (m)
   std::optional<std::array<double, 3>> velocity{};  //!< obstacles: constant linear velocity (m/s)
-  std::filesystem::path file{};                     //!< octree, points: the file (relative to the file naming it)
+  std::optional<std::filesystem::path> file{};      //!< octree, points: the file (relative to the file naming it)
   std::optional<double> resolution{};               //!< points: the cell edge the points are put into (m)
   /// octree, points: the occupied cells, once read (load_cloud()); shared by the spec's copies.
   std::shared_ptr<const OccupancyMap> cloud{};

@@ -330,12 +330,17 @@ void round_box(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double r, c
 // cell is a box: round_box).
 struct RoundMetric final : OccupancyMap::Metric {
   RoundMetric(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double radius, double grow)
-      : p0(from), p1(to), r(radius), g(grow) {}
-  Eigen::Vector3d p0, p1;
+      : p0(from), p1(to), mid(0.5 * (from + to)), reach(0.5 * (to - from).norm() + radius + grow), r(radius), g(grow) {}
+  Eigen::Vector3d p0, p1, mid;
+  double reach;  // the radius of the ball about mid that holds the shape grown by g
   double r, g;
-  [[nodiscard]] double bound(const Eigen::Vector3d& c, double h) const override {
+  [[nodiscard]] double bound(const Eigen::Vector3d& c, double h, double best) const override {
+    // First the ball's distance to the cube (a few flops); only a cube that ball does not rule out gets the exact
+    // distance, which bounds the cells inside it.
+    const double ball = ((mid - c).cwiseAbs().array() - h).max(0.0).matrix().norm() - reach;
+    if (!(ball < best)) return ball;
     Eigen::Vector3d a, b;
-    return cell(c, h, a, b);  // the exact distance to a cube is a lower bound for the cells inside it
+    return cell(c, h, a, b);
   }
   double cell(const Eigen::Vector3d& c, double h, Eigen::Vector3d& on_query, Eigen::Vector3d& on_cloud) const override {
     Eigen::Isometry3d Tc = Eigen::Isometry3d::Identity();
@@ -375,7 +380,7 @@ struct DistanceQuery::Impl {
     std::size_t k;
     Eigen::Isometry3d T;
     double g;
-    [[nodiscard]] double bound(const Eigen::Vector3d& c, double h) const override {
+    [[nodiscard]] double bound(const Eigen::Vector3d& c, double h, double /*best*/) const override {
       return (c - impl.project(k, T, c)).norm() - std::sqrt(3.0) * h - g;
     }
     double cell(const Eigen::Vector3d& c, double h, Eigen::Vector3d& on_query,

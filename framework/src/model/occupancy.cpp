@@ -331,7 +331,7 @@ struct Search {
     };
     for (unsigned i = 0; i < 8; ++i) {
       if (!tree.nodeChildExists(node, i)) continue;
-      const double bound = metric.bound(centre(i), hc);
+      const double bound = metric.bound(centre(i), hc, best);
       if (bound < best) kids[static_cast<std::size_t>(n++)] = {bound, i};
     }
     for (int i = 1; i < n; ++i) {  // insertion sort of at most 8, nearest first
@@ -352,7 +352,7 @@ double OccupancyMap::nearest(const Metric& m, double within, Eigen::Vector3d& on
   const octomap::OcTreeNode* root = tree_->getRoot();
   if (root == nullptr || empty()) return std::numeric_limits<double>::infinity();
   Search s{*tree_, m, within};
-  if (m.bound(Eigen::Vector3d::Zero(), root_half_) < within) s.visit(root, Eigen::Vector3d::Zero(), root_half_);
+  if (m.bound(Eigen::Vector3d::Zero(), root_half_, within) < within) s.visit(root, Eigen::Vector3d::Zero(), root_half_);
   if (!(s.best < within)) return std::numeric_limits<double>::infinity();
   on_query = s.on_query;
   on_cloud = s.on_cloud;

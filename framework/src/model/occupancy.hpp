@@ -28,11 +28,11 @@ class OccupancyMap {
   [[nodiscard]] bool empty() const noexcept { return info_.cells == 0; }
 
   /// A query's measure of a cube (centre c, half edge h, in the cloud's frame): `bound` a lower bound on the distance
-  /// to anything in the cube, `cell` the distance to the occupied cube itself (grown by grow()), with the witness
+  /// to anything in the cube (it may stop at any bound not below `best`, the search's best so far), `cell` the distance to the occupied cube itself (grown by grow()), with the witness
   /// points on the query and on the grown cube.
   struct Metric {
     virtual ~Metric() = default;
-    [[nodiscard]] virtual double bound(const Eigen::Vector3d& c, double h) const = 0;
+    [[nodiscard]] virtual double bound(const Eigen::Vector3d& c, double h, double best) const = 0;
     virtual double cell(const Eigen::Vector3d& c, double h, Eigen::Vector3d& on_query,
                         Eigen::Vector3d& on_cloud) const = 0;
   };

@@ -150,6 +150,7 @@ void Newton::run(const QpProblem& qp, SolverResult& result) {
     case Reduced::kConverged: finish(result, SolverStatus::kSolved, k, f2); return;
     case Reduced::kInfeasible: finish(result, SolverStatus::kInfeasible, k, f2); return;
     case Reduced::kStalled:
+      keep_diagnosis_capacity(result.info.diagnosis);
       result.info.diagnosis.clear();
       TextSink(result.info.diagnosis) << "newton did not converge in " << k << " iterations (residual " << std::sqrt(f2)
                                       << ")";

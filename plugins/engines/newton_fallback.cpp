@@ -58,6 +58,7 @@ void Newton::run_fallback(const QpProblem& qp, SolverResult& result, int newton_
   }
   result.info.status = fb.status;
   result.info.iterations = newton_iterations + fb.iterations;
+  keep_diagnosis_capacity(result.info.diagnosis);
   TextSink(result.info.diagnosis) << "; projection, its fallback, then stopped after " << fb.iterations
                                   << " iterations with residual " << fb.residual;
 }

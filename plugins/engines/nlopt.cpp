@@ -123,11 +123,15 @@ class NloptSlsqp final : public LviEngine {
       // SLSQP met one of its own stopping tests (or rounding stopped it) short of the tolerance: not the iteration
       // cap, which is NLOPT_MAXEVAL_REACHED above.
       info.status = SolverStatus::kNumericalError;
-      info.diagnosis = std::string("SLSQP ended with ") + nlopt_result_to_string(code) + " short of the tolerance";
+      keep_diagnosis_capacity(info.diagnosis);
+      info.diagnosis.clear();
+      TextSink(info.diagnosis) << "SLSQP ended with " << nlopt_result_to_string(code) << " short of the tolerance";
     } else {
       info.status = SolverStatus::kNumericalError;
-      info.diagnosis = "nlopt SLSQP failed with code " + std::to_string(static_cast<int>(code)) + " (" +
-                       nlopt_result_to_string(code) + ")";
+      keep_diagnosis_capacity(info.diagnosis);
+      info.diagnosis.clear();
+      TextSink(info.diagnosis) << "nlopt SLSQP failed with code " << static_cast<int>(code) << " ("
+                               << nlopt_result_to_string(code) << ")";
     }
     have_x_ = info.status == SolverStatus::kSolved;
     (void)n;

@@ -71,6 +71,7 @@ class Projection final : public LviEngine {
     const double tol2 = settings().tolerance * settings().tolerance;
     if (out.broke_down) {
       info.status = SolverStatus::kNumericalError;
+      keep_diagnosis_capacity(info.diagnosis);
       info.diagnosis.clear();
       TextSink(info.diagnosis) << "eq. 15 broke down: ||phi|| = 0 with ||e|| = " << info.residual;
     } else {

@@ -452,5 +452,99 @@ TEST(Clouds, ARobotLinkCannotBeACloud) {
   }
 }
 
+// A point inside the cloud is its own nearest point (as for any shape), so a box corner inside gets no row that would
+// push it deeper.
+TEST(Clouds, APointInsideIsItsOwnNearestPoint) {
+  const auto dir = made("cloud_inside");
+  std::ofstream(dir / "c.xyz") << "0.5 0.5 0.5\n0.52 0.5 0.5\n";
+  ShapeSpec cloud = cloud_spec(dir / "c.xyz", 0.02, 0.01);
+  load_cloud(cloud);
+  const DistanceQuery q({cloud});
+  const auto cells = occupied_cells(*cloud.cloud);
+  ASSERT_FALSE(cells.empty());
+  for (const auto& c : cells) {
+    const Eigen::Vector3d centre(c[0], c[1], c[2]);
+    EXPECT_EQ(q.nearest_point(0, Eigen::Isometry3d::Identity(), centre), centre);
+    const Eigen::Vector3d shell = centre + Eigen::Vector3d(0.5 * c[3] + 0.005, 0.0, 0.0);  // in the grown shell
+    EXPECT_EQ(q.nearest_point(0, Eigen::Isometry3d::Identity(), shell), shell);
+  }
+  const Eigen::Vector3d out(0.5, 0.5, 0.6);
+  const Eigen::Vector3d p = q.nearest_point(0, Eigen::Isometry3d::Identity(), out);
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& c : cells) {
+    const Eigen::Vector3d e = ((out - Eigen::Vector3d(c[0], c[1], c[2])).cwiseAbs().array() - 0.5 * c[3]).max(0.0);
+    best = std::min(best, e.norm() - 0.01);
+  }
+  EXPECT_NEAR((out - p).norm(), best, 1e-12) << "outside: on the grown cell";
+  EXPECT_GT(best, 0.05);
+}
+
+// OctoMap's own files, whole, cut short or foreign: read, or refused with a reason (never a crash: OctoMap's readers
+// recurse without a limit and read past the end, so redres walks the nodes first).
+TEST(Clouds, OctreeFilesAreCheckedBeforeOctoMapReadsThem) {
+  std::mt19937 rng(11);
+  const auto pts = sample_cloud(rng, 800);
+  const auto dir = made("cloud_octree_files");
+  octomap::OcTree tree(0.03);
+  for (const auto& p : pts) tree.updateNode(octomap::point3d(p.x(), p.y(), p.z()), true);
+  tree.updateInnerOccupancy();
+  ASSERT_TRUE(tree.writeBinary((dir / "c.bt").string()));
+  ASSERT_TRUE(tree.write((dir / "c.ot").string()));
+  const auto load = [&](const std::string& name) {
+    ShapeSpec s;
+    s.shape = ShapeSpec::Kind::kOctree;
+    s.file = dir / name;
+    load_cloud(s);
+    return s;
+  };
+  const ShapeSpec bt = load("c.bt"), ot = load("c.ot");
+  EXPECT_EQ(occupancy_info(*bt.cloud).cells, occupancy_info(*ot.cloud).cells);
+  EXPECT_GT(occupancy_info(*bt.cloud).cells, 100U);
+  const auto refused = [&](const std::string& name, const std::string& bytes, const std::string& says) {
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    try {
+      (void)load(name);
+      ADD_FAILURE() << name << " loaded";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  const std::string whole = read_text(dir / "c.bt");
+  refused("cut.bt", whole.substr(0, whole.size() - 40), "end early");
+  std::string deep = "# Octomap OcTree binary file\nid OcTree\nsize 40\nres 0.1\ndata\n";
+  deep += std::string(40, '\xff');  // every child an inner node: deeper than 16 levels, or cut
+  refused("deep.bt", deep, "end early or nest deeper than 16 levels");
+  refused("other.bt", "# Octomap OcTree binary file\nid ColorOcTree\nres 0.1\ndata\n", "'ColorOcTree'");
+  refused("text.bt", "hello\n", "not an OctoMap .bt file");
+  refused("nores.ot", "# Octomap OcTree file\nid OcTree\ndata\n", "no `res`");
+}
+
+TEST(Clouds, MalformedPcdHeadersAreRefusedNotRead) {
+  const auto dir = made("cloud_bad_pcd");
+  const auto message = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name, std::ios::binary) << text;
+    try {
+      (void)read_points(dir / name);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // DATA as the last bytes, without a newline, and no data: nothing is read past the end.
+  EXPECT_NE(message("a.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 3\nDATA binary").find("holds 0 bytes"),
+            std::string::npos);
+  // More points than the data holds: refused before anything is reserved for them.
+  EXPECT_NE(message("b.pcd", "FIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nPOINTS 2000000000\nDATA binary\n")
+                .find("POINTS 2000000000"),
+            std::string::npos);
+  // Counts that would overflow an int.
+  EXPECT_NE(message("c.pcd", "FIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 2000000000\nPOINTS 1\nDATA binary\n")
+                .find("not read"),
+            std::string::npos);
+  // A coordinate beyond the tree's reach at the cloud's resolution (OctoMap would overflow an int converting it).
+  std::ofstream(dir / "far.xyz") << "0 0 0\n1e30 0 0\n";
+  ShapeSpec far = cloud_spec(dir / "far.xyz", 0.01, 0.0);
+  EXPECT_THROW(load_cloud(far), std::invalid_argument);
+}
 }  // namespace
 }  // namespace redres

@@ -114,7 +114,8 @@ void Controller::solve(double t, StepOutput& out) {
     engine_->reset();  // the next step starts cold
     return;
   }
-  engine_->solve_valid(qp_, result_);  // build() checked every entry it wrote
+  engine_->solve_valid(qp_, result_);           // build() checked every entry it wrote
+  keep_diagnosis_capacity(out.info.diagnosis);  // a no-op unless the caller's output lost its reserve
   out.info = result_.info;
   out.task_row_error = 0.0;
   if (result_.info.status == SolverStatus::kSolved) {
@@ -157,7 +158,8 @@ void Controller::relax(StepOutput& out) {
   row_miss_ -= qp_.d;
   out.task_row_error = qp_.m_eq() > 0 ? row_miss_.cwiseAbs().maxCoeff() : 0.0;
   // The failed solve's text goes after the relaxation's: kept aside in note_ (both reserved, so no allocation).
-  note_.swap(out.info.diagnosis);
+  note_.assign(out.info.diagnosis);  // note_ is reserved: a copy, so each string keeps its own storage
+  keep_diagnosis_capacity(out.info.diagnosis);
   out.info.diagnosis.clear();
   TextSink(out.info.diagnosis).precision(6) << "rows relaxed (weight " << rho << "), missed by " << out.task_row_error
                                             << " at most, after " << to_string(out.info.status) << ": " << note_;

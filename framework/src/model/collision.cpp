@@ -231,7 +231,8 @@ double box_point(const Eigen::Vector3d& q, const Eigen::Vector3d& h, Eigen::Vect
 // touches or enters the box, and the signed distance there is max_k (|q_k(s)| - h_k): the largest of six linear
 // functions, convex, whose minimum lies at an end or where two of them cross (at most fifteen candidates).
 void round_box(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double r, const Eigen::Isometry3d& Tb,
-               const Eigen::Vector3d& h, double& d, Eigen::Vector3d& on_round, Eigen::Vector3d& on_box) {
+               const Eigen::Vector3d& h, double& d, Eigen::Vector3d& on_round, Eigen::Vector3d& on_box,
+               Eigen::Vector3d* normal = nullptr) {
   const Eigen::Isometry3d to_box = Tb.inverse();
   const Eigen::Vector3d q0 = to_box * p0, dq = to_box * p1 - q0;
   double best_s = 0.0;
@@ -324,6 +325,7 @@ void round_box(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double r, c
   const Eigen::Vector3d u_world = Tb.linear() * u;
   on_box = Tb * c;
   on_round = Tb * q - r * u_world;
+  if (normal != nullptr) *normal = u_world;
 }
 
 // A sphere or capsule (axis [p0, p1], radius r, in the cloud's frame) against a cloud's cells grown by g, exactly (the
@@ -346,9 +348,11 @@ struct RoundMetric final : OccupancyMap::Metric {
     Eigen::Isometry3d Tc = Eigen::Isometry3d::Identity();
     Tc.translation() = c;
     double d = 0.0;
-    round_box(p0, p1, r, Tc, Eigen::Vector3d::Constant(h), d, on_query, on_cloud);
-    // on_query - on_cloud = d u, with u the cube's outward normal at the witness: the grown cube's point is g further.
-    if (g > 0.0 && d != 0.0) on_cloud += (g / d) * (on_query - on_cloud);
+    Eigen::Vector3d u;
+    round_box(p0, p1, r, Tc, Eigen::Vector3d::Constant(h), d, on_query, on_cloud, &u);
+    // on_query - on_cloud = d u, with u the cube's outward unit normal at the witness: the grown cube's point is g
+    // further along it (u from round_box itself, so a near-zero d does not turn it into noise).
+    on_cloud += g * u;
     return d - g;
   }
 };
@@ -535,9 +539,9 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
       impl_->box_half.push_back(std::nullopt);
       impl_->cylinder_radius.push_back(0.0);
       impl_->cylinder_half.push_back(0.0);
-      impl_->bound.push_back(
-          std::max(impl_->cloud_lo.back().cwiseAbs().norm(), impl_->cloud_hi.back().cwiseAbs().norm()) * (1.0 + 1e-12) +
-          (impl_->cloud_hi.back() - impl_->cloud_lo.back()).norm());
+      // The farthest corner of the grown cells' box from the cloud's origin.
+      impl_->bound.push_back(impl_->cloud_lo.back().cwiseAbs().cwiseMax(impl_->cloud_hi.back().cwiseAbs()).norm() *
+                             (1.0 + 1e-12));
       // In the broadphase a cloud is the box of its grown cells.
       const Eigen::Vector3d side = impl_->cloud_hi.back() - impl_->cloud_lo.back();
       impl_->object_offset.back().translation() = 0.5 * (impl_->cloud_lo.back() + impl_->cloud_hi.back());
@@ -707,7 +711,8 @@ Eigen::Vector3d DistanceQuery::nearest_point(int k, const Eigen::Isometry3d& T, 
     const Eigen::Vector3d local = T.inverse() * w;
     const RoundMetric m(local, local, 0.0, cloud->grow());
     Eigen::Vector3d on_query, on_cloud;
-    if (!std::isfinite(cloud->nearest(m, std::numeric_limits<double>::infinity(), on_query, on_cloud))) return w;
+    const double d = cloud->nearest(m, std::numeric_limits<double>::infinity(), on_query, on_cloud);
+    if (!(d > 0.0)) return w;  // inside the cloud (or an empty one): the point itself, as for any shape
     return T * on_cloud;
   }
   return impl_->project(static_cast<std::size_t>(k), T, w);

@@ -7,8 +7,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <iostream>
-#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -69,7 +67,7 @@ bool number(std::string_view token, double& v) {
   return ec == std::errc() && end == token.data() + token.size();
 }
 
-// Text lines: (line number, content), with '#' comments and blank lines left out when `comments`.
+// Calls f(line number, content) for each line of `text` while f returns true.
 template <class F>
 void for_each_line(std::string_view text, F&& f) {
   std::size_t line = 0, pos = 0;
@@ -118,11 +116,12 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& file, const s
     ++line;
     const std::size_t end = std::min(text.find('\n', pos), text.size());
     std::string_view s(text.data() + pos, end - pos);
-    pos = end + 1;
+    pos = std::min(end + 1, text.size());
     if (const auto hash = s.find('#'); hash != std::string_view::npos) s = s.substr(0, hash);
-    std::array<std::string_view, 64> tok;
-    const int n = split(s, tok.data(), 64);
+    std::array<std::string_view, 65> tok;
+    const int n = split(s, tok.data(), 65);
     if (n == 0) continue;
+    if (n > 64) fail_line(file, line, "more than 63 fields on a header line are not read");
     const std::string key(tok[0]);
     std::vector<std::string> values;
     for (int k = 1; k < n; ++k) values.emplace_back(tok[static_cast<std::size_t>(k)]);
@@ -167,8 +166,8 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& file, const s
   }
   if (points_declared < 0) fail(file, "the header has no POINTS line");
   // Each field's first value: its column (ascii) and byte offset (binary).
-  std::array<int, 3> column{-1, -1, -1}, offset{-1, -1, -1}, size{0, 0, 0};
-  int columns = 0, bytes = 0;
+  std::array<long, 3> column{-1, -1, -1}, offset{-1, -1, -1}, size{0, 0, 0};
+  long columns = 0, bytes = 0;  // sizes and counts are positive ints, at most 63 of them: no overflow
   for (std::size_t f = 0; f < fields.size(); ++f) {
     const int axis = fields[f] == "x" ? 0 : fields[f] == "y" ? 1 : fields[f] == "z" ? 2 : -1;
     if (axis >= 0) {
@@ -183,15 +182,19 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& file, const s
     bytes += sizes[f] * counts[f];
   }
   if (column[0] < 0 || column[1] < 0 || column[2] < 0) fail(file, "FIELDS must include x, y and z");
+  if (columns > 4096 || bytes > 65536) fail(file, "a point of more than 4096 values or 65536 bytes is not read");
   std::vector<Eigen::Vector3d> points;
-  points.reserve(static_cast<std::size_t>(points_declared));
   if (data == "binary") {
-    const std::size_t need = static_cast<std::size_t>(points_declared) * static_cast<std::size_t>(bytes);
-    if (text.size() - pos < need) {
+    // The declared points must fit in the data (checked before anything is reserved for them).
+    const auto have = static_cast<unsigned long long>(text.size() - pos);
+    const unsigned long long need =
+        static_cast<unsigned long long>(points_declared) * static_cast<unsigned long long>(bytes);
+    if (have < need) {
       fail(file, "the binary data holds " + std::to_string(text.size() - pos) + " bytes; POINTS " +
                      std::to_string(points_declared) + " of " + std::to_string(bytes) + " bytes need " +
                      std::to_string(need));
     }
+    points.reserve(static_cast<std::size_t>(points_declared));
     for (long i = 0; i < points_declared; ++i) {
       const char* record = text.data() + pos + static_cast<std::size_t>(i) * static_cast<std::size_t>(bytes);
       Eigen::Vector3d p;
@@ -212,9 +215,9 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& file, const s
   }
   long read = 0;
   const std::size_t header_lines = line;
+  std::vector<std::string_view> tok(static_cast<std::size_t>(columns) + 1);
   for_each_line(std::string_view(text).substr(std::min(pos, text.size())), [&](std::size_t l, std::string_view s) {
-    std::vector<std::string_view> tok(static_cast<std::size_t>(columns) + 1);
-    const int n = split(s, tok.data(), columns + 1);
+    const int n = split(s, tok.data(), static_cast<int>(columns) + 1);
     if (n == 0) return true;
     if (n != columns) {
       fail_line(file, header_lines + l,
@@ -222,7 +225,7 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& file, const s
     }
     Eigen::Vector3d p;
     for (std::size_t k = 0; k < 3; ++k) {
-      const std::string_view t = tok[static_cast<std::size_t>(column[k])];
+      const std::string_view t = tok[static_cast<std::size_t>(column[k])];  // column < columns = n
       if (t == "nan" || t == "NaN" || t == "-nan") {
         p(static_cast<Eigen::Index>(k)) = std::nan("");
       } else if (!number(t, p(static_cast<Eigen::Index>(k)))) {
@@ -273,6 +276,97 @@ std::vector<Eigen::Vector3d> read_ply(const std::filesystem::path& file, const s
     }
   }
   return points;
+}
+
+// OctoMap's files: a text header ("# Octomap OcTree binary file" or "# Octomap OcTree file", comment lines, then
+// `id`, `size`, `res` and `data` lines), then the nodes depth first. The header is read here, so that a wrong file is
+// named precisely, and the nodes are walked once before OctoMap reads them: its readers recurse without a depth limit
+// and read past the end of a truncated file, so only a tree that is whole and at most 16 levels deep reaches them.
+// Binary (.bt): two bytes a node, two bits a child (01 occupied leaf, 10 free leaf, 11 inner node, 00 none).
+std::size_t binary_subtree(const char* p, std::size_t n, int depth) {
+  if (n < 2 || depth > 16) return 0;
+  std::size_t used = 2;
+  for (int b = 0; b < 2; ++b) {
+    const auto bits = static_cast<unsigned char>(p[b]);
+    for (int i = 0; i < 4; ++i) {
+      if (((bits >> (2 * i)) & 3U) != 3U) continue;
+      const std::size_t sub = binary_subtree(p + used, n - used, depth + 1);
+      if (sub == 0) return 0;
+      used += sub;
+    }
+  }
+  return used;
+}
+// Full (.ot, an OcTree's): a 4-byte value and a byte of child flags a node.
+std::size_t full_subtree(const char* p, std::size_t n, int depth) {
+  if (n < 5 || depth > 16) return 0;
+  std::size_t used = 5;
+  const auto bits = static_cast<unsigned char>(p[4]);
+  for (int i = 0; i < 8; ++i) {
+    if (((bits >> i) & 1U) == 0) continue;
+    const std::size_t sub = full_subtree(p + used, n - used, depth + 1);
+    if (sub == 0) return 0;
+    used += sub;
+  }
+  return used;
+}
+
+std::unique_ptr<octomap::OcTree> read_octree(const std::filesystem::path& file, const std::string& text, bool binary) {
+  const std::string_view first = binary ? "# Octomap OcTree binary file" : "# Octomap OcTree file";
+  if (text.rfind(first, 0) != 0)
+    fail(file, "not an OctoMap " + std::string(binary ? ".bt" : ".ot") + " file (its first line is not '" +
+                   std::string(first) + "')");
+  std::string id;
+  double res = 0.0;
+  long size = -1;
+  std::size_t pos = 0, line = 0;
+  bool data = false;
+  while (!data) {
+    if (pos >= text.size()) fail(file, "the header ends before its `data` line");
+    ++line;
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    std::string_view s(text.data() + pos, end - pos);
+    pos = std::min(end + 1, text.size());
+    if (!s.empty() && s.back() == '\r') s.remove_suffix(1);
+    if (s.empty() || s.front() == '#') continue;
+    std::array<std::string_view, 3> tok;
+    const int n = split(s, tok.data(), 3);
+    if (tok[0] == "data" && n == 1) {
+      data = true;
+    } else if (tok[0] == "id" && n == 2) {
+      id = std::string(tok[1]);
+    } else if (tok[0] == "res" && n == 2 && number(tok[1], res)) {
+      if (!(std::isfinite(res) && res >= 1e-4 && res <= 100.0))
+        fail_line(file, line, "res: expected a cell edge in [1e-4, 100] m");
+    } else if (tok[0] == "size" && n == 2) {
+      double v = 0.0;
+      if (!number(tok[1], v) || !(v >= 0.0 && v < 1e12)) fail_line(file, line, "size: expected a node count");
+      size = static_cast<long>(v);
+    } else {
+      fail_line(file, line, "expected `id`, `size`, `res` or `data`, saw '" + std::string(s.substr(0, 60)) + "'");
+    }
+  }
+  if (id != "OcTree") fail(file, "holds an octree of type '" + id + "'; an occupancy octree (id OcTree) is read");
+  if (!(res > 0.0)) fail(file, "the header gives no `res`");
+  const char* nodes = text.data() + pos;
+  const std::size_t left = text.size() - pos;
+  const std::size_t used = left == 0 ? 0 : (binary ? binary_subtree(nodes, left, 0) : full_subtree(nodes, left, 0));
+  if (left > 0 && used == 0)
+    fail(file, "its nodes end early or nest deeper than 16 levels: the file is cut or corrupt");
+  auto tree = std::make_unique<octomap::OcTree>(res);
+  if (used > 0) {
+    std::istringstream in(std::string(nodes, used));
+    if (binary) {
+      tree->readBinaryData(in);
+    } else {
+      tree->readData(in);
+    }
+    if (!in) fail(file, "OctoMap could not read its nodes");
+  }
+  if (size >= 0 && static_cast<long>(tree->size()) != size) {
+    fail(file, "the header says " + std::to_string(size) + " nodes, the data holds " + std::to_string(tree->size()));
+  }
+  return tree;
 }
 
 }  // namespace
@@ -379,41 +473,8 @@ void load_cloud(ShapeSpec& spec) {
     const std::string ext = lower_extension(file);
     if (ext != ".bt" && ext != ".ot")
       fail(file, "an octree is read from an OctoMap .bt or .ot file (saw '" + ext + "')");
-    std::istringstream in(read_cloud_file(file));
-    std::unique_ptr<octomap::OcTree> tree;
-    // Debian's OctoMap reports on std::cerr as it reads ("Reading binary octree type OcTree"): the report is held
-    // back, and its errors go into the message when the file cannot be read.
-    static std::mutex cerr_mutex;
-    std::ostringstream said;
-    {
-      const std::lock_guard<std::mutex> lock(cerr_mutex);
-      std::streambuf* const old = std::cerr.rdbuf(said.rdbuf());
-      try {
-        if (ext == ".bt") {
-          tree = std::make_unique<octomap::OcTree>(0.1);
-          if (!tree->readBinary(in)) tree.reset();
-        } else {
-          std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(in));
-          if (auto* occupancy = dynamic_cast<octomap::OcTree*>(any.get())) {
-            any.release();
-            tree.reset(occupancy);
-          }
-        }
-      } catch (...) {
-        std::cerr.rdbuf(old);
-        throw;
-      }
-      std::cerr.rdbuf(old);
-    }
-    if (!tree) {
-      std::string why = said.str();
-      if (const auto e = why.find("ERROR: "); e != std::string::npos) why = why.substr(e + 7);
-      while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
-      fail(file, std::string("OctoMap could not read it as ") +
-                     (ext == ".bt" ? "a binary occupancy octree (.bt)" : "an occupancy octree (OcTree, .ot)") +
-                     (why.empty() ? "" : ": " + why.substr(0, 200)));
-    }
-    spec.cloud = std::make_shared<const OccupancyMap>(std::move(tree), grow, 0);
+    const std::string text = read_cloud_file(file);
+    spec.cloud = std::make_shared<const OccupancyMap>(read_octree(file, text, ext == ".bt"), grow, 0);
   } else {
     const std::vector<Eigen::Vector3d> points = read_points(file);
     if (points.empty()) fail(file, "holds no points");
@@ -421,7 +482,9 @@ void load_cloud(ShapeSpec& spec) {
     for (std::size_t i = 0; i < points.size(); ++i) {
       const Eigen::Vector3d& p = points[i];
       octomap::OcTreeKey key;
-      if (!tree->coordToKeyChecked(
+      const double reach = *spec.resolution * 32767.0;  // checked first: OctoMap converts to int before it checks
+      if (!(p.cwiseAbs().maxCoeff() < reach) ||
+          !tree->coordToKeyChecked(
               octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())), key)) {
         std::ostringstream s;
         s << "point " << i + 1 << " (" << p.transpose() << ") is outside the octree's reach: at resolution "

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <string>
 
 #include "redres/common/text_sink.hpp"
@@ -40,15 +41,49 @@ void diagnose_rows(const QpProblem& qp, const RowFit& fit, double tolerance, boo
     if (!first) s << ";";
     first = false;
   };
+  // The rows missed by most are named (at most kNamedRows of them, so the joints at their bounds and the rank still
+  // fit in the diagnosis); the rest are counted.
+  constexpr int kNamedRows = 8;
+  int named = 0, unnamed = 0;
+  double cut = 0.0;  // rows missed by no more than this are counted, not named
+  {
+    int over = 0;
+    for (Eigen::Index r = 0; r < eq.size(); ++r) over += std::abs(eq(r)) > tolerance;
+    for (Eigen::Index r = 0; r < in.size(); ++r) over += in(r) > tolerance;
+    if (over > kNamedRows) {
+      // The kNamedRows-th largest miss, by repeated selection (allocation-free; only on such failures).
+      double below = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < kNamedRows; ++k) {
+        double best = -1.0;
+        for (Eigen::Index r = 0; r < eq.size(); ++r) {
+          const double m = std::abs(eq(r));
+          if (m > tolerance && m < below && m > best) best = m;
+        }
+        for (Eigen::Index r = 0; r < in.size(); ++r) {
+          if (in(r) > tolerance && in(r) < below && in(r) > best) best = in(r);
+        }
+        below = best;
+      }
+      cut = std::nextafter(below, 0.0);
+    }
+  }
+  const auto shown = [&](double miss) {
+    if (miss > cut && named < kNamedRows) {
+      ++named;
+      return true;
+    }
+    ++unnamed;
+    return false;
+  };
   for (Eigen::Index r = 0; r < eq.size(); ++r) {
-    if (std::abs(eq(r)) > tolerance) {
+    if (std::abs(eq(r)) > tolerance && shown(std::abs(eq(r)))) {
       next();
       s << " equality row " << r + 1 << " (from '" << source_name(qp, qp.eq_source[static_cast<std::size_t>(r)])
         << "') misses by " << std::abs(eq(r)) << " at best";
     }
   }
   for (Eigen::Index r = 0; r < in.size(); ++r) {
-    if (in(r) > tolerance) {
+    if (in(r) > tolerance && shown(in(r))) {
       next();
       s << " inequality row " << r + 1 << " (from '" << source_name(qp, qp.in_source[static_cast<std::size_t>(r)])
         << "'";
@@ -62,6 +97,10 @@ void diagnose_rows(const QpProblem& qp, const RowFit& fit, double tolerance, boo
       s.precision(6);
       s << ") is exceeded by " << in(r) << " at best";
     }
+  }
+  if (unnamed > 0) {
+    next();
+    s << " and " << unnamed << " more row" << (unnamed == 1 ? "" : "s") << " missed by less";
   }
   next();
   s << " joints held at a bound there:";
@@ -110,7 +149,8 @@ void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& i
   // into the diagnosis's reserved storage (the engine's own note is kept aside in note_ meanwhile): no allocation.
   const RowFit& fit = fitter_.fit(qp);
   const bool unmeetable = fit.miss_norm() > settings_.tolerance;
-  note_.swap(info.diagnosis);
+  note_.assign(info.diagnosis);  // note_ is reserved: a copy, so each string keeps its own storage
+  keep_diagnosis_capacity(info.diagnosis);
   info.diagnosis.clear();
   TextSink s(info.diagnosis);
   s.precision(6);

@@ -92,6 +92,7 @@ void LviEngine::run(const QpProblem& qp, SolverResult& result) {
     double gap = 0.0;
     for (int i = 0; i < n_; ++i) gap = std::max(gap, lo[i] - hi[i]);
     info.residual = std::isfinite(gap) ? gap : std::numeric_limits<double>::max();
+    keep_diagnosis_capacity(info.diagnosis);
     TextSink text(info.diagnosis);
     text << "bounds conflict at ";
     describe(conflict, qp.variable_names, text);

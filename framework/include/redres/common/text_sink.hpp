@@ -16,6 +16,12 @@ namespace redres {
 /// The capacity reserved for a step's diagnosis (SolverInfo::diagnosis) at setup, in bytes.
 inline constexpr std::size_t kDiagnosisCapacity = 4096;
 
+/// Gives a diagnosis string its reserved capacity back if something (an assignment from a temporary, a caller's own
+/// StepOutput) took it: allocates only then, never on a string that kept it.
+inline void keep_diagnosis_capacity(std::string& s) {
+  if (s.capacity() < kDiagnosisCapacity) s.reserve(kDiagnosisCapacity);
+}
+
 /// Appends to a string within the capacity it had when the sink was made.
 class TextSink {
  public:
@@ -24,7 +30,7 @@ class TextSink {
 
   /// Significant digits of the floating-point numbers written next (6, as an ostream's default).
   TextSink& precision(int digits) noexcept {
-    precision_ = digits;
+    precision_ = digits < 1 ? 1 : (digits > 17 ? 17 : digits);  // 17 digits hold any double; the buffer holds them
     return *this;
   }
   TextSink& operator<<(std::string_view s) noexcept {
@@ -44,6 +50,7 @@ class TextSink {
   TextSink& operator<<(double v) noexcept {
     char buf[40];
     const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, precision_);
+    if (r.ec != std::errc()) return *this << "?";
     return *this << std::string_view(buf, static_cast<std::size_t>(r.ptr - buf));
   }
   /// Whether something was cut.

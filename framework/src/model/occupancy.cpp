@@ -167,8 +167,14 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& file, const s
   if (points_declared < 0) fail(file, "the header has no POINTS line");
   // Each field's first value: its column (ascii) and byte offset (binary).
   std::array<long, 3> column{-1, -1, -1}, offset{-1, -1, -1}, size{0, 0, 0};
-  long columns = 0, bytes = 0;  // sizes and counts are positive ints, at most 63 of them: no overflow
+  long columns = 0, bytes = 0;
   for (std::size_t f = 0; f < fields.size(); ++f) {
+    // PCD's sizes are 1, 2, 4 or 8 bytes; a count past 4096 is no point cloud. Checked first, so the sums below stay
+    // small (at most 63 fields).
+    if (sizes[f] > 8 || counts[f] > 4096) {
+      fail(file, "field " + fields[f] + ": SIZE " + std::to_string(sizes[f]) + " and COUNT " +
+                     std::to_string(counts[f]) + " are not read (a point of more than 4096 values is not read)");
+    }
     const int axis = fields[f] == "x" ? 0 : fields[f] == "y" ? 1 : fields[f] == "z" ? 2 : -1;
     if (axis >= 0) {
       if (types[f] != 'F' || (sizes[f] != 4 && sizes[f] != 8)) {
@@ -179,7 +185,7 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& file, const s
       size[static_cast<std::size_t>(axis)] = sizes[f];
     }
     columns += counts[f];
-    bytes += sizes[f] * counts[f];
+    bytes += static_cast<long>(sizes[f]) * counts[f];
   }
   if (column[0] < 0 || column[1] < 0 || column[2] < 0) fail(file, "FIELDS must include x, y and z");
   if (columns > 4096 || bytes > 65536) fail(file, "a point of more than 4096 values or 65536 bytes is not read");

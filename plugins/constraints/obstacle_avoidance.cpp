@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <sstream>
 
 namespace redres {
 
@@ -281,11 +280,7 @@ void ObstacleAvoidance::describe_inequality_row_to(const PluginData* data, int r
 }
 
 std::string ObstacleAvoidance::describe_inequality_row(const PluginData* data, int row) const {
-  std::string out;
-  out.reserve(kDiagnosisCapacity);
-  TextSink s(out);
-  describe_inequality_row_to(data, row, s);
-  return out;
+  return text_of([&](TextSink& s) { describe_inequality_row_to(data, row, s); });
 }
 
 void ObstacleAvoidance::describe_pair_to(const PluginData* data, int pair, TextSink& s) const {
@@ -301,11 +296,7 @@ void ObstacleAvoidance::describe_pair_to(const PluginData* data, int pair, TextS
 }
 
 std::string ObstacleAvoidance::describe_pair(const PluginData* data, int pair) const {
-  std::string out;
-  out.reserve(kDiagnosisCapacity);
-  TextSink s(out);
-  describe_pair_to(data, pair, s);
-  return out;
+  return text_of([&](TextSink& s) { describe_pair_to(data, pair, s); });
 }
 
 void ObstacleAvoidance::scene_obstacles(std::vector<ShapeSpec>& out) const {

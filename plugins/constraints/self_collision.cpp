@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 namespace redres {
 
@@ -105,11 +104,7 @@ void SelfCollision::describe_inequality_row_to(const PluginData* data, int row, 
 }
 
 std::string SelfCollision::describe_inequality_row(const PluginData* data, int row) const {
-  std::string out;
-  out.reserve(kDiagnosisCapacity);
-  TextSink s(out);
-  describe_inequality_row_to(data, row, s);
-  return out;
+  return text_of([&](TextSink& s) { describe_inequality_row_to(data, row, s); });
 }
 
 namespace {

@@ -36,6 +36,17 @@ std::filesystem::path made(const std::string& name) {
   return dir;
 }
 
+// What read_points says of a file `name` in `dir` holding `text` ("no error" when it reads it).
+std::string read_error(const std::filesystem::path& dir, const std::string& name, const std::string& text) {
+  std::ofstream(dir / name, std::ios::binary) << text;
+  try {
+    (void)read_points(dir / name);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
 // A table top, a ball's surface and a scatter: points with structure at several scales.
 std::vector<Eigen::Vector3d> sample_cloud(std::mt19937& rng, int n) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -178,15 +189,7 @@ TEST(Clouds, EveryFormatReadsTheSamePoints) {
 
 TEST(Clouds, BadFilesAreReportedWithTheFileAndTheLine) {
   const auto dir = made("cloud_bad");
-  const auto message = [&](const std::string& name, const std::string& text) {
-    std::ofstream(dir / name, std::ios::binary) << text;
-    try {
-      (void)read_points(dir / name);
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  const auto message = [&](const std::string& name, const std::string& text) { return read_error(dir, name, text); };
   EXPECT_NE(message("a.xyz", "0 0 0\n1 2\n").find("a.xyz:2: expected the numbers x y z"), std::string::npos)
       << message("a.xyz", "0 0 0\n1 2\n");
   EXPECT_NE(message("b.xyz", "0 0 inf\n").find("b.xyz:1: a coordinate is not finite"), std::string::npos);
@@ -521,15 +524,7 @@ TEST(Clouds, OctreeFilesAreCheckedBeforeOctoMapReadsThem) {
 
 TEST(Clouds, MalformedPcdHeadersAreRefusedNotRead) {
   const auto dir = made("cloud_bad_pcd");
-  const auto message = [&](const std::string& name, const std::string& text) {
-    std::ofstream(dir / name, std::ios::binary) << text;
-    try {
-      (void)read_points(dir / name);
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  const auto message = [&](const std::string& name, const std::string& text) { return read_error(dir, name, text); };
   // DATA as the last bytes, without a newline, and no data: nothing is read past the end.
   EXPECT_NE(message("a.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 3\nDATA binary").find("holds 0 bytes"),
             std::string::npos);

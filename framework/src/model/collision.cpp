@@ -155,11 +155,7 @@ void ShapeSpec::describe(TextSink& s) const {
 }
 
 std::string ShapeSpec::describe() const {
-  std::string out;
-  out.reserve(512);
-  TextSink s(out);
-  describe(s);
-  return out;
+  return text_of([this](TextSink& s) { describe(s); });
 }
 
 namespace {

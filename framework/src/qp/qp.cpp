@@ -123,11 +123,7 @@ void describe(const BoundConflict& c, const std::vector<std::string>& joint_name
 }
 
 std::string describe(const BoundConflict& c, const std::vector<std::string>& joint_names) {
-  std::string out;
-  out.reserve(kDiagnosisCapacity);
-  TextSink s(out);
-  describe(c, joint_names, s);
-  return out;
+  return text_of([&](TextSink& s) { describe(c, joint_names, s); });
 }
 
 }  // namespace redres

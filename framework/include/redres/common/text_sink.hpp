@@ -78,4 +78,15 @@ class TextSink {
   bool cut_ = false;
 };
 
+/// What `write(TextSink&)` writes, as a string (the allocating form of a text written into a sink, for callers off
+/// the real-time path).
+template <class Write>
+[[nodiscard]] std::string text_of(Write&& write) {
+  std::string out;
+  out.reserve(kDiagnosisCapacity);
+  TextSink sink(out);
+  write(sink);
+  return out;
+}
+
 }  // namespace redres

@@ -23,7 +23,11 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
       r_d_(Eigen::VectorXd::Zero(robot.reference_dim())),
       r_d_dot_(Eigen::VectorXd::Zero(robot.reference_dim())),
       vlo_(Eigen::VectorXd::Zero(robot.dof())),
-      vhi_(Eigen::VectorXd::Zero(robot.dof())) {
+      vhi_(Eigen::VectorXd::Zero(robot.dof())),
+      prev_(Eigen::VectorXd::Zero(robot.dof())),
+      prev2_(Eigen::VectorXd::Zero(robot.dof())),
+      pending_(Eigen::VectorXd::Zero(robot.dof())),
+      measured_(Eigen::VectorXd::Zero(robot.dof())) {
   REDRES_REQUIRE(&scheme.robot() == &robot, "Controller", "the scheme was built for this robot");
   REDRES_REQUIRE(T > 0.0 && tau > 0.0, "Controller", "T > 0 and tau > 0");
   if (path != nullptr) {
@@ -42,6 +46,9 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
   ctx_.r_d_dot = &r_d_dot_;
   ctx_.velocity_lower = &vlo_;
   ctx_.velocity_upper = &vhi_;
+  ctx_.theta_dot_prev = &prev_;
+  ctx_.theta_dot_prev2 = &prev2_;
+  ctx_.status_prev = SolverStatus::kNotRun;
 }
 
 StepOutput Controller::make_output() const {
@@ -54,9 +61,68 @@ StepOutput Controller::make_output() const {
 void Controller::reset() {
   engine_->reset();
   orientation_.forget_captured();
+  prev_.setZero();
+  prev2_.setZero();
+  have_pending_ = false;
+  started_ = false;
+  ctx_.step_index = 0;
+  ctx_.status_prev = SolverStatus::kNotRun;
+}
+
+void Controller::begin_step() {
+  if (!started_) {
+    scheme_->start(*data_);  // the plugins forget an earlier run
+    started_ = true;
+  }
+  if (!have_pending_) return;
+  prev2_.swap(prev_);  // same sizes: the buffers change hands, nothing is allocated
+  prev_.swap(pending_);
+  ctx_.status_prev = pending_status_;
+  ++ctx_.step_index;
+  have_pending_ = false;
+}
+
+void Controller::end_step(const StepOutput& out) {
+  pending_ = out.theta_dot;
+  pending_status_ = out.info.status;
+  have_pending_ = true;
+}
+
+void Controller::set_applied(const Eigen::Ref<const Eigen::VectorXd>& theta_dot) {
+  REDRES_REQUIRE(have_pending_, "Controller::set_applied", "a step was made since the last set_applied() or reset()");
+  REDRES_REQUIRE(theta_dot.size() == robot_->dof() && theta_dot.allFinite(), "Controller::set_applied",
+                 "theta_dot has dof() = " + std::to_string(robot_->dof()) + " finite entries");
+  pending_ = theta_dot;
+}
+
+void Controller::set_period(double tau) {
+  REDRES_REQUIRE(std::isfinite(tau) && tau > 0.0, "Controller::set_period", "tau > 0 and finite");
+  ctx_.tau = tau;
 }
 
 void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out) {
+  REDRES_REQUIRE(path_ != nullptr, "Controller::step", "a path was given (or pass r_d and r_d_dot)");
+  begin_step();
+  reevaluate(theta, t, out);
+  end_step(out);
+}
+
+void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta,
+                      const Eigen::Ref<const Eigen::VectorXd>& theta_dot_measured, double t, StepOutput& out) {
+  REDRES_REQUIRE(theta_dot_measured.size() == robot_->dof() && theta_dot_measured.allFinite(), "Controller::step",
+                 "theta_dot_measured has dof() = " + std::to_string(robot_->dof()) + " finite entries");
+  measured_ = theta_dot_measured;
+  ctx_.theta_dot_measured = &measured_;
+  try {
+    step(theta, t, out);
+  } catch (...) {
+    ctx_.theta_dot_measured = nullptr;
+    throw;
+  }
+  ctx_.theta_dot_measured = nullptr;
+}
+
+void Controller::reevaluate(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out) {
   REDRES_REQUIRE(path_ != nullptr, "Controller::step", "a path was given (or pass r_d and r_d_dot)");
   compute_kinematics(*robot_, theta, kin_, level_);
   const int p = path_->dim();
@@ -73,10 +139,12 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
                  "r_d and r_d_dot have reference_dim() = " + std::to_string(m) + " entries (got " +
                      std::to_string(r_d.size()) + " and " + std::to_string(r_d_dot.size()) + ")");
   REDRES_REQUIRE(r_d.allFinite() && r_d_dot.allFinite(), "Controller::step", "r_d and r_d_dot are finite");
+  begin_step();
   compute_kinematics(*robot_, theta, kin_, level_);
   r_d_ = r_d;
   r_d_dot_ = r_d_dot;
   solve(t, out);
+  end_step(out);
 }
 
 void Controller::solve(double t, StepOutput& out) {

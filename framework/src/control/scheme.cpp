@@ -72,6 +72,13 @@ SchemeData Scheme::make_data() const {
   return data;
 }
 
+void Scheme::start(SchemeData& data) const {
+  REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size(),
+                 "Scheme::start", "data was made by this scheme's make_data()");
+  for (std::size_t k = 0; k < objectives_.size(); ++k) objectives_[k]->start(data.objectives[k].get());
+  for (std::size_t k = 0; k < constraints_.size(); ++k) constraints_[k]->start(data.constraints[k].get());
+}
+
 void Scheme::setup(QpProblem& qp, const SchemeData& data) const {
   REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size(),
                  "Scheme::setup", "data was made by this scheme's make_data()");

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -66,6 +67,8 @@ void validate(const RobotSpec& spec) {
     REDRES_REQUIRE(jt.lower < jt.upper, fn,
                    who + " lower limit < upper limit (" + num(jt.lower) + " vs " + num(jt.upper) + ")");
     REDRES_REQUIRE(jt.velocity_limit != nullptr, fn, who + " has a velocity-limit law");
+    REDRES_REQUIRE(!jt.effort_limit || (std::isfinite(*jt.effort_limit) && *jt.effort_limit > 0.0), fn,
+                   who + " has an effort limit > 0 when it has one");
     REDRES_REQUIRE(
         std::isfinite(jt.a) && std::isfinite(jt.alpha) && std::isfinite(jt.d) && std::isfinite(jt.theta_offset), fn,
         who + " DH parameters are finite");
@@ -209,6 +212,46 @@ void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta,
     lo[j] = b.lower;
     hi[j] = b.upper;
   }
+}
+
+namespace {
+// A law per joint at theta (unbounded where a joint has none), as velocity_limits() does.
+void law_bounds(const std::vector<JointSpec>& joints, std::shared_ptr<const VelocityLimitLaw> JointSpec::*law,
+                const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
+                Eigen::Ref<Eigen::VectorXd> upper, const char* fn) {
+  const auto n = static_cast<Eigen::Index>(joints.size());
+  REDRES_REQUIRE(theta.size() == n && lower.size() == n && upper.size() == n, fn,
+                 "theta, lower and upper have size dof() = " + std::to_string(n));
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const auto& l = joints[static_cast<std::size_t>(j)].*law;
+    if (!l) {
+      lower(j) = -std::numeric_limits<double>::infinity();
+      upper(j) = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    const VelocityBounds b = l->bounds(theta(j));
+    lower(j) = b.lower;
+    upper(j) = b.upper;
+  }
+}
+}  // namespace
+
+bool RobotModel::has_acceleration_limits() const noexcept {
+  return std::all_of(spec_.joints.begin(), spec_.joints.end(), [](const JointSpec& j) { return j.acceleration_limit; });
+}
+
+bool RobotModel::has_jerk_limits() const noexcept {
+  return std::all_of(spec_.joints.begin(), spec_.joints.end(), [](const JointSpec& j) { return j.jerk_limit; });
+}
+
+void RobotModel::acceleration_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
+                                     Eigen::Ref<Eigen::VectorXd> upper) const {
+  law_bounds(spec_.joints, &JointSpec::acceleration_limit, theta, lower, upper, "RobotModel::acceleration_limits");
+}
+
+void RobotModel::jerk_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
+                             Eigen::Ref<Eigen::VectorXd> upper) const {
+  law_bounds(spec_.joints, &JointSpec::jerk_limit, theta, lower, upper, "RobotModel::jerk_limits");
 }
 
 bool RobotModel::self_collision_pair(int i, int j) const {

@@ -114,18 +114,42 @@ void read_limits(const TableReader& r, JointSpec& jt) {
   }
 }
 
-// A joint's `velocity_limit` table into jt, checked over the joint's range (jt.lower, jt.upper set before).
-void read_velocity_law(const TableReader& r, JointSpec& jt) {
-  const TableReader law_table = r.table("velocity_limit");
-  const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' velocity_limit");
-  jt.velocity_limit = make_velocity_limit(law_reader);
-  jt.velocity_limit_source = r.location("velocity_limit").str();
+// A joint's limit-law table `key` (velocity_limit, acceleration_limit, jerk_limit) into `law` and `source`, checked
+// over the joint's range (jt.lower, jt.upper set before). The three are laws of the same kinds (redres plugins).
+void read_law(const TableReader& r, const char* key, const char* what, JointSpec& jt,
+              std::shared_ptr<const VelocityLimitLaw>& law, std::string& source) {
+  const TableReader law_table = r.table(key);
+  const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' " + key);
+  law = make_velocity_limit(law_reader);
+  source = r.location(key).str();
   law_reader.finish();
-  if (auto bad = check_velocity_law(*jt.velocity_limit, jt.lower, jt.upper)) {
-    law_reader.fail("velocity-limit law '" + jt.velocity_limit->type() + "' is invalid at theta = " + num(bad->theta) +
+  if (auto bad = check_velocity_law(*law, jt.lower, jt.upper)) {
+    law_reader.fail(std::string(what) + " law '" + law->type() + "' is invalid at theta = " + num(bad->theta) +
                     (jt.type == JointType::kRevolute ? " rad" : " m") + " (joint range [" + num(jt.lower) + ", " +
                     num(jt.upper) + "]): " + bad->reason);
   }
+}
+
+void read_velocity_law(const TableReader& r, JointSpec& jt) {
+  read_law(r, "velocity_limit", "velocity-limit", jt, jt.velocity_limit, jt.velocity_limit_source);
+}
+
+void read_effort(const TableReader& r, JointSpec& jt) {
+  const double e = r.number("effort_limit");
+  if (!(std::isfinite(e) && e > 0.0 && e <= 1e7)) {
+    r.fail("effort_limit", "expected a torque or force 0 < effort_limit <= 1e7 (N m or N), got " + num(e));
+  }
+  jt.effort_limit = e;
+}
+
+// The optional motion limits of a joint beyond its velocity: acceleration and jerk laws, and the effort limit (a
+// URDF joint's [[joints]] override; a [[joints]] entry of a TOML chain reads them key by key).
+void read_motion_limits(const TableReader& r, JointSpec& jt) {
+  if (r.has("acceleration_limit")) {
+    read_law(r, "acceleration_limit", "acceleration-limit", jt, jt.acceleration_limit, jt.acceleration_limit_source);
+  }
+  if (r.has("jerk_limit")) read_law(r, "jerk_limit", "jerk-limit", jt, jt.jerk_limit, jt.jerk_limit_source);
+  if (r.has("effort_limit")) read_effort(r, jt);
 }
 
 // The entries of the array of tables `key` (absent: none), by their `name`: each must name a `noun` that `known`
@@ -237,6 +261,19 @@ const Schema<JointReading>& JointReading::schema() {
                "the joint's velocity-limit law; `type` names it, its keys are its own (redres plugins)",
                [](const TableReader& r, C& c) { read_velocity_law(r, c.jt); })
           .required(),
+      entry<C>("acceleration_limit", "table", "rad/s^2 or m/s^2", "",
+               "the joint's acceleration limits: a law of the same kinds as velocity_limit (constant, push_rod, ...)",
+               [](const TableReader& r, C& c) {
+                 read_law(r, "acceleration_limit", "acceleration-limit", c.jt, c.jt.acceleration_limit,
+                          c.jt.acceleration_limit_source);
+               }),
+      entry<C>("jerk_limit", "table", "rad/s^3 or m/s^3", "",
+               "the joint's jerk limits (the rate of change of acceleration): a law as velocity_limit",
+               [](const TableReader& r, C& c) {
+                 read_law(r, "jerk_limit", "jerk-limit", c.jt, c.jt.jerk_limit, c.jt.jerk_limit_source);
+               }),
+      entry<C>("effort_limit", "number", "N m or N", "", "the largest torque (force) the joint's drive gives",
+               [](const TableReader& r, C& c) { read_effort(r, c.jt); }),
   }};
   return s;
 }
@@ -259,7 +296,8 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
 
 // A robot file's top level, read key by key in this order. A file that names a URDF (`urdf`, `base_link`,
 // `tip_link`) takes its chain from it (read_urdf_chain): `[[joints]]` entries, by joint name, may replace a joint's
-// `limits` and `velocity_limit`; `[[links]]` entries, by link name, give collision shapes that replace
+// `limits`, `velocity_limit` and the motion limits (acceleration, jerk, effort); `[[links]]` entries, by link name,
+// give collision shapes that replace
 // (`replace = true`, the default) or add to the URDF's.
 struct RobotReading {
   RobotSpec spec;
@@ -311,6 +349,8 @@ void read_urdf_joints(const TableReader& r, RobotReading& c) {
                          " has no velocity limit: give one in the URDF (<limit velocity=...>) or a `velocity_limit` "
                          "in a [[joints]] entry");
     }
+    if (uj.effort > 0.0) jt.effort_limit = uj.effort;
+    if (entry) read_motion_limits(*entry, jt);
     if (entry) entry->finish();
     c.spec.joints.push_back(std::move(jt));
   }
@@ -484,7 +524,8 @@ const Schema<RobotReading>& RobotReading::schema() {
                "the task rows a scenario tracks unless it sets its own `task`",
                [](const TableReader& r, C& c) { read_task(r, c.spec); }),
       entry<C>("joints", "array of tables [[joints]] (below)", "", "none with `urdf`; required without",
-               "the chain, base to tip (with `urdf`: overrides of `limits` and `velocity_limit` by joint name)",
+               "the chain, base to tip (with `urdf`: overrides of `limits`, `velocity_limit`, `acceleration_limit`, "
+               "`jerk_limit` and `effort_limit` by joint name)",
                [](const TableReader& r, C& c) {
                  if (c.from_urdf) {
                    read_urdf_joints(r, c);

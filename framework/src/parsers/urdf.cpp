@@ -424,6 +424,11 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
           j.lower = joint->limits->lower;
           j.upper = joint->limits->upper;
           j.velocity = joint->limits->velocity;
+          j.effort = joint->limits->effort;
+          if (!(std::isfinite(j.effort) && j.effort >= 0.0 && j.effort <= 1e7)) {
+            throw UrdfError(who + ": <limit> effort expected 0 <= effort <= 1e7 " + (j.prismatic ? "N" : "N m") +
+                            ", got " + num(j.effort));
+          }
           const double bound = *physical_bound(j.prismatic ? "m" : "rad");
           const char* unit = j.prismatic ? " m" : " rad";
           if (!j.continuous && !(std::abs(j.lower) <= bound && std::abs(j.upper) <= bound)) {

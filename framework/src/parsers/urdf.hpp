@@ -37,6 +37,7 @@ struct UrdfJoint {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();           //!< in the joint's frame (normalised)
   double lower = 0.0, upper = 0.0;                           //!< position limits (rad or m); unset if continuous
   double velocity = 0.0;                                     //!< velocity limit (rad/s or m/s); 0 if not given
+  double effort = 0.0;                                       //!< effort limit (N m or N); 0 if not given
 };
 
 /// A link of the chain that moves with a joint: its shapes, placed in that joint's link frame.

@@ -42,7 +42,7 @@ bool integrate(const Scenario& s, Controller& ctrl, StepLog& log, RunResult& run
   // Heun: average the slopes at theta and at the Euler prediction (one more QP per step, into its own output).
   theta_pred = theta + s.tau * out.theta_dot;
   const double t2 = std::min(s.duration, t + s.tau);
-  ctrl.step(theta_pred, t2, out2);
+  ctrl.reevaluate(theta_pred, t2, out2);  // the same step: the plugins see the same previous command
   const int failures_before_stage = run.failures;
   log.note(out2, t2);
   if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before_stage) {
@@ -51,6 +51,8 @@ bool integrate(const Scenario& s, Controller& ctrl, StepLog& log, RunResult& run
   }
   if (usable(out2.info.status)) {
     theta += 0.5 * s.tau * (out.theta_dot + out2.theta_dot);
+    theta_pred = 0.5 * (out.theta_dot + out2.theta_dot);  // the command applied: the next step's theta_dot_prev
+    ctrl.set_applied(theta_pred);
   } else {
     theta += s.tau * out.theta_dot;  // the second stage failed: Euler's step with the first, which solved
   }

@@ -8,6 +8,8 @@
 
 namespace redres {
 
+enum class SolverStatus;  // qp/lvi.hpp
+
 /// Everything a plugin may read at one control step. New inputs are added here, never to plugin signatures.
 struct Context {
   double t = 0.0;                              //!< time since the start of the task (s)
@@ -22,8 +24,24 @@ struct Context {
   const Eigen::VectorXd* velocity_lower = nullptr;
   const Eigen::VectorXd* velocity_upper = nullptr;
 
+  // State between steps (docs/motion.md), kept by the Controller; null where a caller builds a Context itself.
+  /// The command of the previous step (n): what the arm was last asked for, as applied (Heun's average of its two
+  /// stages; zeros after a held step). Zeros at the first step of a run (after construction or reset()).
+  const Eigen::VectorXd* theta_dot_prev = nullptr;
+  /// The command of the step before that (n): with theta_dot_prev, the previous acceleration.
+  const Eigen::VectorXd* theta_dot_prev2 = nullptr;
+  /// The joint velocity the caller measured at this step (n), when it passed one; null otherwise.
+  const Eigen::VectorXd* theta_dot_measured = nullptr;
+  /// The previous step's status (SolverStatus::kNotRun at the first step of a run).
+  SolverStatus status_prev{};
+  /// The steps this run has made before this one (0 at its first step; the second stage of Heun's method is not a
+  /// step of its own).
+  long step_index = 0;
+
   /// Joint positions theta (n).
   [[nodiscard]] const Eigen::VectorXd& theta() const { return kinematics->theta; }
+  /// Whether this step starts a run (no previous command yet).
+  [[nodiscard]] bool first_step() const noexcept { return step_index == 0; }
 };
 
 }  // namespace redres

@@ -56,6 +56,20 @@ class Controller {
   /// orientation reference: the one set with set_orientation_reference(), or else the end effector's orientation
   /// at the first such step after construction or reset().
   void step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out);
+  /// The same with the joint velocity the caller measured (size n, finite): plugins read it as
+  /// Context::theta_dot_measured during this step.
+  void step(const Eigen::Ref<const Eigen::VectorXd>& theta, const Eigen::Ref<const Eigen::VectorXd>& theta_dot_measured,
+            double t, StepOutput& out);
+  /// Solves this step again at another state (Heun's second stage, at the Euler prediction): the plugins see the same
+  /// previous command as the step's first solve, and the step's command stays the first solve's unless
+  /// set_applied() says otherwise.
+  void reevaluate(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out);
+  /// The command the caller actually applied this step (e.g. Heun's average of its two stages): the next step's
+  /// Context::theta_dot_prev. By default it is the step's own theta_dot (zeros for a held step).
+  void set_applied(const Eigen::Ref<const Eigen::VectorXd>& theta_dot);
+  /// The period of the steps from now on (s, > 0), when the caller's loop runs at another one than the scenario's:
+  /// Context::tau.
+  void set_period(double tau);
   /// One step with caller-supplied r_d and r_d_dot (size reference_dim(): every row of the position or pose, also
   /// those a subset of task rows leaves free, which are not used).
   void step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, const Eigen::Ref<const Eigen::VectorXd>& r_d,
@@ -103,6 +117,8 @@ class Controller {
 
  private:
   void solve(double t, StepOutput& out);
+  void begin_step();                     // the previous step's command becomes theta_dot_prev
+  void end_step(const StepOutput& out);  // this step's command and status, for the next
   void relax(StepOutput& out);
 
   const RobotModel* robot_;
@@ -118,8 +134,13 @@ class Controller {
   OrientationReference orientation_;  // the orientation rows of r_d and r_d_dot under a path
   KinematicsLevel level_ = KinematicsLevel::kPosition;
   Context ctx_;
-  double relax_weight_ = 0.0;                // set_relaxation(); 0: hold
-  std::string note_;                         // a failed step's text while relax() writes its own before it
+  double relax_weight_ = 0.0;               // set_relaxation(); 0: hold
+  std::string note_;                        // a failed step's text while relax() writes its own before it
+  Eigen::VectorXd prev_, prev2_, pending_;  // theta_dot_prev, theta_dot_prev2, this step's applied command
+  Eigen::VectorXd measured_;                // the caller's measured joint velocity, during a step that has one
+  SolverStatus pending_status_ = SolverStatus::kNotRun;
+  bool have_pending_ = false;                // a step was made whose command is not yet theta_dot_prev
+  bool started_ = false;                     // the plugins were told that the run starts
   Eigen::VectorXd row_miss_;                 // J x - d of a relaxed step
   std::unique_ptr<LviEngine> relax_engine_;  // an engine like *engine_ for the elastic QP
   ElasticQp relaxed_;                        // the elastic QP (no equality rows)

@@ -81,6 +81,10 @@ class Plugin {
   /// Makes this plugin's data for one controller (at setup; may allocate). Default: none (nullptr), for a plugin
   /// whose steps keep no state and need no scratch.
   [[nodiscard]] virtual std::unique_ptr<PluginData> make_data() const { return nullptr; }
+  /// Called when a run starts, before its first step, and again after Controller::reset(): forget what `data` holds
+  /// from an earlier run (a filter's state, a previous command of your own). `data` is what make_data() made (may be
+  /// null). Allocation-free. Default: nothing.
+  virtual void start(PluginData* data) const { (void)data; }
   /// Whether the state at the last contribution (recorded in `data`, what make_data() made) breaks what this plugin
   /// guards (e.g. two bodies overlap). The simulation counts such a step as failed, with describe_violation() in
   /// its diagnosis. Allocation-free.

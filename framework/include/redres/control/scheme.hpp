@@ -31,6 +31,8 @@ class Scheme {
 
   /// Makes every plugin's data for one controller (allocates; at setup).
   [[nodiscard]] SchemeData make_data() const;
+  /// Tells every plugin that a run starts (Plugin::start), with its data in `data`.
+  void start(SchemeData& data) const;
   /// Sizes `qp` for this scheme (n, m_e, m_i) and names its sources; the descriptions of its inequality rows read
   /// the plugins' data in `data` (which may be moved, but must outlive `qp`'s use).
   void setup(QpProblem& qp, const SchemeData& data) const;

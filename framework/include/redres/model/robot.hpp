@@ -31,6 +31,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,6 +69,13 @@ struct JointSpec {
   double upper = 0.0;                                        //!< position limit theta^+ (rad or m)
   std::shared_ptr<const VelocityLimitLaw> velocity_limit;    //!< theta_dot^-(theta), theta_dot^+(theta)
   std::string velocity_limit_source;  //!< "file:line:col" of the law's table, for diagnoses (empty: built in code)
+  /// theta_ddot^-(theta), theta_ddot^+(theta) (rad/s^2 or m/s^2), a law as the velocity limit is; null: not given.
+  std::shared_ptr<const VelocityLimitLaw> acceleration_limit;
+  std::string acceleration_limit_source;  //!< where the acceleration law was given ("file:line:col")
+  /// Bounds on the rate of change of acceleration (rad/s^3 or m/s^3), a law; null: not given.
+  std::shared_ptr<const VelocityLimitLaw> jerk_limit;
+  std::string jerk_limit_source;       //!< where the jerk law was given ("file:line:col")
+  std::optional<double> effort_limit;  //!< the largest torque or force (N m or N), > 0; from the URDF's `effort`
   /// Collision shapes of the link that joint j moves, in the link frame (the joint's frame after its motion, before
   /// the fixed transform to the next joint). A capsule with neither `length` nor `from`/`to` runs along the link:
   /// from the joint's origin to the next joint's origin (the end effector's, for the last joint).
@@ -184,6 +192,15 @@ class RobotModel {
   /// Velocity limits of every joint at theta; writes into lower/upper (size n). Allocation-free.
   void velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
                        Eigen::Ref<Eigen::VectorXd> upper) const;
+  /// Whether every joint has an acceleration limit (a jerk limit).
+  [[nodiscard]] bool has_acceleration_limits() const noexcept;
+  [[nodiscard]] bool has_jerk_limits() const noexcept;
+  /// Acceleration (jerk) limits of every joint at theta, into lower/upper (size n); a joint without a law gets
+  /// -inf, +inf. Allocation-free.
+  void acceleration_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
+                           Eigen::Ref<Eigen::VectorXd> upper) const;
+  void jerk_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
+                   Eigen::Ref<Eigen::VectorXd> upper) const;
 
  private:
   RobotSpec spec_;

@@ -5,10 +5,9 @@
 #include <Eigen/Core>
 
 #include "redres/model/kinematics.hpp"
+#include "redres/qp/solver_status.hpp"
 
 namespace redres {
-
-enum class SolverStatus;  // qp/lvi.hpp
 
 /// Everything a plugin may read at one control step. New inputs are added here, never to plugin signatures.
 struct Context {
@@ -33,7 +32,7 @@ struct Context {
   /// The joint velocity the caller measured at this step (n), when it passed one; null otherwise.
   const Eigen::VectorXd* theta_dot_measured = nullptr;
   /// The previous step's status (SolverStatus::kNotRun at the first step of a run).
-  SolverStatus status_prev{};
+  SolverStatus status_prev = SolverStatus::kNotRun;
   /// The steps this run has made before this one (0 at its first step; the second stage of Heun's method is not a
   /// step of its own).
   long step_index = 0;

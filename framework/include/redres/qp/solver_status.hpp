@@ -1,0 +1,29 @@
+#pragma once
+/// @file
+/// The outcome of one solve (what the LVI engines report and the Context carries of the previous step).
+
+namespace redres {
+
+/// Outcome of one solve.
+enum class SolverStatus {
+  kSolved,          //!< ||e(u)|| <= tolerance
+  kMaxIterations,   //!< the iteration cap was reached first
+  kInfeasible,      //!< bounds conflict, or J x = d cannot be met inside the bounds
+  kNumericalError,  //!< the iteration broke down (e.g. a zero step); see the diagnosis
+  kNotRun,          //!< no solve has run yet (recorded codes 0-3 keep their meaning)
+  kInvalidProblem,  //!< the step's QP could not be built: a plugin or a velocity-limit law gave a non-finite value
+                    //!< there (Controller; the diagnosis names which); nothing was solved
+  kRelaxed,         //!< the QP failed, and the elastic QP with the equality rows relaxed into a weighted penalty
+                    //!< was solved instead (Controller::set_relaxation); the diagnosis says why and by how much
+                    //!< the rows are missed
+};
+
+/// Whether a step with this status has a usable theta_dot: solved, or solved with the rows relaxed.
+[[nodiscard]] constexpr bool usable(SolverStatus status) noexcept {
+  return status == SolverStatus::kSolved || status == SolverStatus::kRelaxed;
+}
+
+/// "solved", "max_iterations", "infeasible", "numerical_error", "not_run", "invalid_problem", "relaxed".
+[[nodiscard]] const char* to_string(SolverStatus status);
+
+}  // namespace redres

@@ -65,33 +65,31 @@ TEST(MotionLimits, LawsOtherThanConstantsWork) {
   // An acceleration limit that follows the position, as a push-rod joint's velocity limit does.
   const auto dir = scratch("motion_limits_law");
   std::filesystem::create_directories(dir);
-  std::ofstream(dir / "robot.toml") << R"(name = "two"
+  std::ofstream(dir / "robot.toml") << R"toml(name = "two"
 kind = "planar"
 [[joints]]
 name = "j1"
 length = 0.3
 limits = [-1.0, 1.0]
 velocity_limit = { type = "constant", lower = -1.0, upper = 1.0 }
-acceleration_limit = { type = "expression", lower = "-(2 + theta)",
-      upper = "2 + theta"
-}
+acceleration_limit = { type = "expression", lower = "-(2 + theta)", upper = "2 + theta" }
 jerk_limit = { type = "constant", lower = -100.0, upper = 50.0 }
 [[joints]]
 name = "j2"
 length = 0.2
 limits = [-1.0, 1.0]
 velocity_limit = { type = "constant", lower = -1.0, upper = 1.0 }
-)";
+)toml";
   const RobotModel robot = load_robot(dir / "robot.toml");
-EXPECT_FALSE(robot.has_acceleration_limits()) << "joint 2 has none";
-Eigen::VectorXd lo(2), hi(2);
-robot.acceleration_limits(Eigen::Vector2d(0.5, 0.0), lo, hi);
-EXPECT_DOUBLE_EQ(hi(0), 2.5);
-EXPECT_DOUBLE_EQ(lo(0), -2.5);
-EXPECT_TRUE(std::isinf(hi(1)));
-robot.jerk_limits(Eigen::Vector2d(0.0, 0.0), lo, hi);
-EXPECT_EQ(lo(0), -100.0);
-EXPECT_EQ(hi(0), 50.0);
+  EXPECT_FALSE(robot.has_acceleration_limits()) << "joint 2 has none";
+  Eigen::VectorXd lo(2), hi(2);
+  robot.acceleration_limits(Eigen::Vector2d(0.5, 0.0), lo, hi);
+  EXPECT_DOUBLE_EQ(hi(0), 2.5);
+  EXPECT_DOUBLE_EQ(lo(0), -2.5);
+  EXPECT_TRUE(std::isinf(hi(1)));
+  robot.jerk_limits(Eigen::Vector2d(0.0, 0.0), lo, hi);
+  EXPECT_EQ(lo(0), -100.0);
+  EXPECT_EQ(hi(0), 50.0);
 }
 
 }  // namespace

@@ -68,8 +68,8 @@ const std::vector<Bad>& corpus() {
       {"spatial_without_convention.toml", "1:1", {"missing required key 'convention'"}},
       {"end_effector_wrong_size.toml", "4:12", {"key 'position': expected an array of 2 numbers, got 3"}},
       {"joints_zero_axis.toml", "6:8", {"joint 'j1': key 'axis': expected a non-zero axis vector"}},
-      {"joints_with_dh_key.toml", "6:1", {"unknown key 'd' in joint 'j1'", "axis, collision, limits, name, origin"}},
-      {"dh_with_axis.toml", "6:1", {"unknown key 'axis' in joint 'j1'", "a, alpha, collision, d, limits"}},
+      {"joints_with_dh_key.toml", "6:1", {"unknown key 'd' in joint 'j1'", "axis, collision, effort_limit, jerk_limit, limits, name, origin"}},
+      {"dh_with_axis.toml", "6:1", {"unknown key 'axis' in joint 'j1'", "a, acceleration_limit, alpha, collision, d, effort_limit"}},
       {"joints_origin_unknown_key.toml", "6:31", {"unknown key 'quat' in joint 'j1' origin", "rpy, xyz"}},
       {"planar_base_rpy.toml", "5:1", {"unknown key 'rpy' in base", "angle, position, xyz"}},
   };

@@ -131,13 +131,13 @@ TEST(StepState, EachStepSeesTheCommandsHandedOutBeforeIt) {
   // A measured velocity, for one step only; another period.
   const Eigen::VectorXd measured = Eigen::VectorXd::LinSpaced(rig.robot.dof(), 0.1, 0.4);
   ctrl.set_period(0.002);
-  ctrl.step(theta, 0.01, measured, out);
+  ctrl.step(theta, measured, 0.01, out);
   EXPECT_TRUE(recorded(ctrl).seen.back().measured);
   EXPECT_EQ(recorded(ctrl).seen.back().measured_value, measured);
   EXPECT_EQ(recorded(ctrl).seen.back().tau, 0.002);
   ctrl.step(theta, 0.012, out);
   EXPECT_FALSE(recorded(ctrl).seen.back().measured);
-  EXPECT_THROW(ctrl.step(theta, measured.head(2), 0.014, out), std::invalid_argument);
+  EXPECT_THROW(ctrl.step(theta, Eigen::VectorXd(measured.head(2)), 0.014, out), std::invalid_argument);
   EXPECT_THROW(ctrl.set_period(0.0), std::invalid_argument);
 }
 

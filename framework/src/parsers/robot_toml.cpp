@@ -261,19 +261,23 @@ const Schema<JointReading>& JointReading::schema() {
                "the joint's velocity-limit law; `type` names it, its keys are its own (redres plugins)",
                [](const TableReader& r, C& c) { read_velocity_law(r, c.jt); })
           .required(),
-      entry<C>("acceleration_limit", "table", "rad/s^2 or m/s^2", "",
+      entry<C>("acceleration_limit", "table", "rad/s^2 or m/s^2", "none (unbounded)",
                "the joint's acceleration limits: a law of the same kinds as velocity_limit (constant, push_rod, ...)",
                [](const TableReader& r, C& c) {
+                 if (!r.has("acceleration_limit")) return;  // none: unbounded
                  read_law(r, "acceleration_limit", "acceleration-limit", c.jt, c.jt.acceleration_limit,
                           c.jt.acceleration_limit_source);
                }),
-      entry<C>("jerk_limit", "table", "rad/s^3 or m/s^3", "",
+      entry<C>("jerk_limit", "table", "rad/s^3 or m/s^3", "none (unbounded)",
                "the joint's jerk limits (the rate of change of acceleration): a law as velocity_limit",
                [](const TableReader& r, C& c) {
+                 if (!r.has("jerk_limit")) return;  // none: unbounded
                  read_law(r, "jerk_limit", "jerk-limit", c.jt, c.jt.jerk_limit, c.jt.jerk_limit_source);
                }),
-      entry<C>("effort_limit", "number", "N m or N", "", "the largest torque (force) the joint's drive gives",
-               [](const TableReader& r, C& c) { read_effort(r, c.jt); }),
+      entry<C>("effort_limit", "number", "N m or N", "none", "the largest torque (force) the joint's drive gives",
+               [](const TableReader& r, C& c) {
+                 if (r.has("effort_limit")) read_effort(r, c.jt);
+               }),
   }};
   return s;
 }

@@ -25,8 +25,8 @@ Formula compile(const std::string& text, const char* key) {
 const Schema<ExpressionLawConfig>& ExpressionLawConfig::schema() {
   using C = ExpressionLawConfig;
   static const Schema<C> s{
-      {field("lower", &C::lower, "rad/s or m/s", "formula of theta for the lower limit").required(),
-       field("upper", &C::upper, "rad/s or m/s", "formula of theta for the upper limit").required()},
+      {field("lower", &C::lower, "rad/s^k or m/s^k", "formula of theta for the lower limit").required(),
+       field("upper", &C::upper, "rad/s^k or m/s^k", "formula of theta for the upper limit").required()},
       [](const C& c) {
         // Compiled here so that a syntax error names its key (and, from TOML, its file:line:col).
         if (!parses(c.lower)) (void)compile(c.lower, "lower");

@@ -32,8 +32,8 @@ const Schema<TableLawConfig>& TableLawConfig::schema() {
   using C = TableLawConfig;
   static const Schema<C> s{
       {field("theta", &C::theta, "rad or m", "joint positions, strictly increasing").in_group("points"),
-       field("lower", &C::lower, "rad/s or m/s", "lower limits at those positions").in_group("points"),
-       field("upper", &C::upper, "rad/s or m/s", "upper limits at those positions").in_group("points"),
+       field("lower", &C::lower, "rad/s^k or m/s^k", "lower limits at those positions").in_group("points"),
+       field("upper", &C::upper, "rad/s^k or m/s^k", "upper limits at those positions").in_group("points"),
        field("file", &C::file, "", "CSV file with columns theta,lower,upper, relative to the robot file")
            .in_group("points")},
       [](const C& c) {

@@ -116,14 +116,14 @@ void read_limits(const TableReader& r, JointSpec& jt) {
 
 // A joint's limit-law table `key` (velocity_limit, acceleration_limit, jerk_limit) into `law` and `source`, checked
 // over the joint's range (jt.lower, jt.upper set before). The three are laws of the same kinds (redres plugins).
-void read_law(const TableReader& r, const char* key, const char* what, JointSpec& jt,
+void read_law(const TableReader& r, const char* key, const char* what, const char* unit, JointSpec& jt,
               std::shared_ptr<const VelocityLimitLaw>& law, std::string& source) {
   const TableReader law_table = r.table(key);
   const TableReader law_reader(law_table.file_ptr(), law_table.raw(), "joint '" + jt.name + "' " + key);
   law = make_velocity_limit(law_reader);
   source = r.location(key).str();
   law_reader.finish();
-  if (auto bad = check_velocity_law(*law, jt.lower, jt.upper)) {
+  if (auto bad = check_velocity_law(*law, jt.lower, jt.upper, *physical_bound(unit))) {
     law_reader.fail(std::string(what) + " law '" + law->type() + "' is invalid at theta = " + num(bad->theta) +
                     (jt.type == JointType::kRevolute ? " rad" : " m") + " (joint range [" + num(jt.lower) + ", " +
                     num(jt.upper) + "]): " + bad->reason);
@@ -131,7 +131,7 @@ void read_law(const TableReader& r, const char* key, const char* what, JointSpec
 }
 
 void read_velocity_law(const TableReader& r, JointSpec& jt) {
-  read_law(r, "velocity_limit", "velocity-limit", jt, jt.velocity_limit, jt.velocity_limit_source);
+  read_law(r, "velocity_limit", "velocity-limit", "rad/s or m/s", jt, jt.velocity_limit, jt.velocity_limit_source);
 }
 
 void read_effort(const TableReader& r, JointSpec& jt) {
@@ -146,9 +146,9 @@ void read_effort(const TableReader& r, JointSpec& jt) {
 // URDF joint's [[joints]] override; a [[joints]] entry of a TOML chain reads them key by key).
 void read_motion_limits(const TableReader& r, JointSpec& jt) {
   if (r.has("acceleration_limit")) {
-    read_law(r, "acceleration_limit", "acceleration-limit", jt, jt.acceleration_limit, jt.acceleration_limit_source);
+    read_law(r, "acceleration_limit", "acceleration-limit", "rad/s^2 or m/s^2", jt, jt.acceleration_limit, jt.acceleration_limit_source);
   }
-  if (r.has("jerk_limit")) read_law(r, "jerk_limit", "jerk-limit", jt, jt.jerk_limit, jt.jerk_limit_source);
+  if (r.has("jerk_limit")) read_law(r, "jerk_limit", "jerk-limit", "rad/s^3 or m/s^3", jt, jt.jerk_limit, jt.jerk_limit_source);
   if (r.has("effort_limit")) read_effort(r, jt);
 }
 
@@ -265,14 +265,14 @@ const Schema<JointReading>& JointReading::schema() {
                "the joint's acceleration limits: a law of the same kinds as velocity_limit (constant, push_rod, ...)",
                [](const TableReader& r, C& c) {
                  if (!r.has("acceleration_limit")) return;  // none: unbounded
-                 read_law(r, "acceleration_limit", "acceleration-limit", c.jt, c.jt.acceleration_limit,
+                 read_law(r, "acceleration_limit", "acceleration-limit", "rad/s^2 or m/s^2", c.jt, c.jt.acceleration_limit,
                           c.jt.acceleration_limit_source);
                }),
       entry<C>("jerk_limit", "table", "rad/s^3 or m/s^3", "none (unbounded)",
                "the joint's jerk limits (the rate of change of acceleration): a law as velocity_limit",
                [](const TableReader& r, C& c) {
                  if (!r.has("jerk_limit")) return;  // none: unbounded
-                 read_law(r, "jerk_limit", "jerk-limit", c.jt, c.jt.jerk_limit, c.jt.jerk_limit_source);
+                 read_law(r, "jerk_limit", "jerk-limit", "rad/s^3 or m/s^3", c.jt, c.jt.jerk_limit, c.jt.jerk_limit_source);
                }),
       entry<C>("effort_limit", "number", "N m or N", "none", "the largest torque (force) the joint's drive gives",
                [](const TableReader& r, C& c) {

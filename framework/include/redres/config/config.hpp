@@ -380,7 +380,11 @@ std::string value_text(const T& v) {
 /// are refused at load. docs/scenario_format.md lists the bounds.
 [[nodiscard]] inline std::optional<double> physical_bound(std::string_view unit) {
   if (unit == "m" || unit == "m/s" || unit == "rad or m" || unit == "rad/s or m/s" || unit == "m/rot") return 1e3;
-  if (unit == "1/s" || unit == "rad" || unit == "deg" || unit == "rot/s") return 1e6;
+  if (unit == "1/s" || unit == "rad" || unit == "deg" || unit == "rot/s" || unit == "rad/s^2 or m/s^2") return 1e6;
+  if (unit == "rad/s^3 or m/s^3") return 1e9;
+  // A limit law's numbers serve velocity, acceleration and jerk limits; the law's own reading checks the range of
+  // the one it is (check_velocity_law), this bound only keeps the arithmetic finite.
+  if (unit == "rad/s^k or m/s^k") return 1e9;
   return std::nullopt;
 }
 

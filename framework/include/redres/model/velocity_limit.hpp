@@ -61,8 +61,11 @@ class VelocityLimitLaw {
 /// Number of positions (including both ends) at which a law is sampled at load.
 inline constexpr int kVelocityLawSamples = 2001;
 
-/// Checks a law over [lo, hi]: defined everywhere, finite, lower < 0 < upper at every sample. Returns the first
-/// failure (position and reason), or nothing when the law is valid.
-[[nodiscard]] std::optional<UndefinedAt> check_velocity_law(const VelocityLimitLaw& law, double lo, double hi);
+/// Checks a law over [lo, hi]: defined everywhere, finite, lower < 0 < upper and |limit| <= bound at every sample.
+/// Returns the first failure (position and reason), or nothing when the law is valid. The laws serve velocity,
+/// acceleration and jerk limits alike; `bound` is the physical range of the one being read (physical_bound of
+/// "rad/s or m/s", "rad/s^2 or m/s^2", "rad/s^3 or m/s^3").
+[[nodiscard]] std::optional<UndefinedAt> check_velocity_law(const VelocityLimitLaw& law, double lo, double hi,
+                                                            double bound = 1e3);
 
 }  // namespace redres

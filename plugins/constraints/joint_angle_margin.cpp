@@ -31,6 +31,12 @@ void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder, PluginData
   const double kappa = config_.kappa;
   builder.scratch() = kappa * ((robot.lower_limits() + margin_) - theta);
   builder.scratch2() = kappa * ((robot.upper_limits() - margin_) - theta);
+  if (ctx.level == SchemeLevel::kAcceleration) {  // the velocity after the step keeps them
+    for (int j = 0; j < robot.dof(); ++j) {
+      builder.scratch()(j) = ctx.velocity_to_x(builder.scratch()(j), j);
+      builder.scratch2()(j) = ctx.velocity_to_x(builder.scratch2()(j), j);
+    }
+  }
   builder.intersect_bounds(builder.scratch(), builder.scratch2());
 }
 

@@ -18,6 +18,13 @@ void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder, PluginD
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
   const double scale = config_.scale;
+  if (ctx.level == SchemeLevel::kAcceleration) {  // the velocity after the step keeps them
+    for (int j = 0; j < robot.dof(); ++j) {
+      const VelocityBounds b = robot.joint(j).velocity_limit->bounds(theta(j));
+      builder.intersect_bound(j, ctx.velocity_to_x(scale * b.lower, j), ctx.velocity_to_x(scale * b.upper, j));
+    }
+    return;
+  }
   if (ctx.velocity_lower != nullptr && ctx.velocity_upper != nullptr) {
     if (scale == 1.0) {
       builder.intersect_bounds(*ctx.velocity_lower, *ctx.velocity_upper);

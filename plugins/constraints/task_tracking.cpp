@@ -55,9 +55,36 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*
   const int* task_rows = robot.task_rows().data();
   const double* gain = gain_.data();
   const Eigen::Index task = gain_.size();
+  if (ctx.level == SchemeLevel::kVelocity) {
+    for (Eigen::Index i = 0; i < task; ++i) {
+      const int r = task_rows[i];
+      d[i] = r_d_dot[r] + gain[i] * e[r];
+    }
+    return;
+  }
+  // Acceleration level: d = S (r_d_ddot - J_dot theta_dot + 2K (r_d_dot - J theta_dot) + K^2 e).
+  REDRES_REQUIRE(ctx.r_d_ddot != nullptr && ctx.r_d_ddot->size() == rows && ctx.theta_dot != nullptr &&
+                     ctx.theta_dot->size() == n && k.dJ.cols() == n * n,
+                 "task_tracking", "at the acceleration level the context carries r_d_ddot, theta_dot and dJ");
+  const double* v = ctx.theta_dot->data();
+  const double* r_d_ddot = ctx.r_d_ddot->data();
+  double jv[6] = {0, 0, 0, 0, 0, 0}, jdv[6] = {0, 0, 0, 0, 0, 0};
+  for (Eigen::Index c = 0; c < n; ++c) {
+    const double* col = from + c * m;  // J theta_dot
+    for (Eigen::Index r = 0; r < m; ++r) jv[r] += col[r] * v[c];
+  }
+  const double* dj = k.dJ.data();
+  for (Eigen::Index i = 0; i < n; ++i) {  // sum_i theta_dot_i (dJ/dtheta_i theta_dot)
+    if (v[i] == 0.0) continue;
+    for (Eigen::Index c = 0; c < n; ++c) {
+      const double s = v[i] * v[c];
+      const double* col = dj + (i * n + c) * m;
+      for (Eigen::Index r = 0; r < m; ++r) jdv[r] += col[r] * s;
+    }
+  }
   for (Eigen::Index i = 0; i < task; ++i) {
     const int r = task_rows[i];
-    d[i] = r_d_dot[r] + gain[i] * e[r];
+    d[i] = r_d_ddot[r] - jdv[r] + 2.0 * gain[i] * (r_d_dot[r] - jv[r]) + gain[i] * gain[i] * e[r];
   }
 }
 

@@ -263,7 +263,8 @@ toml::table spec_table(py::handle item, std::string& where) {
 
 std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::list& objectives,
                                               const py::list& constraints, py::object engine, py::object path, double T,
-                                              double tau, std::optional<Eigen::VectorXd> theta0) {
+                                              double tau, std::optional<Eigen::VectorXd> theta0,
+                                              const std::string& level) {
   auto c = std::make_unique<PyController>();
   c->robot = robot.model;
   const RobotModel& model = *c->robot;
@@ -279,7 +280,11 @@ std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::li
     cons.push_back(is_spec(item) ? make_constraint_from(spec_table(item, where), where, model)
                                  : wrap_constraint(py::reinterpret_borrow<py::object>(item), model));
   }
-  c->scheme = std::make_unique<Scheme>(model, std::move(objs), std::move(cons));
+  if (level != "velocity" && level != "acceleration") {
+    throw std::invalid_argument("Controller: expected level 'velocity' or 'acceleration', got '" + level + "'");
+  }
+  c->scheme = std::make_unique<Scheme>(model, std::move(objs), std::move(cons),
+                                       level == "velocity" ? SchemeLevel::kVelocity : SchemeLevel::kAcceleration);
   if (py::isinstance<py::str>(engine)) {
     c->engine = make_engine(engine.cast<std::string>());
   } else {
@@ -567,7 +572,7 @@ PYBIND11_MODULE(_redres, m) {
   py::class_<PyController>(m, "Controller")
       .def(py::init(&make_controller), py::arg("robot"), py::arg("objectives"), py::arg("constraints"),
            py::arg("engine") = "newton", py::arg("path") = py::none(), py::arg("T") = 1.0, py::arg("tau") = 0.01,
-           py::arg("theta0") = py::none(),
+           py::arg("theta0") = py::none(), py::arg("level") = "velocity",
            "Builds the scheme from the objectives and constraints for the robot, the engine (a name or an engine "
            "configuration) and the optional path (placed at f(theta0)); T and tau in s. Sized here: step() "
            "allocates nothing.")
@@ -591,6 +596,15 @@ PYBIND11_MODULE(_redres, m) {
           "One control step at (theta, t) with r_d and r_d_dot from the path: returns (theta_dot, StepInfo).")
       .def(
           "step",
+          [](py::handle p, const Eigen::VectorXd& theta, const Eigen::VectorXd& theta_dot_measured, double t) {
+            PyController& c = live(p);
+            return step_in_turn(c, [&](Controller& k) { k.step(theta, theta_dot_measured, t, c.out); });
+          },
+          py::arg("theta"), py::arg("theta_dot_measured"), py::arg("t"),
+          "One control step with the joint velocity the caller measured (plugins read it as "
+          "Context.theta_dot_measured; the acceleration level starts from it): returns (theta_dot, StepInfo).")
+      .def(
+          "step",
           [](py::handle p, const Eigen::VectorXd& theta, double t, const Eigen::VectorXd& r_d,
              const Eigen::VectorXd& r_d_dot) {
             PyController& c = live(p);
@@ -598,6 +612,61 @@ PYBIND11_MODULE(_redres, m) {
           },
           py::arg("theta"), py::arg("t"), py::arg("r_d"), py::arg("r_d_dot"),
           "One control step with the caller's r_d and r_d_dot (reference_dim entries): returns (theta_dot, StepInfo).")
+      .def(
+          "step",
+          [](py::handle p, const Eigen::VectorXd& theta, double t, const Eigen::VectorXd& r_d,
+             const Eigen::VectorXd& r_d_dot, const Eigen::VectorXd& r_d_ddot) {
+            PyController& c = live(p);
+            return step_in_turn(c, [&](Controller& k) { k.step(theta, t, r_d, r_d_dot, r_d_ddot, c.out); });
+          },
+          py::arg("theta"), py::arg("t"), py::arg("r_d"), py::arg("r_d_dot"), py::arg("r_d_ddot"),
+          "The same with the caller's r_d_ddot too (an acceleration-level scheme): returns (theta_dot, StepInfo).")
+      .def(
+          "set_applied",
+          [](py::handle p, const Eigen::VectorXd& theta_dot) {
+            PyController& c = live(p);
+            in_turn(c, "Controller.set_applied", [&](Controller& k) { k.set_applied(theta_dot); });
+          },
+          py::arg("theta_dot"),
+          "The command actually applied this step (the next step's theta_dot_prev), when it is not the step's own.")
+      .def(
+          "set_period",
+          [](py::handle p, double tau) {
+            PyController& c = live(p);
+            in_turn(c, "Controller.set_period", [&](Controller& k) { k.set_period(tau); });
+          },
+          py::arg("tau"), "The period of the steps from now on (s), when the loop runs at another than tau.")
+      .def(
+          "set_failure_policy",
+          [](py::handle p, const std::string& policy, double relax_weight, double recover_error) {
+            PyController& c = live(p);
+            const FailurePolicy f = policy == "hold"    ? FailurePolicy::kHold
+                                    : policy == "relax" ? FailurePolicy::kRelax
+                                    : policy == "brake"
+                                        ? FailurePolicy::kBrake
+                                        : throw std::invalid_argument("Controller.set_failure_policy: expected "
+                                                                      "'hold', 'relax' or 'brake', got '" +
+                                                                      policy + "'");
+            in_turn(c, "Controller.set_failure_policy",
+                    [&](Controller& k) { k.set_failure_policy(f, relax_weight, recover_error); });
+          },
+          py::arg("policy"), py::arg("relax_weight") = 1e4, py::arg("recover_error") = 1e-3,
+          "What a failed step does: 'hold', 'relax' or 'brake' (docs/motion.md).")
+      .def_property_readonly(
+          "theta_ddot",
+          [](py::handle p) {
+            PyController& c = live(p);
+            return in_turn(c, "Controller.theta_ddot", [&c](Controller&) { return Eigen::VectorXd(c.out.theta_ddot); });
+          },
+          "the last step's commanded acceleration (rad/s^2)")
+      .def_property_readonly(
+          "theta_dot_prev",
+          [](py::handle p) {
+            PyController& c = live(p);
+            return in_turn(c, "Controller.theta_dot_prev",
+                           [](Controller& k) { return Eigen::VectorXd(k.theta_dot_prev()); });
+          },
+          "the previous step's command as the last step's plugins saw it")
       .def(
           "reset",
           [](py::handle p) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -22,12 +23,16 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
       kin_(robot),
       r_d_(Eigen::VectorXd::Zero(robot.reference_dim())),
       r_d_dot_(Eigen::VectorXd::Zero(robot.reference_dim())),
+      r_d_ddot_(Eigen::VectorXd::Zero(robot.reference_dim())),
       vlo_(Eigen::VectorXd::Zero(robot.dof())),
       vhi_(Eigen::VectorXd::Zero(robot.dof())),
       prev_(Eigen::VectorXd::Zero(robot.dof())),
       prev2_(Eigen::VectorXd::Zero(robot.dof())),
       pending_(Eigen::VectorXd::Zero(robot.dof())),
-      measured_(Eigen::VectorXd::Zero(robot.dof())) {
+      measured_(Eigen::VectorXd::Zero(robot.dof())),
+      v_(Eigen::VectorXd::Zero(robot.dof())),
+      lim_lo_(Eigen::VectorXd::Zero(robot.dof())),
+      lim_hi_(Eigen::VectorXd::Zero(robot.dof())) {
   REDRES_REQUIRE(&scheme.robot() == &robot, "Controller", "the scheme was built for this robot");
   REDRES_REQUIRE(T > 0.0 && tau > 0.0, "Controller", "T > 0 and tau > 0");
   if (path != nullptr) {
@@ -49,11 +54,19 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
   ctx_.theta_dot_prev = &prev_;
   ctx_.theta_dot_prev2 = &prev2_;
   ctx_.status_prev = SolverStatus::kNotRun;
+  ctx_.level = scheme.level();
+  if (ctx_.level == SchemeLevel::kAcceleration) {
+    ctx_.r_d_ddot = &r_d_ddot_;
+    ctx_.theta_dot = &v_;
+  }
+  // A robot with acceleration limits never stops at once: a failed step brakes.
+  if (robot.has_acceleration_limits()) set_failure_policy(FailurePolicy::kBrake);
 }
 
 StepOutput Controller::make_output() const {
   StepOutput out;
   out.theta_dot = Eigen::VectorXd::Zero(robot_->dof());
+  out.theta_ddot = Eigen::VectorXd::Zero(robot_->dof());
   out.info.diagnosis.reserve(kDiagnosisCapacity);  // a failed step's text is written here without allocating
   return out;
 }
@@ -74,12 +87,14 @@ void Controller::begin_step() {
     scheme_->start(*data_);  // the plugins forget an earlier run
     started_ = true;
   }
-  if (!have_pending_) return;
-  prev2_.swap(prev_);  // same sizes: the buffers change hands, nothing is allocated
-  prev_.swap(pending_);
-  ctx_.status_prev = pending_status_;
-  ++ctx_.step_index;
-  have_pending_ = false;
+  if (have_pending_) {
+    prev2_.swap(prev_);  // same sizes: the buffers change hands, nothing is allocated
+    prev_.swap(pending_);
+    ctx_.status_prev = pending_status_;
+    ++ctx_.step_index;
+    have_pending_ = false;
+  }
+  if (ctx_.level == SchemeLevel::kAcceleration) v_ = ctx_.theta_dot_measured != nullptr ? measured_ : prev_;
 }
 
 void Controller::end_step(const StepOutput& out) {
@@ -126,38 +141,65 @@ void Controller::reevaluate(const Eigen::Ref<const Eigen::VectorXd>& theta, doub
   REDRES_REQUIRE(path_ != nullptr, "Controller::step", "a path was given (or pass r_d and r_d_dot)");
   compute_kinematics(*robot_, theta, kin_, level_);
   const int p = path_->dim();
-  path_->evaluate(t, r_d_.head(p), r_d_dot_.head(p));
-  if (robot_->reference_dim() > p) orientation_.evaluate(*robot_, kin_, t, ctx_.T, p, r_d_, r_d_dot_);
+  if (ctx_.level == SchemeLevel::kVelocity) {
+    path_->evaluate(t, r_d_.head(p), r_d_dot_.head(p));
+    if (robot_->reference_dim() > p) orientation_.evaluate(*robot_, kin_, t, ctx_.T, p, r_d_, r_d_dot_);
+  } else {
+    path_->evaluate(t, r_d_.head(p), r_d_dot_.head(p), r_d_ddot_.head(p));
+    if (robot_->reference_dim() > p) orientation_.evaluate(*robot_, kin_, t, ctx_.T, p, r_d_, r_d_dot_, r_d_ddot_);
+  }
   solve(t, out);
 }
 
 void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
                       const Eigen::Ref<const Eigen::VectorXd>& r_d, const Eigen::Ref<const Eigen::VectorXd>& r_d_dot,
                       StepOutput& out) {
+  REDRES_REQUIRE(ctx_.level == SchemeLevel::kVelocity, "Controller::step",
+                 "a velocity-level scheme (an acceleration-level one needs r_d_ddot too)");
+  step(theta, t, r_d, r_d_dot, r_d_dot, out);  // r_d_ddot is not read at the velocity level
+}
+
+void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
+                      const Eigen::Ref<const Eigen::VectorXd>& r_d, const Eigen::Ref<const Eigen::VectorXd>& r_d_dot,
+                      const Eigen::Ref<const Eigen::VectorXd>& r_d_ddot, StepOutput& out) {
   const int m = robot_->reference_dim();
-  REDRES_REQUIRE(r_d.size() == m && r_d_dot.size() == m, "Controller::step",
-                 "r_d and r_d_dot have reference_dim() = " + std::to_string(m) + " entries (got " +
-                     std::to_string(r_d.size()) + " and " + std::to_string(r_d_dot.size()) + ")");
-  REDRES_REQUIRE(r_d.allFinite() && r_d_dot.allFinite(), "Controller::step", "r_d and r_d_dot are finite");
+  REDRES_REQUIRE(r_d.size() == m && r_d_dot.size() == m && r_d_ddot.size() == m, "Controller::step",
+                 "r_d, r_d_dot and r_d_ddot have reference_dim() = " + std::to_string(m) + " entries (got " +
+                     std::to_string(r_d.size()) + ", " + std::to_string(r_d_dot.size()) + " and " +
+                     std::to_string(r_d_ddot.size()) + ")");
+  REDRES_REQUIRE(r_d.allFinite() && r_d_dot.allFinite() && r_d_ddot.allFinite(), "Controller::step",
+                 "r_d, r_d_dot and r_d_ddot are finite");
   begin_step();
   compute_kinematics(*robot_, theta, kin_, level_);
   r_d_ = r_d;
   r_d_dot_ = r_d_dot;
+  if (ctx_.level == SchemeLevel::kAcceleration) r_d_ddot_ = r_d_ddot;
   solve(t, out);
   end_step(out);
 }
 
+void Controller::apply(const Eigen::VectorXd& x, StepOutput& out) {
+  const double tau = ctx_.tau;
+  if (ctx_.level == SchemeLevel::kVelocity) {
+    out.theta_dot = x;
+    out.theta_ddot = (x - prev_) / tau;
+  } else {
+    out.theta_ddot = x;
+    out.theta_dot = v_ + tau * x;
+  }
+}
+
 void Controller::solve(double t, StepOutput& out) {
-  REDRES_REQUIRE(out.theta_dot.size() == robot_->dof(), "Controller::step",
-                 "out was made by make_output() (theta_dot has n entries)");
+  REDRES_REQUIRE(out.theta_dot.size() == robot_->dof() && out.theta_ddot.size() == robot_->dof(), "Controller::step",
+                 "out was made by make_output() (theta_dot and theta_ddot have n entries)");
   ctx_.t = t;
+  out.task_row_error = 0.0;
   try {
     robot_->velocity_limits(kin_.theta, vlo_, vhi_);
     scheme_->build(ctx_, qp_, *data_);
   } catch (const std::invalid_argument& e) {
     // A plugin or a law gave NaN or inf at this state (a user formula that is NaN in a narrow window): a failed step
     // that moves nothing, not the end of the run. The controller's own calls meet build()'s other conditions.
-    out.theta_dot.setZero();
     out.info.status = SolverStatus::kInvalidProblem;
     out.info.iterations = 0;
     out.info.residual = 0.0;
@@ -178,39 +220,85 @@ void Controller::solve(double t, StepOutput& out) {
       out.info.diagnosis = s.str();
       break;
     }
-    out.task_row_error = 0.0;
     engine_->reset();  // the next step starts cold
+    if (policy_ == FailurePolicy::kBrake || (policy_ == FailurePolicy::kRelax && robot_->has_acceleration_limits())) {
+      brake(out);
+    } else {
+      out.theta_dot.setZero();
+      out.theta_ddot = -base() / ctx_.tau;
+    }
     return;
   }
   engine_->solve_valid(qp_, result_);           // build() checked every entry it wrote
   keep_diagnosis_capacity(out.info.diagnosis);  // a no-op unless the caller's output lost its reserve
   out.info = result_.info;
-  out.task_row_error = 0.0;
   if (result_.info.status == SolverStatus::kSolved) {
-    out.theta_dot = result_.x;
+    apply(result_.x, out);
     return;
   }
-  out.theta_dot.setZero();  // hold: an unconverged iterate is never integrated
-  if (relax_engine_) relax(out);
+  // The step failed: the policy decides (never the unconverged iterate).
+  bool relaxed = false;
+  if (policy_ == FailurePolicy::kRelax) {
+    relaxed = relax(out);
+  } else if (policy_ == FailurePolicy::kBrake) {
+    const int p = robot_->position_rows();
+    const double error = (r_d_.head(p) - kin_.f.head(p)).norm();
+    if (error > recover_error_) relaxed = relax(out);  // behind the target: catch up within the limits
+  }
+  if (relaxed) return;
+  if (policy_ == FailurePolicy::kHold) {
+    out.theta_dot.setZero();
+    out.theta_ddot = -base() / ctx_.tau;
+    return;
+  }
+  brake(out);
 }
 
 void Controller::set_relaxation(double weight) {
   REDRES_REQUIRE(std::isfinite(weight) && weight >= 0.0, "Controller::set_relaxation", "weight >= 0 and finite");
-  relax_weight_ = weight;
   if (weight == 0.0) {
+    set_failure_policy(robot_->has_acceleration_limits() ? FailurePolicy::kBrake : FailurePolicy::kHold);
+    return;
+  }
+  set_failure_policy(FailurePolicy::kRelax, weight, recover_error_);
+}
+
+void Controller::set_failure_policy(FailurePolicy policy, double relax_weight, double recover_error) {
+  REDRES_REQUIRE(std::isfinite(relax_weight) && relax_weight > 0.0, "Controller::set_failure_policy",
+                 "relax_weight > 0 and finite");
+  REDRES_REQUIRE(std::isfinite(recover_error) && recover_error > 0.0, "Controller::set_failure_policy",
+                 "recover_error > 0 and finite");
+  const bool limits = robot_->has_acceleration_limits();
+  if (policy == FailurePolicy::kHold && limits) {
+    throw std::invalid_argument(
+        "Controller::set_failure_policy: 'hold' stops every joint at once, a velocity jump that robot '" +
+        robot_->name() + "''s acceleration limits forbid; use 'brake' (its default) or 'relax'");
+  }
+  if (policy == FailurePolicy::kBrake && !limits) {
+    int j = 0;
+    while (j < robot_->dof() && robot_->joint(j).acceleration_limit) ++j;
+    throw std::invalid_argument("Controller::set_failure_policy: 'brake' decelerates within the joints' acceleration "
+                                "limits, and joint " +
+                                std::to_string(j + 1) + " ('" + robot_->joint(j).name + "') of robot '" +
+                                robot_->name() + "' has none (give `acceleration_limit` in the robot file)");
+  }
+  policy_ = policy;
+  relax_weight_ = policy == FailurePolicy::kHold ? 0.0 : relax_weight;
+  recover_error_ = recover_error;
+  if (policy == FailurePolicy::kHold) {
     relax_engine_.reset();
     return;
   }
+  note_.reserve(kDiagnosisCapacity);
   if (!relax_engine_) {
     relax_engine_ = make_engine(std::string(engine_->name()), engine_->settings());
     relaxed_.setup(qp_);
     relax_engine_->setup(qp_.n(), 0, qp_.m_in(), relaxed_result_);
-    note_.reserve(kDiagnosisCapacity);
     row_miss_.resize(qp_.m_eq());
   }
 }
 
-void Controller::relax(StepOutput& out) {
+bool Controller::relax(StepOutput& out) {
   // The elastic QP (qp/elastic.hpp): the rows become a penalty of weight rho; bounds and inequality rows stay.
   const double rho = relax_weight_;
   relaxed_.build(qp_, rho);
@@ -219,12 +307,13 @@ void Controller::relax(StepOutput& out) {
   if (r.status != SolverStatus::kSolved) {
     TextSink(out.info.diagnosis).precision(6) << "; the elastic QP (rows relaxed with weight " << rho
                                               << ") failed too: " << to_string(r.status) << ": " << r.diagnosis;
-    return;
+    return false;
   }
-  out.theta_dot = relaxed_result_.x;
-  row_miss_.noalias() = qp_.J * out.theta_dot;  // sized at set_relaxation(): no temporary
+  const Eigen::VectorXd& x = relaxed_result_.x;
+  row_miss_.noalias() = qp_.J * x;  // sized at set_failure_policy(): no temporary
   row_miss_ -= qp_.d;
   out.task_row_error = qp_.m_eq() > 0 ? row_miss_.cwiseAbs().maxCoeff() : 0.0;
+  apply(x, out);
   // The failed solve's text goes after the relaxation's: kept aside in note_ (both reserved, so no allocation).
   note_.assign(out.info.diagnosis);  // note_ is reserved: a copy, so each string keeps its own storage
   keep_diagnosis_capacity(out.info.diagnosis);
@@ -234,6 +323,70 @@ void Controller::relax(StepOutput& out) {
   out.info.status = SolverStatus::kRelaxed;
   out.info.iterations += r.iterations;
   out.info.residual = r.residual;
+  return true;
+}
+
+void Controller::brake(StepOutput& out) {
+  // theta_dot = s b (b the velocity before the step, s >= 0: along the previous direction): the smallest s that keeps
+  // every joint's acceleration limits, velocity limits and, where all can hold, its jerk limits from the previous
+  // acceleration. s = 1 keeps the velocity and always meets the acceleration limits; s > 1 is taken only when the
+  // jerk limits ask for it (an arm accelerating cannot turn to braking at once).
+  const double tau = ctx_.tau;
+  const Eigen::VectorXd& b = base();
+  robot_->acceleration_limits(kin_.theta, lim_lo_, lim_hi_);
+  double s_lo = 0.0, s_hi = std::numeric_limits<double>::infinity();
+  int decides = -1;  // the joint whose limit sets s
+  // s in [lo, hi] for every joint with b_j != 0, from a bound lo_j <= (s - 1) b_j / tau + shift <= hi_j.
+  const auto within = [&](int j, double lo, double hi, double& s_min, double& s_max) {
+    double s1 = 1.0 + tau * lo / b(j), s2 = 1.0 + tau * hi / b(j);
+    if (s1 > s2) std::swap(s1, s2);
+    s_min = std::max(s_min, s1);
+    s_max = std::min(s_max, s2);
+  };
+  for (int j = 0; j < robot_->dof(); ++j) {
+    if (b(j) == 0.0) continue;
+    const double before = s_lo;
+    within(j, lim_lo_(j), lim_hi_(j), s_lo, s_hi);
+    if (s_lo > before) decides = j;
+    // The velocity limits: s b_j within [vlo_j, vhi_j] (evaluated at this step's theta), where b_j itself is.
+    if (b(j) > 0.0 && b(j) <= vhi_(j)) s_hi = std::min(s_hi, vhi_(j) / b(j));
+    if (b(j) < 0.0 && b(j) >= vlo_(j)) s_hi = std::min(s_hi, vlo_(j) / b(j));
+  }
+  s_hi = std::max(s_hi, s_lo);
+  double s = s_lo;
+  bool jerk_yields = false;
+  if (robot_->has_jerk_limits()) {
+    robot_->jerk_limits(kin_.theta, lim_lo_, lim_hi_);
+    double lo = s_lo, hi = s_hi;
+    int jerk_decides = decides;
+    for (int j = 0; j < robot_->dof(); ++j) {
+      if (b(j) == 0.0) continue;
+      // The acceleration (s - 1) b_j / tau within a_prev + tau [j^-, j^+].
+      const double a_prev = (prev_(j) - prev2_(j)) / tau;
+      const double before = lo;
+      within(j, a_prev + tau * lim_lo_(j), a_prev + tau * lim_hi_(j), lo, hi);
+      if (lo > before) jerk_decides = j;
+    }
+    jerk_yields = lo > hi;
+    if (!jerk_yields) {
+      s = lo;
+      decides = jerk_decides;
+    } else {
+      s = std::clamp(lo, s_lo, s_hi);  // as near the jerk limits as the acceleration and velocity limits allow
+    }
+  }
+  out.theta_dot = s * b;
+  out.theta_ddot = (out.theta_dot - b) / tau;
+  out.task_row_error = 0.0;
+  note_.assign(out.info.diagnosis);
+  keep_diagnosis_capacity(out.info.diagnosis);
+  out.info.diagnosis.clear();
+  TextSink sink(out.info.diagnosis);
+  sink.precision(6) << "braked to " << s << " of the previous command";
+  if (decides >= 0) sink << " (joint " << decides + 1 << " '" << robot_->joint(decides).name << "' at its limit)";
+  if (jerk_yields) sink << ", the jerk limits yielding to the acceleration limits";
+  sink << ", after " << to_string(out.info.status) << ": " << note_;
+  out.info.status = SolverStatus::kBraked;
 }
 
 }  // namespace redres

@@ -36,21 +36,39 @@ PathSegment PathSegment::arc(const Eigen::Vector3d& centre, double radius, doubl
   return s;
 }
 
-void PathSegment::at(double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent) const {
-  if (kind == Kind::kLine) {
-    const Eigen::Vector3d dir = length > 0.0 ? Eigen::Vector3d((b - a) / length) : Eigen::Vector3d::Zero();
-    point = a + s * dir;
+namespace {
+
+// PathSegment::at with an optional second derivative; point and tangent do not depend on whether it is asked for.
+void segment_at(const PathSegment& seg, double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent,
+                Eigen::Vector3d* d2point) {
+  const double length = seg.length;
+  if (seg.kind == PathSegment::Kind::kLine) {
+    const Eigen::Vector3d dir = length > 0.0 ? Eigen::Vector3d((seg.b - seg.a) / length) : Eigen::Vector3d::Zero();
+    point = seg.a + s * dir;
     tangent = dir;
+    if (d2point != nullptr) d2point->setZero();
     return;
   }
   // Arc or helix: angle advances linearly with arc length.
   const double frac = length > 0.0 ? s / length : 0.0;
-  const double angle = start_angle + frac * sweep;
+  const double angle = seg.start_angle + frac * seg.sweep;
   const double c = std::cos(angle), sn = std::sin(angle);
-  point = a + radius * (c * e1 + sn * e2) + frac * rise * axis;
+  point = seg.a + seg.radius * (c * seg.e1 + sn * seg.e2) + frac * seg.rise * seg.axis;
   // d point / d s = (dangle/ds) radius (-sin e1 + cos e2) + (rise / length) axis.
-  const double dangle = length > 0.0 ? sweep / length : 0.0;
-  tangent = dangle * radius * (-sn * e1 + c * e2) + (length > 0.0 ? rise / length : 0.0) * axis;
+  const double dangle = length > 0.0 ? seg.sweep / length : 0.0;
+  tangent = dangle * seg.radius * (-sn * seg.e1 + c * seg.e2) + (length > 0.0 ? seg.rise / length : 0.0) * seg.axis;
+  // d^2 point / d s^2 = -(dangle/ds)^2 radius (cos e1 + sin e2): the rise is linear in s.
+  if (d2point != nullptr) *d2point = -(dangle * dangle * seg.radius) * (c * seg.e1 + sn * seg.e2);
+}
+
+}  // namespace
+
+void PathSegment::at(double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent) const {
+  segment_at(*this, s, point, tangent, nullptr);
+}
+
+void PathSegment::at(double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent, Eigen::Vector3d& d2point) const {
+  segment_at(*this, s, point, tangent, &d2point);
 }
 
 Eigen::Vector3d PathSegment::start() const {
@@ -81,24 +99,39 @@ PathGeometry strokes_from(std::vector<PathSegment> segments, bool stroke_each) {
   return g;
 }
 
-void timing(TimingLaw law, double u, double& sigma, double& dsigma) {
+namespace {
+
+// timing() with an optional second derivative; sigma and dsigma do not depend on whether it is asked for.
+void timing_impl(TimingLaw law, double u, double& sigma, double& dsigma, double* d2sigma) {
   u = std::clamp(u, 0.0, 1.0);
   switch (law) {
     case TimingLaw::kCycloidal:
       sigma = u - std::sin(2.0 * pi * u) / (2.0 * pi);
       dsigma = 1.0 - std::cos(2.0 * pi * u);
+      if (d2sigma != nullptr) *d2sigma = 2.0 * pi * std::sin(2.0 * pi * u);
       return;
     case TimingLaw::kSin2: {
       const double s = std::sin(0.5 * pi * u);
       sigma = s * s;
       dsigma = 0.5 * pi * std::sin(pi * u);
+      if (d2sigma != nullptr) *d2sigma = 0.5 * pi * pi * std::cos(pi * u);
       return;
     }
     case TimingLaw::kQuintic:
       sigma = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u);
       dsigma = 30.0 * u * u * (1.0 - u) * (1.0 - u);
+      // d/du 30 u^2 (1 - u)^2 = 60 u (1 - u) (1 - 2u).
+      if (d2sigma != nullptr) *d2sigma = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u);
       return;
   }
+}
+
+}  // namespace
+
+void timing(TimingLaw law, double u, double& sigma, double& dsigma) { timing_impl(law, u, sigma, dsigma, nullptr); }
+
+void timing(TimingLaw law, double u, double& sigma, double& dsigma, double& d2sigma) {
+  timing_impl(law, u, sigma, dsigma, &d2sigma);
 }
 
 Path::Path(PathGeometry geometry, int dim, double duration, TimingLaw law, TimingScope scope,
@@ -134,34 +167,70 @@ Path::Path(PathGeometry geometry, int dim, double duration, TimingLaw law, Timin
   }
 }
 
-void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot) const {
-  REDRES_REQUIRE(r.size() == dim_ && r_dot.size() == dim_, "Path::evaluate", "r and r_dot have dim() entries");
+void Path::evaluate_3d(double t, Eigen::Vector3d& point, Eigen::Vector3d& velocity,
+                       Eigen::Vector3d* acceleration) const {
+  const bool outside = t < 0.0 || t > duration_;
   t = std::clamp(t, 0.0, duration_);
   double s = 0.0, speed = 0.0;  // arc length from the path start, and ds/dt
+  double s_ddot = 0.0;          // d^2 s / dt^2 (computed only when `acceleration` is asked for)
   if (scope_ == TimingScope::kWhole) {
-    double sigma = 0.0, dsigma = 0.0;
-    timing(law_, t / duration_, sigma, dsigma);
+    double sigma = 0.0, dsigma = 0.0, d2sigma = 0.0;
+    if (acceleration != nullptr) {
+      timing(law_, t / duration_, sigma, dsigma, d2sigma);
+      s_ddot = total_ * d2sigma / (duration_ * duration_);
+    } else {
+      timing(law_, t / duration_, sigma, dsigma);
+    }
     s = total_ * sigma;
     speed = total_ * dsigma / duration_;
   } else {
     // The stroke running at t (the last one whose start time is <= t).
     const auto it = std::upper_bound(stroke_t0_.begin(), stroke_t0_.end(), t);
     const auto k = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - stroke_t0_.begin()) - 1));
-    double sigma = 0.0, dsigma = 0.0;
-    timing(law_, (t - stroke_t0_[k]) / stroke_T_[k], sigma, dsigma);
+    double sigma = 0.0, dsigma = 0.0, d2sigma = 0.0;
+    if (acceleration != nullptr) {
+      timing(law_, (t - stroke_t0_[k]) / stroke_T_[k], sigma, dsigma, d2sigma);
+      s_ddot = stroke_length_[k] * d2sigma / (stroke_T_[k] * stroke_T_[k]);
+    } else {
+      timing(law_, (t - stroke_t0_[k]) / stroke_T_[k], sigma, dsigma);
+    }
     s = stroke_start_[k] + stroke_length_[k] * sigma;
     speed = stroke_length_[k] * dsigma / stroke_T_[k];
   }
   s = std::clamp(s, 0.0, total_);
   const auto it = std::upper_bound(seg_start_.begin(), seg_start_.end(), s);
   const auto j = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - seg_start_.begin()) - 1));
-  Eigen::Vector3d p, tangent;
-  segments_[j].at(std::min(s - seg_start_[j], segments_[j].length), p, tangent);
-  const Eigen::Vector3d world = origin_ + rotation_ * p;
-  const Eigen::Vector3d velocity = rotation_ * tangent * speed;
+  Eigen::Vector3d p, tangent, d2p;
+  segments_[j].at(std::min(s - seg_start_[j], segments_[j].length), p, tangent, d2p);
+  point = origin_ + rotation_ * p;
+  velocity = rotation_ * tangent * speed;
+  if (acceleration != nullptr) {
+    // d/dt (tangent(s) s') = tangent s'' + d^2p/ds^2 s'^2; held at an end point outside [0, T].
+    *acceleration =
+        outside ? Eigen::Vector3d::Zero() : Eigen::Vector3d(rotation_ * (tangent * s_ddot + d2p * (speed * speed)));
+  }
+}
+
+void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot) const {
+  REDRES_REQUIRE(r.size() == dim_ && r_dot.size() == dim_, "Path::evaluate", "r and r_dot have dim() entries");
+  Eigen::Vector3d world, velocity;
+  evaluate_3d(t, world, velocity, nullptr);
   for (int i = 0; i < dim_; ++i) {
     r(i) = world(i);
     r_dot(i) = velocity(i);
+  }
+}
+
+void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot,
+                    Eigen::Ref<Eigen::VectorXd> r_ddot) const {
+  REDRES_REQUIRE(r.size() == dim_ && r_dot.size() == dim_ && r_ddot.size() == dim_, "Path::evaluate",
+                 "r, r_dot and r_ddot have dim() entries");
+  Eigen::Vector3d world, velocity, acceleration;
+  evaluate_3d(t, world, velocity, &acceleration);
+  for (int i = 0; i < dim_; ++i) {
+    r(i) = world(i);
+    r_dot(i) = velocity(i);
+    r_ddot(i) = acceleration(i);
   }
 }
 

@@ -2,24 +2,34 @@
 
 #include <algorithm>
 #include <set>
+#include <stdexcept>
+#include <string_view>
 
 namespace redres {
 
 Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
-               std::vector<std::unique_ptr<Constraint>> constraints)
-    : robot_(&robot), objectives_(std::move(objectives)), constraints_(std::move(constraints)) {
+               std::vector<std::unique_ptr<Constraint>> constraints, SchemeLevel level)
+    : robot_(&robot), objectives_(std::move(objectives)), constraints_(std::move(constraints)), scheme_level_(level) {
   std::set<std::string> names;
+  const auto check_level = [level](const Plugin& p, const char* kind) {
+    if (!p.active() || p.supports(level)) return;
+    throw std::invalid_argument(std::string(kind) + " '" + p.name() + "' (type " + p.type() + ") does not work at the " +
+                                (level == SchemeLevel::kAcceleration ? "acceleration" : "velocity") +
+                                " level ([scheme] level); docs/motion.md lists the plugins that do");
+  };
   for (const auto& o : objectives_) {
     REDRES_REQUIRE(o != nullptr, "Scheme", "every objective is non-null");
     REDRES_REQUIRE(names.insert(o->name()).second, "Scheme",
                    "plugin names are unique (two are named '" + o->name() + "'; rename one with set_name())");
     level_ = std::max(level_, o->kinematics_level());
+    check_level(*o, "objective");
   }
   for (const auto& c : constraints_) {
     REDRES_REQUIRE(c != nullptr, "Scheme", "every constraint is non-null");
     REDRES_REQUIRE(names.insert(c->name()).second, "Scheme",
                    "plugin names are unique (two are named '" + c->name() + "'; rename one with set_name())");
     level_ = std::max(level_, c->kinematics_level());
+    check_level(*c, "constraint");
     const int e = c->equality_rows(robot);
     const int i = c->inequality_rows(robot);
     REDRES_REQUIRE(e >= 0 && i >= 0, "Scheme", "constraint '" + c->name() + "' declares non-negative row counts");
@@ -30,6 +40,8 @@ Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> 
     m_eq_ += e;
     m_in_ += i;
   }
+  // The acceleration level's task reads J_dot theta_dot = sum_i theta_dot_i dJ/dtheta_i theta_dot.
+  if (level == SchemeLevel::kAcceleration) level_ = std::max(level_, KinematicsLevel::kManipulability);
 }
 
 Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, double duration, double step) {
@@ -62,7 +74,35 @@ Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, doubl
     }
   }
   if (objectives.empty()) root.fail("expected at least one [[objectives]] entry (e.g. type = \"min_velocity_norm\")");
-  return Scheme(robot, std::move(objectives), std::move(constraints));
+  // The robot file's acceleration and jerk limits hold in every run: a scheme that lists no constraint for them gets
+  // one (docs/motion.md).
+  const auto listed = [&constraints](std::string_view type) {
+    return std::any_of(constraints.begin(), constraints.end(), [type](const auto& c) { return c->type() == type; });
+  };
+  const auto add_default = [&](const char* type) {
+    auto doc = std::make_shared<TomlFile>();
+    doc->path = root.file_ptr() ? root.file_ptr()->path : std::filesystem::path();
+    doc->root.insert("type", type);
+    auto c = make_constraint(TableReader::root(doc, "constraints"), robot);
+    c->set_source("the robot file's limits (added: the scenario lists no " + std::string(type) + ")");
+    if (names.insert(c->name()).second) constraints.push_back(std::move(c));
+  };
+  if (robot.has_acceleration_limits() && !listed("joint_acceleration_limits")) add_default("joint_acceleration_limits");
+  if (robot.has_jerk_limits() && !listed("joint_jerk_limits")) add_default("joint_jerk_limits");
+  SchemeLevel level = SchemeLevel::kVelocity;
+  if (root.has("scheme")) {
+    const TableReader t = root.table("scheme");
+    const TableReader scheme(t.file_ptr(), t.raw(), "scheme");
+    level = scheme.choice("level", {"velocity", "acceleration"}, "velocity") == "velocity" ? SchemeLevel::kVelocity
+                                                                                           : SchemeLevel::kAcceleration;
+    scheme.finish();
+    try {
+      return Scheme(robot, std::move(objectives), std::move(constraints), level);
+    } catch (const std::invalid_argument& e) {
+      scheme.fail("level", e.what());
+    }
+  }
+  return Scheme(robot, std::move(objectives), std::move(constraints), level);
 }
 
 SchemeData Scheme::make_data() const {

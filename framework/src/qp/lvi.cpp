@@ -20,6 +20,7 @@ const char* to_string(SolverStatus status) {
     case SolverStatus::kNotRun: return "not_run";
     case SolverStatus::kInvalidProblem: return "invalid_problem";
     case SolverStatus::kRelaxed: return "relaxed";
+    case SolverStatus::kBraked: return "braked";
   }
   return "unknown";
 }

@@ -137,6 +137,7 @@ const double* RowRecorder::write(int k, double t, const Eigen::VectorXd& theta, 
       case StepValue::kLawLower: put(vlo); break;
       case StepValue::kLawUpper: put(vhi); break;
       case StepValue::kStatus: row[c++] = static_cast<double>(static_cast<int>(out.info.status)); break;
+      case StepValue::kThetaDdot: put(out.theta_ddot); break;
     }
   }
   for (const Recorder& r : recorders_) r.output->record(r.data, row + r.first);

@@ -107,12 +107,20 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   out.max_joint_angle_violation = std::max(0.0, angle_viol);
   out.max_joint_velocity_violation = std::max(0.0, vel_viol);
   out.steps_with_active_bounds = active_steps;
+  out.max_joint_acceleration = run.max_joint_acceleration;
+  out.max_joint_jerk = run.max_joint_jerk;
+  out.max_joint_acceleration_violation = run.max_joint_acceleration_violation;
+  out.max_joint_jerk_violation = run.max_joint_jerk_violation;
+  out.steps_over_acceleration_limit = run.steps_over_acceleration_limit;
+  out.steps_over_jerk_limit = run.steps_over_jerk_limit;
   for (int j = 0; j < n; ++j) out.final_theta.push_back(tr(rows - 1, c_th[static_cast<std::size_t>(j)]));
   out.solver = {run.engine(), it_sum / static_cast<double>(rows), it_max, max_res, run.failures, run.first_failure,
                 run.stopped};
   out.solver.on_infeasible = s.on_infeasible == OnInfeasible::kStop    ? "stop"
                              : s.on_infeasible == OnInfeasible::kRelax ? "relax"
+                             : s.on_infeasible == OnInfeasible::kBrake ? "brake"
                                                                        : "hold";
+  out.solver.braked_steps = run.braked_steps;
   out.solver.held_steps = run.held_steps;
   out.solver.relaxed_steps = run.relaxed_steps;
   out.solver.max_relaxed_task_error = run.max_relaxed_task_error;
@@ -249,6 +257,24 @@ const std::vector<SummaryField>& summary_fields() {
       {"max_joint_velocity_violation", "number >= 0",
        "largest excursion of any theta_dot_i beyond its velocity law `vel_lo_i` or `vel_hi_i` (rad/s)",
        [](const S& s) { return SummaryValue(s.max_joint_velocity_violation); }},
+      {"max_joint_acceleration", "array of n numbers",
+       "per joint, the largest \\|acceleration\\| of the commands the arm was given, (applied_k - applied_{k-1}) / tau "
+       "(Heun's average counts; a held step's zero too) (rad/s^2)",
+       [](const S& s) { return SummaryValue(s.max_joint_acceleration); }},
+      {"max_joint_jerk", "array of n numbers", "per joint, the largest \\|jerk\\| of those commands (rad/s^3)",
+       [](const S& s) { return SummaryValue(s.max_joint_jerk); }},
+      {"max_joint_acceleration_violation", "array of n numbers >= 0, or empty",
+       "per joint, the largest excursion of that acceleration beyond the robot's `acceleration_limit` at the step's "
+       "theta (0 when never; empty when the robot gives none)",
+       [](const S& s) { return SummaryValue(s.max_joint_acceleration_violation); }},
+      {"max_joint_jerk_violation", "array of n numbers >= 0, or empty",
+       "the same against the robot's `jerk_limit`",
+       [](const S& s) { return SummaryValue(s.max_joint_jerk_violation); }},
+      {"steps_over_acceleration_limit", "integer",
+       "steps whose command leaves some joint's acceleration limit by more than 1e-9 (1 + \\|limit\\|)",
+       [](const S& s) { return count(s.steps_over_acceleration_limit); }},
+      {"steps_over_jerk_limit", "integer", "the same for the jerk limits",
+       [](const S& s) { return count(s.steps_over_jerk_limit); }},
       {"steps_with_active_bounds", "integer",
        "rows in which some theta_dot_i is at lo_i or hi_i, to within 1e-9 (1 + abs(bound))",
        [](const S& s) { return count(s.steps_with_active_bounds); }},
@@ -275,11 +301,15 @@ const std::vector<SummaryField>& summary_fields() {
        "the run ended at its first failed step (`[solver] on_infeasible = \"stop\"`): its last row is that step's, "
        "before T",
        [](const S& s) { return SummaryValue(s.solver.stopped); }},
-      {"solver.on_infeasible", "string", "the policy: `\"hold\"`, `\"stop\"` or `\"relax\"`",
+      {"solver.on_infeasible", "string", "the policy: `\"hold\"`, `\"stop\"`, `\"relax\"` or `\"brake\"`",
        [](const S& s) { return text(s.solver.on_infeasible); }},
       {"solver.held_steps", "integer",
        "failed steps held with theta_dot = 0 (the rows whose `solver_status` is neither 0 nor 6, before T)",
        [](const S& s) { return count(s.solver.held_steps); }},
+      {"solver.braked_steps", "integer",
+       "failed steps that braked (`solver_status` 7): the arm decelerated within its acceleration limits; counted in "
+       "`solver.failures`",
+       [](const S& s) { return count(s.solver.braked_steps); }},
       {"solver.relaxed_steps", "integer",
        "steps solved with the rows relaxed (`solver_status` 6); they are not failures",
        [](const S& s) { return count(s.solver.relaxed_steps); }},

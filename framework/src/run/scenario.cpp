@@ -19,24 +19,32 @@ namespace {
 
 // The [solver] table's keys that are the run's, not the engine's: what a failed step does. Read through a schema,
 // like the engine's keys, so that `redres plugins` lists them with their defaults and rules.
-enum class Policy { kHold, kStop, kRelax, kContinue };
+enum class Policy { kHold, kStop, kRelax, kContinue, kBrake };
 auto enum_names(Policy) {
   return std::array{
       std::pair{Policy::kHold, std::string_view("hold")}, std::pair{Policy::kStop, std::string_view("stop")},
-      std::pair{Policy::kRelax, std::string_view("relax")}, std::pair{Policy::kContinue, std::string_view("continue")}};
+      std::pair{Policy::kRelax, std::string_view("relax")}, std::pair{Policy::kContinue, std::string_view("continue")},
+      std::pair{Policy::kBrake, std::string_view("brake")}};
 }
 struct SolverPolicy {
   Policy on_infeasible = Policy::kHold;
   double relax_weight = 1e4;
+  double recover_error = 1e-3;
   double max_task_error = 0.01;
   static const Schema<SolverPolicy>& schema() {
     using C = SolverPolicy;
     static const Schema<C> s{
         {field("on_infeasible", &C::on_infeasible, "",
                "what a step whose QP is not solved does: hold (theta_dot = 0; `continue` is the same), stop (the run "
-               "ends there), relax (solves the elastic QP, rows relaxed, every bound kept)"),
-         field("relax_weight", &C::relax_weight, "", "rho of the elastic QP; only with on_infeasible = \"relax\"",
+               "ends there), relax (solves the elastic QP, rows relaxed, every bound kept), brake (decelerates within "
+               "the acceleration limits, then catches up; docs/motion.md). Default: brake for a robot with "
+               "acceleration limits (which refuses hold), else hold"),
+         field("relax_weight", &C::relax_weight, "",
+               "rho of the elastic QP; only with on_infeasible = \"relax\" or \"brake\"",
                rule<double>("a weight in [1, 1e8]", [](double w) { return w >= 1.0 && w <= 1e8; })),
+         field("recover_error", &C::recover_error, "m",
+               "under brake, a failed step tries the elastic QP first while the position error exceeds this",
+               greater(0.0)),
          field("max_task_error", &C::max_task_error, "m",
                "a run whose largest position error exceeds this is not a success (exit code 1, summary.json's "
                "task_error_exceeded), however many of its steps were solved",
@@ -241,6 +249,11 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                  Scenario& s = c.s;
                  // Reads `constraints` too: one scheme holds both.
                  s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot, s.duration, s.tau));
+                 if (s.scheme->level() == SchemeLevel::kAcceleration && s.integrator == Integrator::kHeun) {
+                   r.fail("integrator", "an acceleration-level scheme ([scheme] level = \"acceleration\") integrates "
+                                        "its own way (constant acceleration over each step, exact); leave "
+                                        "`integrator` out or set it to \"euler\"");
+                 }
                  const std::size_t width = trajectory_width(s);
                  if (const double bytes = (s.steps() + 1.0) * static_cast<double>(width) * 8.0;
                      bytes > kMaxTableBytes) {
@@ -255,10 +268,15 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
       entry<C>("constraints", "array of tables [[constraints]]", "", "none",
                "the hard constraints; their keys are their type's (redres plugins)",
                [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
+      entry<C>("scheme", "table [scheme]", "", "level = \"velocity\"",
+               "`level`: \"velocity\" (x = theta_dot, the paper's) or \"acceleration\" (x = theta_ddot; docs/motion.md)",
+               [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
       entry<C>("solver", "table", "", "engine = \"projection\"",
                "the LVI engine and its settings (redres plugins), and what a step that is not solved does",
                [](const TableReader& r, C& c) {
                  Scenario& s = c.s;
+                 const bool limits = s.robot->has_acceleration_limits();
+                 s.on_infeasible = limits ? OnInfeasible::kBrake : OnInfeasible::kHold;
                  if (!r.has("solver")) {
                    s.engine = make_engine("projection");
                    return;
@@ -267,14 +285,39 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                  const TableReader solver(t.file_ptr(), t.raw(), "solver");
                  SolverPolicy policy;
                  read_config(solver, SolverPolicy::schema(), policy);
-                 s.on_infeasible = policy.on_infeasible == Policy::kStop    ? OnInfeasible::kStop
-                                   : policy.on_infeasible == Policy::kRelax ? OnInfeasible::kRelax
-                                                                            : OnInfeasible::kHold;
+                 if (solver.has("on_infeasible")) {
+                   s.on_infeasible = policy.on_infeasible == Policy::kStop    ? OnInfeasible::kStop
+                                     : policy.on_infeasible == Policy::kRelax ? OnInfeasible::kRelax
+                                     : policy.on_infeasible == Policy::kBrake ? OnInfeasible::kBrake
+                                                                              : OnInfeasible::kHold;
+                 }
                  s.relax_weight = policy.relax_weight;
+                 s.recover_error = policy.recover_error;
                  s.max_task_error = policy.max_task_error;
-                 if (solver.has("relax_weight") && s.on_infeasible != OnInfeasible::kRelax) {
-                   solver.fail("relax_weight", "is used only with on_infeasible = \"relax\" (on_infeasible is \"" +
-                                                   std::string(solver.string("on_infeasible", "hold")) + "\")");
+                 const std::string chosen = solver.has("on_infeasible")
+                                                ? std::string(solver.string("on_infeasible"))
+                                                : std::string(limits ? "brake" : "hold") + "\", the default";
+                 if (s.on_infeasible == OnInfeasible::kHold && limits) {
+                   solver.fail("on_infeasible", "\"" + chosen +
+                                                    "\" stops every joint at once, a velocity jump that robot '" +
+                                                    s.robot->name() +
+                                                    "''s acceleration limits forbid; use \"brake\" (the default for "
+                                                    "it), \"relax\" or \"stop\"");
+                 }
+                 if (s.on_infeasible == OnInfeasible::kBrake && !limits) {
+                   solver.fail("on_infeasible", "\"brake\" decelerates within the joints' acceleration limits, and "
+                                                "robot '" + s.robot->name() +
+                                                    "' gives none on some joint (`acceleration_limit` in the robot "
+                                                    "file's [[joints]])");
+                 }
+                 if (solver.has("relax_weight") && s.on_infeasible != OnInfeasible::kRelax &&
+                     s.on_infeasible != OnInfeasible::kBrake) {
+                   solver.fail("relax_weight", "is used only with on_infeasible = \"relax\" or \"brake\" "
+                                               "(on_infeasible is \"" + chosen + "\")");
+                 }
+                 if (solver.has("recover_error") && s.on_infeasible != OnInfeasible::kBrake) {
+                   solver.fail("recover_error",
+                               "is used only with on_infeasible = \"brake\" (on_infeasible is \"" + chosen + "\")");
                  }
                  s.engine = make_engine(solver);
                }),

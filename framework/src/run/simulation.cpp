@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "run/recording.hpp"
 
@@ -27,15 +28,25 @@ RunResult simulate(Scenario& s, const ProgressCallback& progress) {
 namespace {
 
 // Integrates one step from theta at t with the step's solution `out`: Euler's method, or Heun's (one more QP, at the
-// Euler prediction, into `out2`). A failed step moves nothing. Returns false when the run must stop (a failed second
-// stage under on_infeasible = "stop").
+// Euler prediction, into `out2`); at the acceleration level the step's constant acceleration exactly. `velocity` is
+// the command applied over the previous step on entry and this step's on return (zero for a held step). A held step moves nothing; a braked step moves with its braking
+// command (Euler's step: no second stage). Returns false when the run must stop (a failed second stage under
+// on_infeasible = "stop").
 bool integrate(const Scenario& s, Controller& ctrl, StepLog& log, RunResult& run, double t, const StepOutput& out,
-               StepOutput& out2, Eigen::VectorXd& theta, Eigen::VectorXd& theta_pred) {
-  if (!usable(out.info.status)) {
+               StepOutput& out2, Eigen::VectorXd& theta, Eigen::VectorXd& theta_pred, Eigen::VectorXd& velocity) {
+  if (!moves(out.info.status)) {
     ++run.held_steps;  // theta_dot = 0 (the controller never hands out an unconverged iterate): theta stays
+    velocity.setZero();
     return true;
   }
-  if (s.integrator == Integrator::kEuler) {
+  if (out.info.status == SolverStatus::kBraked) ++run.braked_steps;
+  if (s.scheme->level() == SchemeLevel::kAcceleration) {
+    theta += (0.5 * s.tau) * (velocity + out.theta_dot);  // (v + v') / 2 over the step: exact for its acceleration
+    velocity = out.theta_dot;
+    return true;
+  }
+  velocity = out.theta_dot;  // the command applied over the step (Heun's average below replaces it)
+  if (s.integrator == Integrator::kEuler || out.info.status == SolverStatus::kBraked) {
     theta += s.tau * out.theta_dot;
     return true;
   }
@@ -49,15 +60,74 @@ bool integrate(const Scenario& s, Controller& ctrl, StepLog& log, RunResult& run
     run.stopped = true;
     return false;
   }
-  if (usable(out2.info.status)) {
+  if (usable(out2.info.status)) {  // a braked second stage is not averaged in
     theta += 0.5 * s.tau * (out.theta_dot + out2.theta_dot);
-    theta_pred = 0.5 * (out.theta_dot + out2.theta_dot);  // the command applied: the next step's theta_dot_prev
-    ctrl.set_applied(theta_pred);
+    velocity = 0.5 * (out.theta_dot + out2.theta_dot);  // the command applied: the next step's theta_dot_prev
+    ctrl.set_applied(velocity);
   } else {
     theta += s.tau * out.theta_dot;  // the second stage failed: Euler's step with the first, which solved
   }
   return true;
 }
+
+// The motion the arm is asked for (RunResult's max_joint_acceleration ... steps_over_jerk_limit), from the commands
+// applied step after step. Sized at setup; add() allocates nothing.
+class MotionStats {
+ public:
+  MotionStats(const RobotModel& robot, RunResult& run)
+      : robot_(robot),
+        prev_(Eigen::VectorXd::Zero(robot.dof())),
+        acc_(Eigen::VectorXd::Zero(robot.dof())),
+        acc_prev_(Eigen::VectorXd::Zero(robot.dof())),
+        lo_(robot.dof()),
+        hi_(robot.dof()) {
+    const auto n = static_cast<std::size_t>(robot.dof());
+    run.max_joint_acceleration.assign(n, 0.0);
+    run.max_joint_jerk.assign(n, 0.0);
+    if (robot.has_acceleration_limits()) run.max_joint_acceleration_violation.assign(n, 0.0);
+    if (robot.has_jerk_limits()) run.max_joint_jerk_violation.assign(n, 0.0);
+  }
+
+  // `applied` is the command the arm followed over a step that started at theta.
+  void add(const Eigen::VectorXd& applied, const Eigen::VectorXd& theta, double tau, RunResult& run) {
+    const int n = robot_.dof();
+    acc_ = (applied - prev_) / tau;
+    for (int j = 0; j < n; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      run.max_joint_acceleration[k] = std::max(run.max_joint_acceleration[k], std::abs(acc_(j)));
+      run.max_joint_jerk[k] = std::max(run.max_joint_jerk[k], std::abs((acc_(j) - acc_prev_(j)) / tau));
+    }
+    if (!run.max_joint_acceleration_violation.empty()) {
+      robot_.acceleration_limits(theta, lo_, hi_);
+      if (over(acc_, run.max_joint_acceleration_violation)) ++run.steps_over_acceleration_limit;
+    }
+    if (!run.max_joint_jerk_violation.empty()) {
+      robot_.jerk_limits(theta, lo_, hi_);
+      acc_prev_ = (acc_ - acc_prev_) / tau;  // the jerk, in acc_prev_'s storage for the moment
+      if (over(acc_prev_, run.max_joint_jerk_violation)) ++run.steps_over_jerk_limit;
+    }
+    acc_prev_ = acc_;
+    prev_ = applied;
+  }
+
+ private:
+  // Whether some joint of `value` leaves [lo_, hi_] by more than 1e-9 (1 + |limit|); the largest excursions into
+  // `worst`.
+  bool over(const Eigen::VectorXd& value, std::vector<double>& worst) const {
+    bool any = false;
+    for (Eigen::Index j = 0; j < value.size(); ++j) {
+      const double up = value(j) - hi_(j), down = lo_(j) - value(j);
+      const double excess = std::max({0.0, up, down});
+      auto& w = worst[static_cast<std::size_t>(j)];
+      w = std::max(w, excess);
+      any = any || up > 1e-9 * (1.0 + std::abs(hi_(j))) || down > 1e-9 * (1.0 + std::abs(lo_(j)));
+    }
+    return any;
+  }
+
+  const RobotModel& robot_;
+  Eigen::VectorXd prev_, acc_, acc_prev_, lo_, hi_;
+};
 
 }  // namespace
 
@@ -82,9 +152,11 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
   RowRecorder rows(s, ctrl, std::move(recorders), run.trajectory.width());
   StepLog log(run, *s.scheme, ctrl.plugin_data());
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
-  Eigen::VectorXd theta = s.theta0, theta_pred(s.robot->dof());
+  Eigen::VectorXd theta = s.theta0, theta_pred(s.robot->dof()), velocity = Eigen::VectorXd::Zero(s.robot->dof());
   const auto start = std::chrono::steady_clock::now();
   const int report_every = std::max(1, steps / 200);
+  MotionStats motion(*s.robot, run);
+  Eigen::VectorXd theta_start(s.robot->dof());
 
   for (int k = 0; k <= steps; ++k) {
     const double t = k == steps ? s.duration : k * s.tau;
@@ -103,7 +175,9 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
       run.stopped = true;  // the row of the failed step is the last
       break;
     }
-    if (!integrate(s, ctrl, log, run, t, out, out2, theta, theta_pred)) break;
+    theta_start = theta;
+    if (!integrate(s, ctrl, log, run, t, out, out2, theta, theta_pred, velocity)) break;
+    motion.add(velocity, theta_start, s.tau, run);
   }
   run.trajectory.publish();
   run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -9,6 +9,10 @@
 
 namespace redres {
 
+/// What a scheme's QP solves for ([scheme] level; docs/motion.md): x = theta_dot (the paper's velocity level) or
+/// x = theta_ddot (the acceleration level: theta_dot and theta are integrated from x).
+enum class SchemeLevel { kVelocity, kAcceleration };
+
 /// Everything a plugin may read at one control step. New inputs are added here, never to plugin signatures.
 struct Context {
   double t = 0.0;                              //!< time since the start of the task (s)
@@ -18,6 +22,13 @@ struct Context {
   const KinematicsData* kinematics = nullptr;  //!< kinematics at theta (f, J, dJ, w, grad w, ...)
   const Eigen::VectorXd* r_d = nullptr;        //!< desired task coordinates r_d(t) (m_task)
   const Eigen::VectorXd* r_d_dot = nullptr;    //!< desired task velocity r_d_dot(t) (m_task)
+  /// Desired task acceleration r_d_ddot(t) (m_task): set at the acceleration level; null at the velocity level.
+  const Eigen::VectorXd* r_d_ddot = nullptr;
+  /// What x is: theta_dot (velocity level) or theta_ddot (acceleration level).
+  SchemeLevel level = SchemeLevel::kVelocity;
+  /// The joint velocity at this step (n) at the acceleration level: the measured one when the caller passed it, else
+  /// the previous step's command (theta_dot_prev). Null at the velocity level.
+  const Eigen::VectorXd* theta_dot = nullptr;
   /// The robot's velocity-limit laws at theta (n each), evaluated once per step by the Controller; null where a
   /// caller builds a Context without them (plugins then evaluate the laws themselves).
   const Eigen::VectorXd* velocity_lower = nullptr;
@@ -39,6 +50,11 @@ struct Context {
 
   /// Joint positions theta (n).
   [[nodiscard]] const Eigen::VectorXd& theta() const { return kinematics->theta; }
+  /// Bounds lo <= v' <= hi on the joint velocity v' after this step, as bounds on x: (lo - theta_dot) / tau at the
+  /// acceleration level, lo itself at the velocity level. For plugins that bound velocities at either level.
+  [[nodiscard]] double velocity_to_x(double v_next, int j) const {
+    return level == SchemeLevel::kVelocity ? v_next : (v_next - (*theta_dot)(j)) / tau;
+  }
   /// Whether this step starts a run (no previous command yet).
   [[nodiscard]] bool first_step() const noexcept { return step_index == 0; }
 };

@@ -22,14 +22,29 @@ namespace redres {
 /// (e.g. the two stages of Heun's method) never alias. Make one with Controller::make_output() (sized once);
 /// step() then reuses its buffers without allocating (the diagnosis text of a failed step excepted).
 struct StepOutput {
-  Eigen::VectorXd theta_dot;    //!< x = theta_dot (n), inside the merged bounds; zero when the step failed (the
-                                //!< unconverged iterate is never handed out: Controller::result() keeps it)
+  /// The velocity command (n): at the velocity level the QP's x, inside the merged bounds; at the acceleration level
+  /// theta_dot + tau x. A braked step's braking command; zero when the step held (the unconverged iterate is never
+  /// handed out: Controller::result() keeps it).
+  Eigen::VectorXd theta_dot;
+  /// The commanded acceleration (n): at the acceleration level the QP's x; at the velocity level (theta_dot -
+  /// theta_dot_prev) / tau. What the robot's acceleration limits bound.
+  Eigen::VectorXd theta_ddot;
   SolverInfo info;              //!< status, iterations, residual, engine, diagnosis
   double task_row_error = 0.0;  //!< for a `relaxed` step, max_r |J_r theta_dot - d_r|: how far the equality rows
                                 //!< are missed (0 for every other status)
 };
 
 struct Scenario;
+
+/// What a step whose QP is not solved does (docs/motion.md has the table):
+/// - kHold: theta_dot = 0, at once. Refused for a robot with acceleration limits (a velocity jump).
+/// - kRelax: solves the elastic QP (rows relaxed into a weighted penalty, every bound kept); when that fails too,
+///   brakes (a robot with acceleration limits) or holds.
+/// - kBrake (needs acceleration limits on every joint): decelerates every joint along the previous command within
+///   its acceleration (and jerk) limits. While the task's position error exceeds the recovery bound (a step after
+///   braking falls behind its moving target) the elastic QP is tried first, so that the arm catches up within its
+///   limits instead of braking again; once the error is back under the bound a failed step brakes.
+enum class FailurePolicy { kHold, kRelax, kBrake };
 
 /// Runs the scheme for one robot. The robot, scheme, engine and path must outlive the controller.
 class Controller {
@@ -60,6 +75,11 @@ class Controller {
   /// Context::theta_dot_measured during this step.
   void step(const Eigen::Ref<const Eigen::VectorXd>& theta, const Eigen::Ref<const Eigen::VectorXd>& theta_dot_measured,
             double t, StepOutput& out);
+  /// Steps with caller-supplied r_d, r_d_dot and r_d_ddot (size reference_dim() each): the acceleration level's
+  /// form (at the velocity level r_d_ddot is not read).
+  void step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, const Eigen::Ref<const Eigen::VectorXd>& r_d,
+            const Eigen::Ref<const Eigen::VectorXd>& r_d_dot, const Eigen::Ref<const Eigen::VectorXd>& r_d_ddot,
+            StepOutput& out);
   /// Solves this step again at another state (Heun's second stage, at the Euler prediction): the plugins see the same
   /// previous command as the step's first solve, and the step's command stays the first solve's unless
   /// set_applied() says otherwise.
@@ -92,6 +112,12 @@ class Controller {
   /// how much the rows are missed; when it does not, the step holds with the first failure's status. weight = 0
   /// turns relaxation off. Allocates (a second engine of the same type and its QP): call it before the loop.
   void set_relaxation(double weight);
+  /// The failure policy (FailurePolicy), with the elastic QP's weight (> 0; used by kRelax and kBrake) and the
+  /// position error (m, > 0) above which kBrake tries the elastic QP first. Throws std::invalid_argument for kBrake
+  /// or kHold on a robot that has (kHold) or lacks (kBrake) acceleration limits on every joint. The default is kBrake
+  /// for a robot with acceleration limits, else kHold. Allocates: call it before the loop.
+  void set_failure_policy(FailurePolicy policy, double relax_weight = 1e4, double recover_error = 1e-3);
+  [[nodiscard]] FailurePolicy failure_policy() const noexcept { return policy_; }
   /// Forgets the engine's warm start and a captured (not an explicitly set) orientation reference.
   void reset();
 
@@ -100,6 +126,10 @@ class Controller {
   [[nodiscard]] const QpProblem& qp() const noexcept { return qp_; }
   [[nodiscard]] const Eigen::VectorXd& r_d() const noexcept { return r_d_; }
   [[nodiscard]] const Eigen::VectorXd& r_d_dot() const noexcept { return r_d_dot_; }
+  /// The last step's desired task acceleration (acceleration level; zeros at the velocity level).
+  [[nodiscard]] const Eigen::VectorXd& r_d_ddot() const noexcept { return r_d_ddot_; }
+  /// The previous step's command as this step's plugins saw it (Context::theta_dot_prev).
+  [[nodiscard]] const Eigen::VectorXd& theta_dot_prev() const noexcept { return prev_; }
   /// The velocity-limit laws at the last step's theta (n each).
   [[nodiscard]] const Eigen::VectorXd& velocity_lower() const noexcept { return vlo_; }
   [[nodiscard]] const Eigen::VectorXd& velocity_upper() const noexcept { return vhi_; }
@@ -119,7 +149,12 @@ class Controller {
   void solve(double t, StepOutput& out);
   void begin_step();                     // the previous step's command becomes theta_dot_prev
   void end_step(const StepOutput& out);  // this step's command and status, for the next
-  void relax(StepOutput& out);
+  bool relax(StepOutput& out);   // the elastic QP; false when it fails too
+  void brake(StepOutput& out);   // the braking command
+  void apply(const Eigen::VectorXd& x, StepOutput& out);  // x (the QP's) into theta_dot and theta_ddot
+  [[nodiscard]] const Eigen::VectorXd& base() const noexcept {  // the velocity before this step
+    return ctx_.level == SchemeLevel::kVelocity ? prev_ : v_;
+  }
 
   const RobotModel* robot_;
   const Scheme* scheme_;
@@ -129,7 +164,7 @@ class Controller {
   KinematicsData kin_;
   QpProblem qp_;
   SolverResult result_;
-  Eigen::VectorXd r_d_, r_d_dot_;
+  Eigen::VectorXd r_d_, r_d_dot_, r_d_ddot_;
   Eigen::VectorXd vlo_, vhi_;         // the velocity-limit laws at theta, once per step
   OrientationReference orientation_;  // the orientation rows of r_d and r_d_dot under a path
   KinematicsLevel level_ = KinematicsLevel::kPosition;
@@ -142,6 +177,10 @@ class Controller {
   bool have_pending_ = false;                // a step was made whose command is not yet theta_dot_prev
   bool started_ = false;                     // the plugins were told that the run starts
   Eigen::VectorXd row_miss_;                 // J x - d of a relaxed step
+  Eigen::VectorXd v_;                        // acceleration level: the joint velocity at this step
+  Eigen::VectorXd lim_lo_, lim_hi_;          // acceleration (then jerk) limits at theta, for braking
+  FailurePolicy policy_ = FailurePolicy::kHold;
+  double recover_error_ = 1e-3;              // kBrake: the position error above which the elastic QP goes first
   std::unique_ptr<LviEngine> relax_engine_;  // an engine like *engine_ for the elastic QP
   ElasticQp relaxed_;                        // the elastic QP (no equality rows)
   SolverResult relaxed_result_;

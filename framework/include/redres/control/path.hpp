@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// Desired end-effector paths r_d(t), r_d_dot(t) on [0, T] (position rows only: 2 for planar tasks, 3 for
-/// spatial ones). A path is geometry (lines, arcs, helices, grouped into strokes) plus a timing law:
+/// Desired end-effector paths r_d(t), r_d_dot(t) and r_d_ddot(t) on [0, T] (position rows only: 2 for planar tasks,
+/// 3 for spatial ones); all three are analytic. A path is geometry (lines, arcs, helices, grouped into strokes) plus a
+/// timing law:
 ///
 /// - timing laws sigma(u), u in [0, 1], sigma(0) = 0, sigma(1) = 1 (the share of arc length covered):
 ///   `cycloidal` u - sin(2 pi u) / (2 pi); `sin2` sin^2(pi u / 2) (the 2 pi sin^2(pi t / 2T) style law);
@@ -54,6 +55,9 @@ struct PathSegment {
                          const Eigen::Vector3d& e2 = Eigen::Vector3d::UnitY());
   /// Point and unit tangent at arc length s in [0, length].
   void at(double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent) const;
+  /// Point, unit tangent and d^2 point / ds^2 (the curvature vector: zero on a line, towards the axis on an arc or
+  /// a helix) at arc length s in [0, length]; point and tangent are bit-identical to the overload above.
+  void at(double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent, Eigen::Vector3d& d2point) const;
   /// Start and end points.
   [[nodiscard]] Eigen::Vector3d start() const;
   [[nodiscard]] Eigen::Vector3d end() const;
@@ -95,8 +99,12 @@ struct PathGeometry {
 /// to rest.
 [[nodiscard]] PathGeometry strokes_from(std::vector<PathSegment> segments, bool stroke_each);
 
-/// sigma(u) and d sigma / du for u in [0, 1].
+/// sigma(u) and d sigma / du for u in [0, 1] (u is clamped to it).
 void timing(TimingLaw law, double u, double& sigma, double& dsigma);
+/// sigma(u), d sigma / du and d^2 sigma / du^2 for u in [0, 1] (u is clamped to it); sigma and dsigma are
+/// bit-identical to the overload above. sin2's d2sigma is pi^2/2 at u = 0 and -pi^2/2 at u = 1 (it starts and stops
+/// with a jump in acceleration); cycloidal's and quintic's are zero there.
+void timing(TimingLaw law, double u, double& sigma, double& dsigma, double& d2sigma);
 
 /// A desired end-effector path on [0, T]. Immutable; evaluate() is allocation-free.
 class Path {
@@ -108,6 +116,13 @@ class Path {
 
   /// r_d(t) and r_d_dot(t) (size dim); t is clamped to [0, T].
   void evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot) const;
+  /// r_d(t), r_d_dot(t) and r_d_ddot(t) (size dim); r and r_dot are bit-identical to the overload above. On [0, T]
+  /// r_ddot = R (tangent s'' + d^2p/ds^2 s'^2), s the arc length, R the placement rotation; at a time where it jumps
+  /// (a segment joint, where the curvature changes; a stroke boundary under sin2 timing) it is the value of the
+  /// piece that starts there (t = T: of the piece that ends there). Outside [0, T] the path is held at its end
+  /// point with r_dot at its end value (zero), so r_ddot is zero there.
+  void evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot,
+                Eigen::Ref<Eigen::VectorXd> r_ddot) const;
   /// Rows it provides (2 or 3).
   [[nodiscard]] int dim() const noexcept { return dim_; }
   /// Duration T (s).
@@ -133,6 +148,9 @@ class Path {
   Eigen::Matrix3d rotation_;
   Eigen::Vector3d origin_;
   std::string description_{};
+
+  // The placed point, velocity and (when `acceleration` is not null) acceleration at t, in 3-D.
+  void evaluate_3d(double t, Eigen::Vector3d& point, Eigen::Vector3d& velocity, Eigen::Vector3d* acceleration) const;
 };
 
 /// What a path plugin receives besides its Config.

@@ -74,6 +74,9 @@ class Plugin {
   /// Inactive plugins are built but contribute nothing.
   [[nodiscard]] bool active() const noexcept { return active_; }
   void set_active(bool active) noexcept { active_ = active; }
+  /// Whether this plugin works at a scheme level (Context::level). Default: the velocity level only; a plugin that
+  /// also serves the acceleration level reads Context::level and writes its terms for x = theta_ddot there.
+  [[nodiscard]] virtual bool supports(SchemeLevel level) const { return level == SchemeLevel::kVelocity; }
   /// The kinematics this plugin reads.
   [[nodiscard]] virtual KinematicsLevel kinematics_level() const { return KinematicsLevel::kPosition; }
   /// The full configuration (type, common keys and the plugin's own), readable by the same registry.

@@ -21,10 +21,14 @@ struct SchemeData {
 class Scheme {
  public:
   /// Takes ownership of the plugins; sizes follow from the robot and the constraints' row counts.
+  /// Throws std::invalid_argument when an active plugin does not work at `level` (Plugin::supports).
   Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
-         std::vector<std::unique_ptr<Constraint>> constraints);
+         std::vector<std::unique_ptr<Constraint>> constraints, SchemeLevel level = SchemeLevel::kVelocity);
 
-  /// Reads `[[objectives]]` and `[[constraints]]` arrays of tables from `root`. Each plugin's source() is its
+  /// Reads `[[objectives]]` and `[[constraints]]` arrays of tables from `root`, and the `[scheme]` table's `level`.
+  /// When the robot file gives every joint an acceleration (jerk) limit and no constraint of type
+  /// `joint_acceleration_limits` (`joint_jerk_limits`) is listed, one is added with its defaults, so that the robot's
+  /// limits hold in every run (list one with `active = false` to run without). Each plugin's source() is its
   /// table's file:line:col. With `duration` and `step` (> 0), each plugin's check_run(duration, step) runs too, and
   /// its FieldError is a ConfigError at the key.
   static Scheme from_toml(const TableReader& root, const RobotModel& robot, double duration = 0.0, double step = 0.0);
@@ -45,6 +49,8 @@ class Scheme {
 
   /// The deepest kinematics any plugin reads.
   [[nodiscard]] KinematicsLevel kinematics_level() const noexcept { return level_; }
+  /// What the QP's x is: theta_dot or theta_ddot.
+  [[nodiscard]] SchemeLevel level() const noexcept { return scheme_level_; }
   /// Total equality and inequality rows.
   [[nodiscard]] int equality_rows() const noexcept { return m_eq_; }
   [[nodiscard]] int inequality_rows() const noexcept { return m_in_; }
@@ -61,6 +67,7 @@ class Scheme {
   std::vector<int> eq_offset_, eq_rows_, in_offset_, in_rows_;
   int m_eq_ = 0, m_in_ = 0;
   KinematicsLevel level_ = KinematicsLevel::kPosition;
+  SchemeLevel scheme_level_ = SchemeLevel::kVelocity;
   // Clears qp and lets every plugin write (checked: through contribute(), which throws naming a culprit); returns
   // whether a plugin wrote off W's diagonal.
   bool contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked) const;

@@ -16,6 +16,9 @@ enum class SolverStatus {
   kRelaxed,         //!< the QP failed, and the elastic QP with the equality rows relaxed into a weighted penalty
                     //!< was solved instead (Controller::set_relaxation); the diagnosis says why and by how much
                     //!< the rows are missed
+  kBraked,          //!< the QP (and the elastic QP, where it was tried) failed, and the step decelerated every joint
+                    //!< along the previous command within its acceleration (and jerk) limits instead of stopping at
+                    //!< once (Controller::set_braking; docs/motion.md); a failed step, but the arm moves
 };
 
 /// Whether a step with this status has a usable theta_dot: solved, or solved with the rows relaxed.
@@ -23,7 +26,12 @@ enum class SolverStatus {
   return status == SolverStatus::kSolved || status == SolverStatus::kRelaxed;
 }
 
-/// "solved", "max_iterations", "infeasible", "numerical_error", "not_run", "invalid_problem", "relaxed".
+/// Whether a step with this status moves the arm: usable(), or braked (its theta_dot is the braking command).
+[[nodiscard]] constexpr bool moves(SolverStatus status) noexcept {
+  return usable(status) || status == SolverStatus::kBraked;
+}
+
+/// "solved", "max_iterations", "infeasible", "numerical_error", "not_run", "invalid_problem", "relaxed", "braked".
 [[nodiscard]] const char* to_string(SolverStatus status);
 
 }  // namespace redres

@@ -33,6 +33,7 @@ struct SolverStats {
   std::string on_infeasible;            //!< the policy: "hold", "stop" or "relax"
   int held_steps = 0;                   //!< failed steps held with theta_dot = 0
   int relaxed_steps = 0;                //!< steps solved with the rows relaxed ("relax")
+  int braked_steps = 0;                 //!< failed steps that braked ("brake", or "relax" where the elastic QP failed)
   double max_relaxed_task_error = 0.0;  //!< the largest max_r |J_r theta_dot - d_r| of a relaxed step
   std::string first_relaxed;            //!< "t = ...: <diagnosis>" of the first relaxed step, or empty
 };
@@ -87,6 +88,11 @@ struct RunSummary {
   double max_joint_angle_violation = 0.0;     //!< how far any theta left its limits (0 when never)
   double max_joint_velocity_violation = 0.0;  //!< how far any theta_dot left its velocity law (0 when never)
   long steps_with_active_bounds = 0;          //!< steps where some theta_dot sits on a merged bound
+  /// Per joint, over the applied commands (RunResult's): the largest |acceleration| and |jerk|, and the largest
+  /// excursion beyond the robot's acceleration and jerk limits (empty where it gives none), with the steps over.
+  std::vector<double> max_joint_acceleration, max_joint_jerk;
+  std::vector<double> max_joint_acceleration_violation, max_joint_jerk_violation;
+  int steps_over_acceleration_limit = 0, steps_over_jerk_limit = 0;
   std::vector<double> final_theta;            //!< theta(T)
   SolverStats solver;
   double wall_time_s = 0.0;  //!< time spent in the loop (s)

@@ -37,8 +37,13 @@ enum class Integrator { kEuler, kHeun };
 /// - kStop ("stop"): the run ends there, with every row up to that step;
 /// - kRelax ("relax"): the step solves the elastic QP (Controller::set_relaxation) with [solver] relax_weight; it
 ///   holds only when that fails too.
-/// A failed step never integrates the engine's unconverged iterate.
-enum class OnInfeasible { kHold, kStop, kRelax };
+/// - kBrake ("brake", the default for a robot with acceleration limits on every joint): the step decelerates every
+///   joint along the previous command within its acceleration (and jerk) limits (Controller FailurePolicy::kBrake),
+///   and a run that falls behind catches up through the elastic QP while its position error exceeds [solver]
+///   recover_error.
+/// A failed step never integrates the engine's unconverged iterate. A robot with acceleration limits refuses "hold"
+/// (a velocity jump), and under "relax" brakes where the elastic QP fails too.
+enum class OnInfeasible { kHold, kStop, kRelax, kBrake };
 
 /// A loaded scenario. Owns everything a run needs.
 struct Scenario {
@@ -56,7 +61,8 @@ struct Scenario {
   /// through over the run, from the orientation it has at t = 0 (Controller::set_orientation_turn); zero: hold it.
   Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();
   OnInfeasible on_infeasible = OnInfeasible::kHold;  //!< [solver] on_infeasible: "hold", "stop" or "relax"
-  double relax_weight = 1e4;     //!< [solver] relax_weight: rho of the elastic QP under "relax" (1 to 1e8)
+  double relax_weight = 1e4;     //!< [solver] relax_weight: rho of the elastic QP under "relax" and "brake" (1 to 1e8)
+  double recover_error = 1e-3;   //!< [solver] recover_error (m): under "brake", the elastic QP goes first above it
   double max_task_error = 0.01;  //!< [solver] max_task_error (m): a larger position error makes the run no success
   RecordOptions record;          //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
   bool plots = false;            //!< [output] plots

@@ -25,7 +25,15 @@ struct RunResult {
   bool stopped = false;                   //!< ended at the first failed step ([solver] on_infeasible = "stop")
   int held_steps = 0;                     //!< steps whose solve failed, held with theta_dot = 0
   int relaxed_steps = 0;                  //!< steps solved with the rows relaxed (on_infeasible = "relax")
+  int braked_steps = 0;                   //!< failed steps that braked (on_infeasible = "brake"; counted in failures)
   double max_relaxed_task_error = 0.0;    //!< the largest task_row_error of a relaxed step
+  /// The motion the arm was asked for, per joint, over every applied command (Heun's average; a held step's zero):
+  /// the largest |acceleration| (rad/s^2) and |jerk| (rad/s^3), the largest excursion beyond the robot's acceleration
+  /// and jerk limits at the step's theta (0 when never; empty where the robot gives no such limits), and the steps
+  /// over them (by more than 1e-9 (1 + |limit|)).
+  std::vector<double> max_joint_acceleration, max_joint_jerk;
+  std::vector<double> max_joint_acceleration_violation, max_joint_jerk_violation;
+  int steps_over_acceleration_limit = 0, steps_over_jerk_limit = 0;
   std::string first_relaxed;              //!< "t = ...: <diagnosis>" of the first relaxed step
   bool interrupted = false;               //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
   /// The plugins' data as the run's last step left it (what their summaries read, e.g. FCL's failures).

@@ -37,7 +37,8 @@ enum class StepValue {
   kResidual,
   kLawLower,
   kLawUpper,
-  kStatus
+  kStatus,
+  kThetaDdot
 };
 
 /// One group of standard columns.

@@ -24,6 +24,8 @@ class JointAngleMargin final : public Configured<Constraint, JointAngleMarginCon
  public:
   static constexpr const char* kType = "joint_angle_margin";
   JointAngleMargin(const Config& config, const RobotModel& robot);
+  /// Both levels: at the acceleration level the bounds hold the velocity after the step (Context::velocity_to_x).
+  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
   /// The margin per joint.
   [[nodiscard]] const Eigen::VectorXd& margin() const noexcept { return margin_; }
   void summarise(const RobotModel& robot, const Trajectory& run, const PluginData* data,

@@ -19,6 +19,8 @@ class JointVelocityLimits final : public Configured<Constraint, JointVelocityLim
  public:
   static constexpr const char* kType = "joint_velocity_limits";
   JointVelocityLimits(const Config& config, const RobotModel& robot);
+  /// Both levels: at the acceleration level the laws bound the velocity after the step (Context::velocity_to_x).
+  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
 
  private:
   void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;

@@ -2,7 +2,10 @@
 /// @file
 /// `task_tracking`: the end-effector task with position-error feedback (eq. 6), m equality rows
 ///   J x = r_d_dot + K (r_d - f(theta)),
-/// where m is the robot's number of task rows and K = diag(gain). For spatial `pose` tasks the orientation rows use
+/// where m is the robot's number of task rows and K = diag(gain). At the acceleration level (x = theta_ddot) the rows
+/// are those of the error dynamics e_ddot + 2K e_dot + K^2 e = 0 (critically damped at the same rate K):
+///   J x = r_d_ddot - J_dot theta_dot + 2K (r_d_dot - J theta_dot) + K^2 (r_d - f(theta)),
+/// with J_dot theta_dot = sum_i theta_dot_i (dJ/dtheta_i) theta_dot. For spatial `pose` tasks the orientation rows use
 /// the rotation-vector error log(R_d R') (r_d's orientation entries are a rotation vector). A task that names a subset
 /// of rows (`task = ["x", "y", "z", "wz"]`) keeps those rows of the error and of J: S J x = S (r_d_dot + K e).
 /// Reports to the run summary, for tasks with orientation rows: `max_orientation_error` (rad), the largest
@@ -26,6 +29,8 @@ class TaskTracking final : public Configured<Constraint, TaskTrackingConfig>, pu
  public:
   static constexpr const char* kType = "task_tracking";
   TaskTracking(const Config& config, const RobotModel& robot);
+  /// Both levels (the acceleration level's rows are in the file comment).
+  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
   [[nodiscard]] int equality_rows(const RobotModel& robot) const override { return robot.task_dim(); }
   [[nodiscard]] KinematicsLevel kinematics_level() const override { return KinematicsLevel::kJacobian; }
   void summarise(const RobotModel& robot, const Trajectory& run, const PluginData* data,

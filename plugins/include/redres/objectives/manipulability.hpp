@@ -63,6 +63,8 @@ class Manipulability final : public Configured<Objective, ManipulabilityConfig> 
   using Schedule = ManipulabilityConfig::Schedule;
 
   Manipulability(const Config& config, const RobotModel& robot);
+  /// Both levels: zeta = -weight p(t) grad w pushes x (theta_dot or theta_ddot) up the gradient.
+  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
 
   /// The coefficient p(t).
   [[nodiscard]] double coefficient(double t, double T) const;

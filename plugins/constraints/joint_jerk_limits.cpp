@@ -1,0 +1,71 @@
+#include "redres/constraints/joint_jerk_limits.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "redres/constraints/joint_acceleration_limits.hpp"
+#include "redres/model/velocity_limit.hpp"
+
+namespace redres {
+
+namespace {
+struct Data final : PluginData {
+  explicit Data(int n) : j_lo(n), j_hi(n), lo(n), hi(n) {}
+  Eigen::VectorXd j_lo, j_hi, lo, hi;
+};
+}  // namespace
+
+const Schema<JointJerkLimitsConfig>& JointJerkLimitsConfig::schema() {
+  using C = JointJerkLimitsConfig;
+  static const Schema<C> s{{field("scale", &C::scale, "", "fraction of the robot's jerk limits",
+                                  rule<double>("in (0, 1]", [](double v) { return v > 0.0 && v <= 1.0; }))}};
+  return s;
+}
+
+JointJerkLimits::JointJerkLimits(const Config& config, const RobotModel& robot)
+    : Configured(kType, config), n_(robot.dof()) {
+  for (int j = 0; j < robot.dof(); ++j) {
+    if (robot.joint(j).jerk_limit) continue;
+    throw std::invalid_argument(std::string(kType) + " needs a `jerk_limit` on every joint of robot '" + robot.name() +
+                                "'; joint " + std::to_string(j + 1) + " ('" + robot.joint(j).name +
+                                "') has none (give it in the robot file's [[joints]] entry)");
+  }
+}
+
+std::unique_ptr<PluginData> JointJerkLimits::make_data() const { return std::make_unique<Data>(n_); }
+
+void JointJerkLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
+  REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
+  REDRES_REQUIRE(ctx.theta_dot_prev != nullptr && ctx.theta_dot_prev2 != nullptr, kType,
+                 "the context carries the last two commands (a Controller's does)");
+  auto& d = static_cast<Data&>(*data);
+  ctx.robot->jerk_limits(ctx.theta(), d.j_lo, d.j_hi);
+  const Eigen::VectorXd& prev = *ctx.theta_dot_prev;
+  const Eigen::VectorXd& prev2 = *ctx.theta_dot_prev2;
+  const Eigen::VectorXd& v = ctx.level == SchemeLevel::kVelocity ? prev : *ctx.theta_dot;
+  const double tau = ctx.tau, scale = config_.scale;
+  const RobotModel& robot = *ctx.robot;
+  for (int j = 0; j < n_; ++j) {
+    const double a_prev = (prev(j) - prev2(j)) / tau;
+    const double j_lo = scale * d.j_lo(j), j_hi = scale * d.j_hi(j);
+    // v' = v + tau a with a in a_prev + tau [j^-, j^+] ...
+    double a_lo = a_prev + tau * j_lo, a_hi = a_prev + tau * j_hi;
+    // ... and, towards a velocity limit, an acceleration that the jerk limit can still bring to zero before the
+    // velocity reaches it: v' + a^2 / (2 |j^-|) <= v^+ after the step, i.e. a <= stopping_speed(v^+ - v, |j^-|, tau)
+    // (yielding to a_prev + tau j^-, the hardest the jerk limit lets it turn).
+    const VelocityBounds vb = robot.joint(j).velocity_limit->bounds(ctx.theta()(j));
+    a_hi = std::max(std::min(a_hi, stopping_speed(vb.upper - v(j), -j_lo, tau)), a_lo);
+    a_lo = std::min(std::max(a_lo, -stopping_speed(v(j) - vb.lower, j_hi, tau)), a_hi);
+    d.lo(j) = ctx.velocity_to_x(v(j) + tau * a_lo, j);
+    d.hi(j) = ctx.velocity_to_x(v(j) + tau * a_hi, j);
+  }
+  builder.intersect_bounds(d.lo, d.hi);
+}
+
+namespace {
+const bool kRegistered = constraint_registry().add_plugin<JointJerkLimits>(
+    "a_prev + tau j^- <= (theta_dot - theta_dot_prev) / tau <= a_prev + tau j^+ (the robot file's jerk_limit; both "
+    "levels)");
+}  // namespace
+
+}  // namespace redres

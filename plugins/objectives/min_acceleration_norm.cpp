@@ -1,0 +1,32 @@
+#include "redres/objectives/min_acceleration_norm.hpp"
+
+namespace redres {
+
+const Schema<MinAccelerationNormConfig>& MinAccelerationNormConfig::schema() {
+  using C = MinAccelerationNormConfig;
+  static const Schema<C> s{
+      {field("damping", &C::damping, "1/s", "damping of the joint velocity at the acceleration level", at_least(0.0))}};
+  return s;
+}
+
+MinAccelerationNorm::MinAccelerationNorm(const Config& config, const RobotModel& /*robot*/)
+    : Configured(kType, config) {}
+
+void MinAccelerationNorm::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
+  builder.add_identity();
+  if (ctx.level == SchemeLevel::kAcceleration) {
+    REDRES_REQUIRE(ctx.theta_dot != nullptr, kType, "the context carries theta_dot at the acceleration level");
+    if (config_.damping > 0.0) builder.add_linear(config_.damping, *ctx.theta_dot);
+    return;
+  }
+  REDRES_REQUIRE(ctx.theta_dot_prev != nullptr, kType,
+                 "the context carries the previous command (a Controller's does; set Context::theta_dot_prev)");
+  builder.add_linear(-1.0, *ctx.theta_dot_prev);
+}
+
+namespace {
+const bool kRegistered = objective_registry().add_plugin<MinAccelerationNorm>(
+    "x'x/2 + damping theta_dot'x at the acceleration level (MAN); |x - theta_dot_prev|^2/2 at the velocity level");
+}  // namespace
+
+}  // namespace redres

@@ -5,10 +5,14 @@
 //   per_step  the mean of those minima (s)     p99_9  their 99.9th percentile (s)     max  their largest (s)
 // BM_ScenarioStep/<scenario> (the paper's configs, the Panda's, the iiwa's, ...). The ratio that issue 24 names:
 // panda_table_pole against panda_helix.
+// BM_MotionStep/<variant>: configs/panda_helix_fast.toml with the robot's acceleration and jerk constraints switched
+// on and off (`none`: both listed with active = false; `acceleration`, `jerk`, `both`), for the cost per step of
+// each against the run without them (issue 25).
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -21,8 +25,8 @@
 namespace redres {
 namespace {
 
-void BM_ScenarioStep(benchmark::State& state, const std::string& name) {
-  Scenario s = load_scenario(source_path("configs/" + name + ".toml"));
+void BM_ScenarioFileStep(benchmark::State& state, const std::filesystem::path& file) {
+  Scenario s = load_scenario(file);
   const RunResult run = simulate(s);
   const std::size_t steps = run.trajectory.size();
   std::vector<Eigen::VectorXd> thetas;
@@ -56,6 +60,34 @@ void BM_ScenarioStep(benchmark::State& state, const std::string& name) {
   state.counters["max"] = sorted.back();
   state.counters["steps"] = static_cast<double>(steps);
 }
+
+void BM_ScenarioStep(benchmark::State& state, const std::string& name) {
+  BM_ScenarioFileStep(state, source_path("configs/" + name + ".toml"));
+}
+
+// panda_helix_fast with the acceleration (jerk) constraint active or not: a copy of the file, its robot path made
+// absolute, with both constraints listed.
+std::filesystem::path motion_variant(bool acceleration, bool jerk) {
+  std::string text = read_text(source_path("configs/panda_helix_fast.toml"));
+  const std::string robot = "\"../robots/franka_panda.toml\"";
+  text.replace(text.find(robot), robot.size(), "\"" + source_path("robots/franka_panda.toml").string() + "\"");
+  const auto flag = [](bool on) { return on ? "true" : "false"; };
+  text += std::string("\n[[constraints]]\ntype = \"joint_acceleration_limits\"\nactive = ") + flag(acceleration) +
+          "\n\n[[constraints]]\ntype = \"joint_jerk_limits\"\nactive = " + flag(jerk) + "\n";
+  const std::filesystem::path dir = scratch(std::string("motion_") + flag(acceleration) + "_" + flag(jerk));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path file = dir / "panda_helix_fast.toml";
+  std::ofstream(file) << text;
+  return file;
+}
+
+void BM_MotionStep(benchmark::State& state, bool acceleration, bool jerk) {
+  BM_ScenarioFileStep(state, motion_variant(acceleration, jerk));
+}
+BENCHMARK_CAPTURE(BM_MotionStep, none, false, false)->Iterations(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_MotionStep, acceleration, true, false)->Iterations(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_MotionStep, jerk, false, true)->Iterations(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_MotionStep, both, true, true)->Iterations(5)->Unit(benchmark::kMillisecond);
 
 // Every scenario of configs/ (sorted by name), registered before main() runs.
 const bool registered = [] {

@@ -10,8 +10,8 @@ namespace {
 const Rule<double> kFraction = rule<double>("in (0, 1]", [](double v) { return v > 0.0 && v <= 1.0; });
 
 struct Data final : PluginData {
-  explicit Data(int n) : a_lo(n), a_hi(n), lo(n), hi(n) {}
-  Eigen::VectorXd a_lo, a_hi, lo, hi;
+  explicit Data(int n) : a_lo(n), a_hi(n), lo(n), hi(n), zero(Eigen::VectorXd::Zero(n)) {}
+  Eigen::VectorXd a_lo, a_hi, lo, hi, zero;
 };
 
 // The first joint without the law `law`, for the constructors' messages.
@@ -19,8 +19,8 @@ void require_laws(const RobotModel& robot, std::shared_ptr<const VelocityLimitLa
                   const char* type) {
   for (int j = 0; j < robot.dof(); ++j) {
     if (robot.joint(j).*law) continue;
-    throw std::invalid_argument(std::string(type) + " needs a `" + key + "` on every joint of robot '" +
-                                robot.name() + "'; joint " + std::to_string(j + 1) + " ('" + robot.joint(j).name +
+    throw std::invalid_argument(std::string(type) + " needs a `" + key + "` on every joint of robot '" + robot.name() +
+                                "'; joint " + std::to_string(j + 1) + " ('" + robot.joint(j).name +
                                 "') has none (give it in the robot file's [[joints]] entry)");
   }
 }
@@ -49,8 +49,6 @@ std::unique_ptr<PluginData> JointAccelerationLimits::make_data() const { return 
 
 void JointAccelerationLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
-  REDRES_REQUIRE(ctx.theta_dot_prev != nullptr, kType,
-                 "the context carries the previous command (a Controller's does; set Context::theta_dot_prev)");
   auto& d = static_cast<Data&>(*data);
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
@@ -60,7 +58,9 @@ void JointAccelerationLimits::add_to(const Context& ctx, QpBuilder& builder, Plu
   const bool jerk = robot.has_jerk_limits();
   if (jerk) robot.jerk_limits(theta, d.lo, d.hi);
   const bool velocity_level = ctx.level == SchemeLevel::kVelocity;
-  const Eigen::VectorXd& v = velocity_level ? *ctx.theta_dot_prev : *ctx.theta_dot;
+  // A Context without the state between steps (one a caller builds) reads as an arm at rest.
+  const Eigen::VectorXd* state = velocity_level ? ctx.theta_dot_prev : ctx.theta_dot;
+  const Eigen::VectorXd& v = state != nullptr ? *state : d.zero;
   const double tau = ctx.tau, scale = config_.scale;
   // The time the joint moves on at v' before it brakes, and the distance the step covers at v on top (the
   // acceleration level's step moves at (v + v') / 2).

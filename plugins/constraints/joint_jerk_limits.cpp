@@ -10,8 +10,8 @@ namespace redres {
 
 namespace {
 struct Data final : PluginData {
-  explicit Data(int n) : j_lo(n), j_hi(n), lo(n), hi(n) {}
-  Eigen::VectorXd j_lo, j_hi, lo, hi;
+  explicit Data(int n) : j_lo(n), j_hi(n), lo(n), hi(n), zero(Eigen::VectorXd::Zero(n)) {}
+  Eigen::VectorXd j_lo, j_hi, lo, hi, zero;
 };
 }  // namespace
 
@@ -36,13 +36,12 @@ std::unique_ptr<PluginData> JointJerkLimits::make_data() const { return std::mak
 
 void JointJerkLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
-  REDRES_REQUIRE(ctx.theta_dot_prev != nullptr && ctx.theta_dot_prev2 != nullptr, kType,
-                 "the context carries the last two commands (a Controller's does)");
   auto& d = static_cast<Data&>(*data);
   ctx.robot->jerk_limits(ctx.theta(), d.j_lo, d.j_hi);
-  const Eigen::VectorXd& prev = *ctx.theta_dot_prev;
-  const Eigen::VectorXd& prev2 = *ctx.theta_dot_prev2;
-  const Eigen::VectorXd& v = ctx.level == SchemeLevel::kVelocity ? prev : *ctx.theta_dot;
+  // A Context without the state between steps (one a caller builds) reads as an arm at rest.
+  const Eigen::VectorXd& prev = ctx.theta_dot_prev != nullptr ? *ctx.theta_dot_prev : d.zero;
+  const Eigen::VectorXd& prev2 = ctx.theta_dot_prev2 != nullptr ? *ctx.theta_dot_prev2 : d.zero;
+  const Eigen::VectorXd& v = ctx.level == SchemeLevel::kVelocity || ctx.theta_dot == nullptr ? prev : *ctx.theta_dot;
   const double tau = ctx.tau, scale = config_.scale;
   const RobotModel& robot = *ctx.robot;
   for (int j = 0; j < n_; ++j) {

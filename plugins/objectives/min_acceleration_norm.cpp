@@ -14,14 +14,12 @@ MinAccelerationNorm::MinAccelerationNorm(const Config& config, const RobotModel&
 
 void MinAccelerationNorm::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
   builder.add_identity();
+  // A Context without the state between steps (one a caller builds) reads as an arm at rest: no linear term.
   if (ctx.level == SchemeLevel::kAcceleration) {
-    REDRES_REQUIRE(ctx.theta_dot != nullptr, kType, "the context carries theta_dot at the acceleration level");
-    if (config_.damping > 0.0) builder.add_linear(config_.damping, *ctx.theta_dot);
+    if (config_.damping > 0.0 && ctx.theta_dot != nullptr) builder.add_linear(config_.damping, *ctx.theta_dot);
     return;
   }
-  REDRES_REQUIRE(ctx.theta_dot_prev != nullptr, kType,
-                 "the context carries the previous command (a Controller's does; set Context::theta_dot_prev)");
-  builder.add_linear(-1.0, *ctx.theta_dot_prev);
+  if (ctx.theta_dot_prev != nullptr) builder.add_linear(-1.0, *ctx.theta_dot_prev);
 }
 
 namespace {

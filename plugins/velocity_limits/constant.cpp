@@ -7,9 +7,10 @@ namespace redres {
 
 const Schema<ConstantLawConfig>& ConstantLawConfig::schema() {
   using C = ConstantLawConfig;
-  static const Schema<C> s{
-      {field("lower", &C::lower, "rad/s^k or m/s^k", "lower limit (k = 1: velocity; 2: acceleration; 3: jerk)", less(0.0)).required(),
-       field("upper", &C::upper, "rad/s^k or m/s^k", "upper limit", greater(0.0)).required()}};
+  static const Schema<C> s{{field("lower", &C::lower, "rad/s^k or m/s^k",
+                                  "lower limit (k = 1: velocity; 2: acceleration; 3: jerk)", less(0.0))
+                                .required(),
+                            field("upper", &C::upper, "rad/s^k or m/s^k", "upper limit", greater(0.0)).required()}};
   return s;
 }
 

@@ -180,7 +180,7 @@ TEST(PluginsListing, TheSolverTableListsTheRunPolicyKeysWithTheirDefaultsAndRule
   const Cli text = redres("plugins");
   ASSERT_EQ(text.code, 0) << text.out;
   EXPECT_NE(text.out.find("on_infeasible   = 'hold'"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("[one of 'hold', 'stop', 'relax', 'continue']"), std::string::npos);
+  EXPECT_NE(text.out.find("[one of 'hold', 'stop', 'relax', 'continue', 'brake']"), std::string::npos);
   EXPECT_NE(text.out.find("relax_weight    = 10000.0"), std::string::npos);
   EXPECT_NE(text.out.find("a weight in [1, 1e8]"), std::string::npos);
   const Cli json = redres("plugins --json");

@@ -1,8 +1,12 @@
 // The per-step API: Controller::step allocates nothing over long runs with every built-in per-step plugin and the
 // real-time engines; outputs are the caller's (two never alias); the orientation reference of pose tasks is the
-// Controller's; a solve that has not run says so.
+// Controller's, and its r_d_ddot rows are the derivative of its r_d_dot rows; a solve that has not run says so.
+
+#include <cmath>
 
 #include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 
 #include "alloc_counter.hpp"
 #include "redres/constraints/joint_angle_margin.hpp"
@@ -10,6 +14,7 @@
 #include "redres/constraints/task_tracking.hpp"
 #include "redres/control/controller.hpp"
 #include "redres/control/engine_registry.hpp"
+#include "redres/control/orientation_reference.hpp"
 #include "redres/objectives/joint_centering.hpp"
 #include "redres/objectives/manipulability.hpp"
 #include "redres/objectives/min_velocity_norm.hpp"
@@ -212,6 +217,79 @@ TEST(Controller, HoldsTheOrientationItFindsAtTheFirstStepUnlessTold) {
   ctrl.reset();
   ctrl.step(theta0, 0.0, out);
   EXPECT_EQ(ctrl.r_d().tail<3>(), Eigen::Vector3d(0.1, 0.2, 0.3));
+}
+
+// The orientation rows of r_d_ddot, for a planar (the z angle) and a spatial (a rotation vector) pose task turning
+// with cycloidal timing: they are the central differences of the r_d_dot rows (the angular velocity, itself checked
+// against the rotations of r_d), equal turn s''(t) = turn 2 pi sin(2 pi t / T) / T^2, are zero while the orientation
+// is held and outside [0, T], leave the position rows alone, and the overload without them writes the same r_d and
+// r_d_dot bit for bit.
+TEST(OrientationReference, AngularAccelerationIsTheDerivativeOfTheAngularVelocity) {
+  struct Turn {
+    const char* robot;
+    Eigen::Vector3d start, turn;
+  };
+  for (const Turn& c : {Turn{"tests/data/robots/planar_laws_pose.toml", {0.0, 0.0, 0.4}, {0.0, 0.0, 0.9}},
+                        Turn{"robots/kuka_iiwa14.toml", {0.1, 0.2, 0.3}, {0.3, -0.5, 0.4}},
+                        Turn{"robots/kuka_iiwa14.toml", {0.5, -1.2, 2.0}, {-2.0, 1.5, 2.5}}}) {
+    SCOPED_TRACE(c.robot);
+    const RobotModel robot = load_robot(source_path(c.robot));
+    ASSERT_TRUE(robot.has_orientation_rows());
+    const bool planar = robot.kind() == ChainKind::kPlanar;
+    const int m = robot.reference_dim(), p = planar ? 2 : 3, rest = m - p;
+    const KinematicsData kin(robot);  // not read: the orientation is set
+    OrientationReference ref, ref3;
+    ref.set(c.start);
+    ref.set_turn(c.turn);
+    ref3.set(c.start);
+    ref3.set_turn(c.turn);
+    const double T = 10.0, h = 1e-5;
+    Eigen::VectorXd r(m), v(m), a(m), r3(m), v3(m), rp(m), vp(m), rm(m), vm(m), ap(m);
+    const auto fill = [&] {
+      for (Eigen::VectorXd* x : {&r, &v, &a, &r3, &v3, &rp, &vp, &rm, &vm, &ap}) x->setConstant(7.0);
+    };
+    // The rotation the r_d rows describe.
+    const auto rotation = [&](const Eigen::VectorXd& x) {
+      return planar ? Eigen::Matrix3d(Eigen::AngleAxisd(x(2), Eigen::Vector3d::UnitZ()))
+                    : rotation_from_vector(x.tail<3>());
+    };
+    double worst = 0.0, worst_omega = 0.0, peak = 0.0;
+    for (double t = 0.013; t < T; t += 0.0371) {
+      fill();
+      ref.evaluate(robot, kin, t, T, p, r, v, a);
+      ref3.evaluate(robot, kin, t, T, p, r3, v3);
+      EXPECT_EQ(r, r3);  // bit for bit
+      EXPECT_EQ(v, v3);
+      EXPECT_EQ(a.head(p), Eigen::VectorXd::Constant(p, 7.0));  // the path's rows are not the reference's
+      ref.evaluate(robot, kin, t + h, T, p, rp, vp, ap);
+      ref.evaluate(robot, kin, t - h, T, p, rm, vm, ap);
+      worst = std::max(worst, ((vp - vm).tail(rest) / (2 * h) - a.tail(rest)).cwiseAbs().maxCoeff());
+      const Eigen::VectorXd expected = c.turn.tail(rest) * 2.0 * M_PI * std::sin(2.0 * M_PI * t / T) / (T * T);
+      EXPECT_LT((a.tail(rest) - expected).cwiseAbs().maxCoeff(), 1e-15);
+      peak = std::max(peak, a.tail(rest).cwiseAbs().maxCoeff());
+      // r_d_dot's rows are the world angular velocity of r_d's rotation: R(t+h) R(t-h)^T = exp(2h [omega]).
+      const Eigen::AngleAxisd step(rotation(rp) * rotation(rm).transpose());
+      const Eigen::Vector3d omega = step.angle() * step.axis() / (2 * h);
+      worst_omega = std::max(worst_omega, (omega.tail(rest) - v.tail(rest)).cwiseAbs().maxCoeff());
+    }
+    // |a| <= |turn| 2 pi / T^2 (~0.16 rad/s^2 at most here); the differences' error is O(h^2) and roundoff ~1e-11.
+    EXPECT_GT(peak, 0.9 * c.turn.tail(rest).cwiseAbs().maxCoeff() * 2.0 * M_PI / (T * T));
+    EXPECT_LT(worst, 1e-9);
+    EXPECT_LT(worst_omega, 1e-8);
+    // Outside [0, T] the turn has not started or is over: the rows rest.
+    for (double t : {-1.0, -1e-9, T + 1e-9, T + 1.0}) {
+      fill();
+      ref.evaluate(robot, kin, t, T, p, r, v, a);
+      EXPECT_EQ(a.tail(rest), Eigen::VectorXd::Zero(rest)) << "t = " << t;
+      EXPECT_EQ(v.tail(rest), Eigen::VectorXd::Zero(rest)) << "t = " << t;
+    }
+    // Held: zero.
+    ref.set_turn(Eigen::Vector3d::Zero());
+    fill();
+    ref.evaluate(robot, kin, 2.5, T, p, r, v, a);
+    EXPECT_EQ(a.tail(rest), Eigen::VectorXd::Zero(rest));
+    EXPECT_EQ(r.tail(rest), c.start.tail(rest));
+  }
 }
 
 }  // namespace

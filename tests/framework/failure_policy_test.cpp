@@ -415,7 +415,7 @@ TEST(OnInfeasible, PolicyKeysAreChecked) {
     return std::string("accepted");
   };
   EXPECT_NE(message({"solver.on_infeasible=\"abort\""})
-                .find("key 'on_infeasible': expected one of 'hold', 'stop', 'relax', 'continue', got 'abort'"),
+                .find("key 'on_infeasible': expected one of 'hold', 'stop', 'relax', 'continue', 'brake', got 'abort'"),
             std::string::npos);
   EXPECT_NE(message({"solver.on_infeasible=\"relax\"", "solver.relax_weight=0.5"})
                 .find("key 'relax_weight': expected a weight in [1, 1e8], got 0.5"),

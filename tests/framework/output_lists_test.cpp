@@ -39,7 +39,7 @@ TEST(OutputLists, ARunRecordsTheListedColumnsThenThePlugins) {
   Scenario s = load_scenario(source_path("configs/paper_r_obstacle.toml"), {"duration=0.2"});
   const RunResult run = simulate(s);
   const std::vector<std::string> standard = standard_trajectory_columns(*s.robot);
-  ASSERT_EQ(standard.size(), 46U);  // 1 + 6n + 2m + 5 for the paper's arm (n = 6, m = 2)
+  ASSERT_EQ(standard.size(), 52U);  // 1 + 7n + 2m + 5 for the paper's arm (n = 6, m = 2)
   const auto& recorded = run.trajectory.columns();
   ASSERT_GT(recorded.size(), standard.size());
   for (std::size_t c = 0; c < standard.size(); ++c) EXPECT_EQ(recorded[c], standard[c]) << "column " << c;

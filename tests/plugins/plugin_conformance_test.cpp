@@ -155,6 +155,12 @@ TEST(PluginConformance, EveryConstraint) {
   for (const auto& robot : robots()) {
     for (const auto* entry : constraint_registry().entries()) {
       SCOPED_TRACE(entry->type + " on " + robot->name());
+      // The motion-limit constraints need the robot's limits (the Panda has them; the others refuse, naming a joint).
+      if ((entry->type == "joint_acceleration_limits" && !robot->has_acceleration_limits()) ||
+          (entry->type == "joint_jerk_limits" && !robot->has_jerk_limits())) {
+        EXPECT_THROW((void)build_and_round_trip(*entry, *robot, make_constraint), std::exception);
+        continue;
+      }
       const std::unique_ptr<Constraint> p = build_and_round_trip(*entry, *robot, make_constraint);
       const int me = p->equality_rows(*robot), mi = p->inequality_rows(*robot);
       ASSERT_GE(me, 0);

@@ -123,3 +123,24 @@ def test_the_column_groups_name_the_result_columns():
             names.append(g["name"])
     assert list(result.columns)[: len(names)] == names
     assert all(g["meaning"] for g in groups)
+
+
+def test_a_measured_velocity_steps_within_the_pandas_acceleration_limits():
+    s = redres.Scenario.load(source("configs/panda_helix_fast.toml"))
+    ctrl = redres.Controller.from_scenario(s)
+    limits = np.array([15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0])  # robots/franka_panda.toml
+    theta = s.theta0.copy()
+    velocity = np.zeros(7)
+    for k in range(200):
+        theta_dot, info = ctrl.step(theta, velocity, k * s.step)
+        assert info.status in ("solved", "relaxed"), info.diagnosis
+        # The commanded acceleration, from the previous command, within the limits.
+        assert np.allclose(ctrl.theta_ddot, (theta_dot - velocity) / s.step, rtol=0, atol=1e-9)
+        assert np.all(np.abs(ctrl.theta_ddot) <= limits + 1e-9)
+        assert np.array_equal(ctrl.theta_dot_prev, velocity)
+        theta = theta + s.step * theta_dot
+        velocity = theta_dot
+    # A robot with acceleration limits brakes by default and refuses to hold (a velocity jump).
+    with pytest.raises(ValueError, match="velocity jump"):
+        ctrl.set_failure_policy("hold")
+    ctrl.set_failure_policy("brake", recover_error=0.002)

@@ -642,11 +642,11 @@ PYBIND11_MODULE(_redres, m) {
             PyController& c = live(p);
             const FailurePolicy f = policy == "hold"    ? FailurePolicy::kHold
                                     : policy == "relax" ? FailurePolicy::kRelax
-                                    : policy == "brake"
-                                        ? FailurePolicy::kBrake
-                                        : throw std::invalid_argument("Controller.set_failure_policy: expected "
-                                                                      "'hold', 'relax' or 'brake', got '" +
-                                                                      policy + "'");
+                                    : policy == "brake" ? FailurePolicy::kBrake
+                                                        : throw std::invalid_argument(
+                                                              "Controller.set_failure_policy: expected "
+                                                              "'hold', 'relax' or 'brake', got '" +
+                                                              policy + "'");
             in_turn(c, "Controller.set_failure_policy",
                     [&](Controller& k) { k.set_failure_policy(f, relax_weight, recover_error); });
           },

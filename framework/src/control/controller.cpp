@@ -277,10 +277,11 @@ void Controller::set_failure_policy(FailurePolicy policy, double relax_weight, d
   if (policy == FailurePolicy::kBrake && !limits) {
     int j = 0;
     while (j < robot_->dof() && robot_->joint(j).acceleration_limit) ++j;
-    throw std::invalid_argument("Controller::set_failure_policy: 'brake' decelerates within the joints' acceleration "
-                                "limits, and joint " +
-                                std::to_string(j + 1) + " ('" + robot_->joint(j).name + "') of robot '" +
-                                robot_->name() + "' has none (give `acceleration_limit` in the robot file)");
+    throw std::invalid_argument(
+        "Controller::set_failure_policy: 'brake' decelerates within the joints' acceleration "
+        "limits, and joint " +
+        std::to_string(j + 1) + " ('" + robot_->joint(j).name + "') of robot '" + robot_->name() +
+        "' has none (give `acceleration_limit` in the robot file)");
   }
   policy_ = policy;
   relax_weight_ = policy == FailurePolicy::kHold ? 0.0 : relax_weight;

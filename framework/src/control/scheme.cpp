@@ -13,7 +13,8 @@ Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> 
   std::set<std::string> names;
   const auto check_level = [level](const Plugin& p, const char* kind) {
     if (!p.active() || p.supports(level)) return;
-    throw std::invalid_argument(std::string(kind) + " '" + p.name() + "' (type " + p.type() + ") does not work at the " +
+    throw std::invalid_argument(std::string(kind) + " '" + p.name() + "' (type " + p.type() +
+                                ") does not work at the " +
                                 (level == SchemeLevel::kAcceleration ? "acceleration" : "velocity") +
                                 " level ([scheme] level); docs/motion.md lists the plugins that do");
   };

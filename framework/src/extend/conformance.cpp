@@ -69,6 +69,8 @@ std::vector<RobotModel> test_robots() {
     spatial.joints.back().a = a[j];
     spatial.joints.back().d = d[j];
     spatial.joints.back().alpha = alpha[j];
+    spatial.joints.back().acceleration_limit = std::make_shared<FixedLaw>();  // +-1.5 rad/s^2
+    spatial.joints.back().jerk_limit = std::make_shared<FixedLaw>();          // +-1.5 rad/s^3
   }
   spatial.home = (Eigen::VectorXd(7) << 0.1, -0.5, 0.2, -1.8, 0.1, 1.5, 0.7).finished();
   robots.emplace_back(spatial);

@@ -146,9 +146,11 @@ void read_effort(const TableReader& r, JointSpec& jt) {
 // URDF joint's [[joints]] override; a [[joints]] entry of a TOML chain reads them key by key).
 void read_motion_limits(const TableReader& r, JointSpec& jt) {
   if (r.has("acceleration_limit")) {
-    read_law(r, "acceleration_limit", "acceleration-limit", "rad/s^2 or m/s^2", jt, jt.acceleration_limit, jt.acceleration_limit_source);
+    read_law(r, "acceleration_limit", "acceleration-limit", "rad/s^2 or m/s^2", jt, jt.acceleration_limit,
+             jt.acceleration_limit_source);
   }
-  if (r.has("jerk_limit")) read_law(r, "jerk_limit", "jerk-limit", "rad/s^3 or m/s^3", jt, jt.jerk_limit, jt.jerk_limit_source);
+  if (r.has("jerk_limit"))
+    read_law(r, "jerk_limit", "jerk-limit", "rad/s^3 or m/s^3", jt, jt.jerk_limit, jt.jerk_limit_source);
   if (r.has("effort_limit")) read_effort(r, jt);
 }
 
@@ -265,14 +267,15 @@ const Schema<JointReading>& JointReading::schema() {
                "the joint's acceleration limits: a law of the same kinds as velocity_limit (constant, push_rod, ...)",
                [](const TableReader& r, C& c) {
                  if (!r.has("acceleration_limit")) return;  // none: unbounded
-                 read_law(r, "acceleration_limit", "acceleration-limit", "rad/s^2 or m/s^2", c.jt, c.jt.acceleration_limit,
-                          c.jt.acceleration_limit_source);
+                 read_law(r, "acceleration_limit", "acceleration-limit", "rad/s^2 or m/s^2", c.jt,
+                          c.jt.acceleration_limit, c.jt.acceleration_limit_source);
                }),
       entry<C>("jerk_limit", "table", "rad/s^3 or m/s^3", "none (unbounded)",
                "the joint's jerk limits (the rate of change of acceleration): a law as velocity_limit",
                [](const TableReader& r, C& c) {
                  if (!r.has("jerk_limit")) return;  // none: unbounded
-                 read_law(r, "jerk_limit", "jerk-limit", "rad/s^3 or m/s^3", c.jt, c.jt.jerk_limit, c.jt.jerk_limit_source);
+                 read_law(r, "jerk_limit", "jerk-limit", "rad/s^3 or m/s^3", c.jt, c.jt.jerk_limit,
+                          c.jt.jerk_limit_source);
                }),
       entry<C>("effort_limit", "number", "N m or N", "none", "the largest torque (force) the joint's drive gives",
                [](const TableReader& r, C& c) {

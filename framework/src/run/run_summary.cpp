@@ -267,8 +267,7 @@ const std::vector<SummaryField>& summary_fields() {
        "per joint, the largest excursion of that acceleration beyond the robot's `acceleration_limit` at the step's "
        "theta (0 when never; empty when the robot gives none)",
        [](const S& s) { return SummaryValue(s.max_joint_acceleration_violation); }},
-      {"max_joint_jerk_violation", "array of n numbers >= 0, or empty",
-       "the same against the robot's `jerk_limit`",
+      {"max_joint_jerk_violation", "array of n numbers >= 0, or empty", "the same against the robot's `jerk_limit`",
        [](const S& s) { return SummaryValue(s.max_joint_jerk_violation); }},
       {"steps_over_acceleration_limit", "integer",
        "steps whose command leaves some joint's acceleration limit by more than 1e-9 (1 + \\|limit\\|)",

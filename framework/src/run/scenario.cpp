@@ -250,9 +250,10 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                  // Reads `constraints` too: one scheme holds both.
                  s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot, s.duration, s.tau));
                  if (s.scheme->level() == SchemeLevel::kAcceleration && s.integrator == Integrator::kHeun) {
-                   r.fail("integrator", "an acceleration-level scheme ([scheme] level = \"acceleration\") integrates "
-                                        "its own way (constant acceleration over each step, exact); leave "
-                                        "`integrator` out or set it to \"euler\"");
+                   r.fail("integrator",
+                          "an acceleration-level scheme ([scheme] level = \"acceleration\") integrates "
+                          "its own way (constant acceleration over each step, exact); leave "
+                          "`integrator` out or set it to \"euler\"");
                  }
                  const std::size_t width = trajectory_width(s);
                  if (const double bytes = (s.steps() + 1.0) * static_cast<double>(width) * 8.0;
@@ -268,9 +269,10 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
       entry<C>("constraints", "array of tables [[constraints]]", "", "none",
                "the hard constraints; their keys are their type's (redres plugins)",
                [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
-      entry<C>("scheme", "table [scheme]", "", "level = \"velocity\"",
-               "`level`: \"velocity\" (x = theta_dot, the paper's) or \"acceleration\" (x = theta_ddot; docs/motion.md)",
-               [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
+      entry<C>(
+          "scheme", "table [scheme]", "", "level = \"velocity\"",
+          "`level`: \"velocity\" (x = theta_dot, the paper's) or \"acceleration\" (x = theta_ddot; docs/motion.md)",
+          [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
       entry<C>("solver", "table", "", "engine = \"projection\"",
                "the LVI engine and its settings (redres plugins), and what a step that is not solved does",
                [](const TableReader& r, C& c) {
@@ -305,15 +307,19 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                                                     "it), \"relax\" or \"stop\"");
                  }
                  if (s.on_infeasible == OnInfeasible::kBrake && !limits) {
-                   solver.fail("on_infeasible", "\"brake\" decelerates within the joints' acceleration limits, and "
-                                                "robot '" + s.robot->name() +
-                                                    "' gives none on some joint (`acceleration_limit` in the robot "
-                                                    "file's [[joints]])");
+                   solver.fail("on_infeasible",
+                               "\"brake\" decelerates within the joints' acceleration limits, and "
+                               "robot '" +
+                                   s.robot->name() +
+                                   "' gives none on some joint (`acceleration_limit` in the robot "
+                                   "file's [[joints]])");
                  }
                  if (solver.has("relax_weight") && s.on_infeasible != OnInfeasible::kRelax &&
                      s.on_infeasible != OnInfeasible::kBrake) {
-                   solver.fail("relax_weight", "is used only with on_infeasible = \"relax\" or \"brake\" "
-                                               "(on_infeasible is \"" + chosen + "\")");
+                   solver.fail("relax_weight",
+                               "is used only with on_infeasible = \"relax\" or \"brake\" "
+                               "(on_infeasible is \"" +
+                                   chosen + "\")");
                  }
                  if (solver.has("recover_error") && s.on_infeasible != OnInfeasible::kBrake) {
                    solver.fail("recover_error",

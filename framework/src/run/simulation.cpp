@@ -29,9 +29,9 @@ namespace {
 
 // Integrates one step from theta at t with the step's solution `out`: Euler's method, or Heun's (one more QP, at the
 // Euler prediction, into `out2`); at the acceleration level the step's constant acceleration exactly. `velocity` is
-// the command applied over the previous step on entry and this step's on return (zero for a held step). A held step moves nothing; a braked step moves with its braking
-// command (Euler's step: no second stage). Returns false when the run must stop (a failed second stage under
-// on_infeasible = "stop").
+// the command applied over the previous step on entry and this step's on return (zero for a held step). A held step
+// moves nothing; a braked step moves with its braking command (Euler's step: no second stage). Returns false when the
+// run must stop (a failed second stage under on_infeasible = "stop").
 bool integrate(const Scenario& s, Controller& ctrl, StepLog& log, RunResult& run, double t, const StepOutput& out,
                StepOutput& out2, Eigen::VectorXd& theta, Eigen::VectorXd& theta_pred, Eigen::VectorXd& velocity) {
   if (!moves(out.info.status)) {

@@ -147,11 +147,11 @@ class Controller {
 
  private:
   void solve(double t, StepOutput& out);
-  void begin_step();                     // the previous step's command becomes theta_dot_prev
-  void end_step(const StepOutput& out);  // this step's command and status, for the next
-  bool relax(StepOutput& out);   // the elastic QP; false when it fails too
-  void brake(StepOutput& out);   // the braking command
-  void apply(const Eigen::VectorXd& x, StepOutput& out);  // x (the QP's) into theta_dot and theta_ddot
+  void begin_step();                                            // the previous step's command becomes theta_dot_prev
+  void end_step(const StepOutput& out);                         // this step's command and status, for the next
+  bool relax(StepOutput& out);                                  // the elastic QP; false when it fails too
+  void brake(StepOutput& out);                                  // the braking command
+  void apply(const Eigen::VectorXd& x, StepOutput& out);        // x (the QP's) into theta_dot and theta_ddot
   [[nodiscard]] const Eigen::VectorXd& base() const noexcept {  // the velocity before this step
     return ctx_.level == SchemeLevel::kVelocity ? prev_ : v_;
   }
@@ -174,11 +174,11 @@ class Controller {
   Eigen::VectorXd prev_, prev2_, pending_;  // theta_dot_prev, theta_dot_prev2, this step's applied command
   Eigen::VectorXd measured_;                // the caller's measured joint velocity, during a step that has one
   SolverStatus pending_status_ = SolverStatus::kNotRun;
-  bool have_pending_ = false;                // a step was made whose command is not yet theta_dot_prev
-  bool started_ = false;                     // the plugins were told that the run starts
-  Eigen::VectorXd row_miss_;                 // J x - d of a relaxed step
-  Eigen::VectorXd v_;                        // acceleration level: the joint velocity at this step
-  Eigen::VectorXd lim_lo_, lim_hi_;          // acceleration (then jerk) limits at theta, for braking
+  bool have_pending_ = false;        // a step was made whose command is not yet theta_dot_prev
+  bool started_ = false;             // the plugins were told that the run starts
+  Eigen::VectorXd row_miss_;         // J x - d of a relaxed step
+  Eigen::VectorXd v_;                // acceleration level: the joint velocity at this step
+  Eigen::VectorXd lim_lo_, lim_hi_;  // acceleration (then jerk) limits at theta, for braking
   FailurePolicy policy_ = FailurePolicy::kHold;
   double recover_error_ = 1e-3;              // kBrake: the position error above which the elastic QP goes first
   std::unique_ptr<LviEngine> relax_engine_;  // an engine like *engine_ for the elastic QP

@@ -26,8 +26,8 @@
 #include "redres/config/config.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/qp/qp.hpp"
-#include "redres/qp/solver_status.hpp"
 #include "redres/qp/row_fit.hpp"  // RowFit, best_row_fit: the test behind `infeasible`
+#include "redres/qp/solver_status.hpp"
 
 namespace redres {
 

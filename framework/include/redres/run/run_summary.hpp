@@ -93,7 +93,7 @@ struct RunSummary {
   std::vector<double> max_joint_acceleration, max_joint_jerk;
   std::vector<double> max_joint_acceleration_violation, max_joint_jerk_violation;
   int steps_over_acceleration_limit = 0, steps_over_jerk_limit = 0;
-  std::vector<double> final_theta;            //!< theta(T)
+  std::vector<double> final_theta;  //!< theta(T)
   SolverStats solver;
   double wall_time_s = 0.0;  //!< time spent in the loop (s)
   RobotFacts robot;

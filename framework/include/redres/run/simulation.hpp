@@ -34,8 +34,8 @@ struct RunResult {
   std::vector<double> max_joint_acceleration, max_joint_jerk;
   std::vector<double> max_joint_acceleration_violation, max_joint_jerk_violation;
   int steps_over_acceleration_limit = 0, steps_over_jerk_limit = 0;
-  std::string first_relaxed;              //!< "t = ...: <diagnosis>" of the first relaxed step
-  bool interrupted = false;               //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
+  std::string first_relaxed;  //!< "t = ...: <diagnosis>" of the first relaxed step
+  bool interrupted = false;   //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
   /// The plugins' data as the run's last step left it (what their summaries read, e.g. FCL's failures).
   std::shared_ptr<const SchemeData> plugin_data;
 

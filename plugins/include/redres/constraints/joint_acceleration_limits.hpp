@@ -22,8 +22,8 @@ namespace redres {
 
 /// The configuration of `joint_acceleration_limits`.
 struct JointAccelerationLimitsConfig {
-  double scale = 1.0;    //!< fraction of the robot's acceleration limits, 0 < scale <= 1
-  bool braking = true;   //!< the position limits as a stopping distance at the acceleration limit
+  double scale = 1.0;   //!< fraction of the robot's acceleration limits, 0 < scale <= 1
+  bool braking = true;  //!< the position limits as a stopping distance at the acceleration limit
 
   static const Schema<JointAccelerationLimitsConfig>& schema();
 };

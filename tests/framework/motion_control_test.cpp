@@ -1,0 +1,433 @@
+// Motion a real arm can follow (issue 25): the acceleration and jerk constraints, braking after a failed step and the
+// recovery after it, no velocity jump in any shipped scenario (nor under forced failures), and the acceleration-level
+// scheme (its task, J_dot theta_dot against central differences, MAN against an independent solve).
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "qp_util.hpp"
+#include "redres/config/toml_reader.hpp"
+#include "redres/constraints/joint_acceleration_limits.hpp"
+#include "redres/control/controller.hpp"
+#include "redres/control/engine_registry.hpp"
+#include "redres/parsers/robot_toml.hpp"
+#include "redres/run/scenario.hpp"
+#include "redres/run/simulation.hpp"
+#include "test_util.hpp"
+
+namespace redres {
+namespace {
+
+std::unique_ptr<RobotModel> panda() {
+  return std::make_unique<RobotModel>(load_robot(source_path("robots/franka_panda.toml")));
+}
+
+// The plugins of `text` ([[objectives]], [[constraints]], optional [scheme]) for `robot`.
+std::unique_ptr<Scheme> scheme_of(const std::string& text, const RobotModel& robot) {
+  auto file = parse_toml_string(text, "scheme.toml");
+  return std::make_unique<Scheme>(Scheme::from_toml(TableReader::root(file), robot));
+}
+
+// A constraint that makes every step with t in [from, to) infeasible (an empty box for joint 1): forced failures.
+struct NoConfig {
+  static const Schema<NoConfig>& schema() {
+    static const Schema<NoConfig> s{{}};
+    return s;
+  }
+};
+class Blocker final : public Configured<Constraint, NoConfig> {
+ public:
+  Blocker(double from, double to) : Configured("test_blocker", NoConfig{}), from_(from), to_(to) {}
+  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
+
+ private:
+  void add_to(const Context& ctx, QpBuilder& b, PluginData* /*data*/) const override {
+    if (ctx.t >= from_ && ctx.t < to_) b.intersect_bound(0, 1.0, -1.0);
+  }
+  double from_, to_;
+};
+
+// A scheme read from `text` with a Blocker added.
+std::unique_ptr<Scheme> with_blocker(const std::string& text, const RobotModel& robot, double from, double to) {
+  auto file = parse_toml_string(text, "scheme.toml");
+  const TableReader root = TableReader::root(file);
+  std::vector<std::unique_ptr<Objective>> objectives;
+  std::vector<std::unique_ptr<Constraint>> constraints;
+  for (const TableReader& t : root.tables("objectives")) objectives.push_back(make_objective(t, robot));
+  for (const TableReader& t : root.tables("constraints")) constraints.push_back(make_constraint(t, robot));
+  constraints.push_back(std::make_unique<Blocker>(from, to));
+  return std::make_unique<Scheme>(robot, std::move(objectives), std::move(constraints));
+}
+
+Eigen::VectorXd accel_limit(const RobotModel& robot, const Eigen::VectorXd& theta, bool upper) {
+  Eigen::VectorXd lo(robot.dof()), hi(robot.dof());
+  robot.acceleration_limits(theta, lo, hi);
+  return upper ? hi : lo;
+}
+
+const char* const kPlain = R"(
+[[objectives]]
+type = "min_velocity_norm"
+[[constraints]]
+type = "joint_acceleration_limits"
+)";
+
+TEST(AccelerationLimits, BoundsComeFromThePreviousCommandAndEveryJointCanStillStop) {
+  const auto robot = panda();
+  const int n = robot->dof();
+  const auto scheme = scheme_of(kPlain, *robot);
+  auto engine = make_engine("newton");
+  const double tau = 0.01;
+  Controller ctrl(*robot, *scheme, *engine, nullptr, 1.0, tau);
+  StepOutput out = ctrl.make_output();
+  const Eigen::VectorXd r = Eigen::VectorXd::Zero(robot->reference_dim());
+  Eigen::VectorXd theta = robot->home();
+  theta(0) = robot->upper_limits()(0) - 0.02;  // joint 1 near its upper limit
+  ctrl.step(theta, 0.0, r, r, out);
+  Eigen::VectorXd prev = Eigen::VectorXd::Constant(n, 0.3);
+  prev(0) = 0.5;  // moving towards that limit
+  ctrl.set_applied(prev);
+  ctrl.step(theta, tau, r, r, out);
+  const Eigen::VectorXd a_lo = accel_limit(*robot, theta, false), a_hi = accel_limit(*robot, theta, true);
+  const QpProblem& qp = ctrl.qp();
+  for (int j = 1; j < n; ++j) {  // far from the limits: prev +- tau a
+    EXPECT_NEAR(qp.lo(j), prev(j) + tau * a_lo(j), 1e-12) << "joint " << j + 1;
+    EXPECT_NEAR(qp.hi(j), prev(j) + tau * a_hi(j), 1e-12) << "joint " << j + 1;
+  }
+  // Joint 1: the braking term binds below prev + tau a^+, and braking from it at a^- stops before the limit.
+  EXPECT_LT(qp.hi(0), prev(0) + tau * a_hi(0) - 1e-3);
+  EXPECT_GE(qp.hi(0), prev(0) + tau * a_lo(0) - 1e-12);  // never asks for more than a^- to brake
+  double v = qp.hi(0), travelled = 0.0;
+  while (v > 0.0) {
+    travelled += tau * v;
+    v += tau * a_lo(0);
+  }
+  EXPECT_LE(travelled, 0.02 + 1e-12);
+  // ... and the bound is the fastest that does, with the jerk ramp counted (the Panda has jerk limits): moving on at
+  // x for tau + |a^-| / j^+, then braking at a^-.
+  Eigen::VectorXd j_lo(n), j_hi(n);
+  robot->jerk_limits(theta, j_lo, j_hi);
+  const double a = -a_lo(0), c = tau + a / j_hi(0);
+  EXPECT_NEAR(qp.hi(0), stopping_speed(0.02, a, c), 1e-12);
+  EXPECT_NEAR(c * qp.hi(0) + qp.hi(0) * qp.hi(0) / (2.0 * a), 0.02, 1e-12);
+  EXPECT_EQ(out.info.status, SolverStatus::kSolved);
+  for (int j = 0; j < n; ++j) {
+    EXPECT_NEAR(out.theta_ddot(j), (out.theta_dot(j) - prev(j)) / tau, 1e-9);
+    EXPECT_LE(out.theta_ddot(j), a_hi(j) + 1e-9);
+    EXPECT_GE(out.theta_ddot(j), a_lo(j) - 1e-9);
+  }
+}
+
+TEST(AccelerationLimits, ARobotWithoutThemIsRefusedWithTheJointNamed) {
+  const auto robot = std::make_unique<RobotModel>(load_robot(source_path("robots/paper_pushrod_6dof.toml")));
+  try {
+    (void)scheme_of(kPlain, *robot);
+    FAIL() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("acceleration_limit"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("joint 1"), std::string::npos) << e.what();
+  }
+}
+
+TEST(JerkLimits, BoundTheChangeOfAccelerationFromTheLastTwoCommands) {
+  const auto robot = panda();
+  const int n = robot->dof();
+  const auto scheme = scheme_of(R"(
+[[objectives]]
+type = "min_velocity_norm"
+[[constraints]]
+type = "joint_jerk_limits"
+[[constraints]]
+type = "joint_acceleration_limits"
+active = false
+)",
+                                *robot);
+  auto engine = make_engine("newton");
+  const double tau = 0.001;
+  Controller ctrl(*robot, *scheme, *engine, nullptr, 1.0, tau);
+  StepOutput out = ctrl.make_output();
+  const Eigen::VectorXd r = Eigen::VectorXd::Zero(robot->reference_dim());
+  const Eigen::VectorXd theta = robot->home();
+  const Eigen::VectorXd p2 = Eigen::VectorXd::Constant(n, 0.10), p1 = Eigen::VectorXd::Constant(n, 0.102);
+  ctrl.step(theta, 0.0, r, r, out);
+  ctrl.set_applied(p2);
+  ctrl.step(theta, tau, r, r, out);
+  ctrl.set_applied(p1);
+  ctrl.step(theta, 2 * tau, r, r, out);
+  Eigen::VectorXd j_lo(n), j_hi(n);
+  robot->jerk_limits(theta, j_lo, j_hi);
+  for (int j = 0; j < n; ++j) {
+    const double a_prev = (p1(j) - p2(j)) / tau;  // 2 rad/s^2
+    EXPECT_NEAR(ctrl.qp().lo(j), p1(j) + tau * (a_prev + tau * j_lo(j)), 1e-12) << "joint " << j + 1;
+    EXPECT_NEAR(ctrl.qp().hi(j), p1(j) + tau * (a_prev + tau * j_hi(j)), 1e-12) << "joint " << j + 1;
+  }
+  // The MVN answer brakes as hard as the jerk allows.
+  EXPECT_EQ(out.info.status, SolverStatus::kSolved);
+  EXPECT_NEAR(out.theta_dot(0), ctrl.qp().lo(0), 1e-9);
+}
+
+TEST(Brake, AFailedStepDeceleratesAlongThePreviousCommandWithinTheLimits) {
+  const auto robot = panda();
+  const int n = robot->dof();
+  const auto scheme = with_blocker(kPlain, *robot, 0.015, 10.0);
+  auto engine = make_engine("newton");
+  const double tau = 0.01;
+  Controller ctrl(*robot, *scheme, *engine, nullptr, 10.0, tau);
+  EXPECT_EQ(ctrl.failure_policy(), FailurePolicy::kBrake);  // the default for a robot with acceleration limits
+  StepOutput out = ctrl.make_output();
+  const Eigen::VectorXd r = Eigen::VectorXd::Zero(robot->reference_dim());
+  Eigen::VectorXd theta = robot->home();
+  ctrl.step(theta, 0.0, r, r, out);
+  EXPECT_EQ(out.info.status, SolverStatus::kSolved) << out.info.diagnosis;
+  Eigen::VectorXd prev(n);
+  prev << 0.5, -0.4, 0.3, 0.6, -0.2, 0.1, 0.7;  // the arm moves at prev (two commands: no acceleration) ...
+  ctrl.set_applied(prev);
+  ctrl.step(theta, tau, r, r, out);
+  ctrl.set_applied(prev);
+  int braked = 0;
+  for (int step = 2; step < 40; ++step) {  // ... and every later step fails
+    const double t = step * tau;
+    ctrl.step(theta, t, r, r, out);
+    ASSERT_EQ(out.info.status, SolverStatus::kBraked) << out.info.diagnosis;
+    ++braked;
+    EXPECT_NE(out.info.diagnosis.find("test_blocker"), std::string::npos) << out.info.diagnosis;
+    const Eigen::VectorXd a_lo = accel_limit(*robot, theta, false), a_hi = accel_limit(*robot, theta, true);
+    // Along the previous command: theta_dot = s prev, 0 <= s <= 1, as low as one joint's limit lets it be.
+    const double s = prev.norm() > 0.0 ? out.theta_dot.dot(prev) / prev.squaredNorm() : 0.0;
+    EXPECT_LE((out.theta_dot - s * prev).norm(), 1e-12);
+    EXPECT_GE(s, 0.0);
+    EXPECT_LE(s, 1.0);
+    bool at_limit = s == 0.0;
+    for (int j = 0; j < n; ++j) {  // never a jump
+      const double a = (out.theta_dot(j) - prev(j)) / tau;
+      EXPECT_LE(a, a_hi(j) + 1e-9) << "t = " << t << ", joint " << j + 1;
+      EXPECT_GE(a, a_lo(j) - 1e-9) << "t = " << t << ", joint " << j + 1;
+      EXPECT_NEAR(out.theta_ddot(j), a, 1e-9);
+      at_limit = at_limit || std::abs(a - a_lo(j)) < 1e-9 || std::abs(a - a_hi(j)) < 1e-9;
+    }
+    EXPECT_TRUE(at_limit) << "t = " << t << ": s = " << s << " is not the hardest braking the limits allow";
+    theta += tau * out.theta_dot;
+    prev = out.theta_dot;
+  }
+  EXPECT_EQ(braked, 38);
+  EXPECT_EQ(prev.norm(), 0.0);  // at rest: 0.7 rad/s at 20 rad/s^2 takes 4 steps, 0.4 at 7.5 takes 6
+}
+
+// A run blocked for 0.5 s brakes, then catches up: after the window the task is tracked again.
+void expect_recovery(const std::string& policy) {
+  Scenario s = load_scenario(source_path("configs/panda_helix.toml"),
+                             {"duration=6.0", "solver.on_infeasible=\"" + policy + "\""});
+  s.scheme = with_blocker(R"(
+[[objectives]]
+type = "min_velocity_norm"
+[[constraints]]
+type = "task_tracking"
+gain = 8.0
+[[constraints]]
+type = "joint_angle_margin"
+kappa = 4.0
+margin = 0.05
+[[constraints]]
+type = "joint_velocity_limits"
+[[constraints]]
+type = "joint_acceleration_limits"
+[[constraints]]
+type = "joint_jerk_limits"
+)",
+                          *s.robot, 2.0, 2.5);
+  const RunResult run = simulate(s);
+  EXPECT_EQ(run.braked_steps, 50) << policy;
+  EXPECT_EQ(run.failures, 50) << policy;
+  EXPECT_GT(run.relaxed_steps, 0) << policy << ": the catch-up relaxes the task";
+  EXPECT_EQ(run.steps_over_acceleration_limit, 0) << policy;
+  EXPECT_FALSE(run.stopped);
+  const std::size_t c = run.trajectory.column("position_error"), ct = run.trajectory.column("t");
+  double during = 0.0, late = 0.0;
+  for (std::size_t r = 0; r < run.trajectory.size(); ++r) {
+    const double t = run.trajectory(r, ct), e = run.trajectory(r, c);
+    if (t >= 2.0 && t <= 3.0) during = std::max(during, e);
+    if (t >= 4.5) late = std::max(late, e);
+  }
+  EXPECT_GT(during, 5e-3) << policy << ": the blocked arm falls behind";
+  EXPECT_LT(late, 1e-3) << policy << ": and tracks again once nothing blocks it";
+  EXPECT_LT(late, during / 20.0) << policy;
+}
+
+TEST(Brake, ARunRecoversAfterAWindowOfFailedStepsUnderBrake) { expect_recovery("brake"); }
+TEST(Brake, ARunRecoversAfterAWindowOfFailedStepsUnderRelax) { expect_recovery("relax"); }
+
+TEST(Brake, HoldIsRefusedForARobotWithAccelerationLimitsAndBrakeForOneWithout) {
+  const auto message = [](const std::filesystem::path& file, const std::vector<std::string>& o) {
+    try {
+      (void)load_scenario(file, o);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("(loaded)");
+  };
+  const std::string hold = message(source_path("configs/panda_helix.toml"), {"solver.on_infeasible=\"hold\""});
+  EXPECT_NE(hold.find("velocity jump"), std::string::npos) << hold;
+  EXPECT_NE(hold.find("on_infeasible"), std::string::npos) << hold;
+  const std::string brake = message(source_path("configs/paper_r_tvcmm.toml"), {"solver.on_infeasible=\"brake\""});
+  EXPECT_NE(brake.find("acceleration_limit"), std::string::npos) << brake;
+  const std::string heun = message(source_path("configs/panda_helix_acceleration.toml"), {"integrator=\"heun\""});
+  EXPECT_NE(heun.find("integrator"), std::string::npos) << heun;
+  Scenario paper = load_scenario(source_path("configs/paper_r_tvcmm.toml"));
+  EXPECT_EQ(paper.on_infeasible, OnInfeasible::kHold);  // the paper's runs keep their policy
+}
+
+// Every shipped scenario whose robot gives acceleration limits: no command beyond them, as shipped and with every
+// solve forced to fail (an iteration cap of 1), where every step brakes.
+TEST(NoVelocityJump, EveryShippedScenarioAndForcedFailures) {
+  int checked = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(source_path("configs"))) {
+    if (entry.path().extension() != ".toml") continue;
+    Scenario probe = load_scenario(entry.path());
+    if (!probe.robot->has_acceleration_limits()) continue;
+    // At most 600 steps of each (the same path, faster: harder on the limits).
+    const int steps = std::min(probe.steps(), 600);
+    const std::string duration = "duration=" + std::to_string(steps * probe.tau);
+    for (const bool forced : {false, true}) {
+      std::vector<std::string> o = {duration};
+      if (forced) {  // no solve converges: one projection iteration to a tolerance of 1e-14
+        o.emplace_back("solver.engine=\"projection\"");
+        o.emplace_back("solver.max_iterations=1");
+        o.emplace_back("solver.tolerance=1e-14");
+      }
+      Scenario s = load_scenario(entry.path(), o);
+      const RunResult run = simulate(s);
+      SCOPED_TRACE(entry.path().filename().string() + (forced ? " (forced failures)" : ""));
+      EXPECT_EQ(run.steps_over_acceleration_limit, 0);
+      for (double v : run.max_joint_acceleration_violation) EXPECT_LE(v, 1e-9);
+      if (forced) EXPECT_GT(run.braked_steps, 0);
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 8);  // the Panda's scenarios, twice each
+}
+
+TEST(AccelerationLevel, TheTaskHoldsOnASmoothPath) {
+  Scenario s = load_scenario(source_path("configs/panda_helix_acceleration.toml"));
+  const RunResult run = simulate(s);
+  EXPECT_EQ(run.failures, 0);
+  const std::size_t c = run.trajectory.column("position_error");
+  double worst = 0.0;
+  for (std::size_t r = 0; r < run.trajectory.size(); ++r) worst = std::max(worst, run.trajectory(r, c));
+  EXPECT_LT(worst, 1e-5);
+  EXPECT_EQ(run.steps_over_acceleration_limit, 0);
+  // theta_ddot is x, theta_dot integrates it.
+  const std::size_t a = run.trajectory.column("theta_ddot_2"), v = run.trajectory.column("theta_dot_2");
+  for (std::size_t r = 1; r < run.trajectory.size() - 1; ++r) {
+    EXPECT_NEAR(run.trajectory(r, v), run.trajectory(r - 1, v) + s.tau * run.trajectory(r, a), 1e-12);
+  }
+}
+
+// At theta with velocity v, r_d = f, r_d_dot = J v, r_d_ddot = 0: the task rows' d is -J_dot v; against central
+// differences of J along v.
+TEST(AccelerationLevel, JdotThetaDotMatchesCentralDifferences) {
+  const auto robot = panda();
+  const int n = robot->dof();
+  const auto scheme = scheme_of(R"(
+[scheme]
+level = "acceleration"
+[[objectives]]
+type = "min_acceleration_norm"
+[[constraints]]
+type = "task_tracking"
+[[constraints]]
+type = "joint_acceleration_limits"
+active = false
+[[constraints]]
+type = "joint_jerk_limits"
+active = false
+)",
+                                *robot);
+  auto engine = make_engine("newton");
+  std::mt19937 rng(25);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 10; ++trial) {
+    Controller ctrl(*robot, *scheme, *engine, nullptr, 1.0, 0.01);
+    StepOutput out = ctrl.make_output();
+    const Eigen::VectorXd theta = random_inside(*robot, rng, 0.1);
+    Eigen::VectorXd v(n);
+    for (int j = 0; j < n; ++j) v(j) = u(rng);
+    KinematicsData k(*robot), kp(*robot), km(*robot);
+    compute_kinematics(*robot, theta, k, KinematicsLevel::kJacobian);
+    const double h = 1e-6;
+    compute_kinematics(*robot, theta + h * v, kp, KinematicsLevel::kJacobian);
+    compute_kinematics(*robot, theta - h * v, km, KinematicsLevel::kJacobian);
+    const Eigen::VectorXd jdv = (kp.J - km.J) * v / (2.0 * h);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(robot->reference_dim());
+    ctrl.step(theta, 0.0, k.f, zero, zero, out);
+    ctrl.set_applied(v);  // the velocity at the next step
+    ctrl.step(theta, 0.01, k.f, k.J * v, zero, out);
+    const Eigen::VectorXd d = ctrl.qp().d;
+    ASSERT_EQ(d.size(), jdv.size());
+    EXPECT_LT((d + jdv).norm(), 1e-7 * (1.0 + jdv.norm()))
+        << "d = " << d.transpose() << "\n-J_dot v = " << -jdv.transpose();
+    EXPECT_GT(jdv.norm(), 1e-3);  // a real test: the term is not zero
+  }
+}
+
+// MAN at the acceleration level (W = I, zeta = damping theta_dot, J x = d, bounds on x) at random states: the
+// controller's answer meets the KKT conditions and equals NLopt's.
+TEST(AccelerationLevel, MinimumAccelerationNormAgreesWithAnIndependentSolve) {
+  const auto robot = panda();
+  const int n = robot->dof();
+  const auto scheme = scheme_of(R"(
+[scheme]
+level = "acceleration"
+[[objectives]]
+type = "min_acceleration_norm"
+damping = 2.0
+[[constraints]]
+type = "task_tracking"
+[[constraints]]
+type = "joint_velocity_limits"
+[[constraints]]
+type = "joint_acceleration_limits"
+)",
+                                *robot);
+  auto engine = make_engine("newton");
+  auto nlopt = make_engine("nlopt");
+  std::mt19937 rng(2025);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int compared = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    Controller ctrl(*robot, *scheme, *engine, nullptr, 1.0, 0.01);
+    StepOutput out = ctrl.make_output();
+    const Eigen::VectorXd theta = random_inside(*robot, rng, 0.3);
+    Eigen::VectorXd v(n);
+    for (int j = 0; j < n; ++j) v(j) = 0.3 * u(rng);
+    KinematicsData k(*robot);
+    compute_kinematics(*robot, theta, k, KinematicsLevel::kJacobian);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(robot->reference_dim());
+    Eigen::VectorXd r_d_dot = k.J * v, r_d_ddot(robot->reference_dim());
+    for (int r = 0; r < r_d_ddot.size(); ++r) r_d_ddot(r) = 0.5 * u(rng);
+    ctrl.step(theta, 0.0, k.f, zero, zero, out);
+    ctrl.set_applied(v);
+    ctrl.step(theta, 0.01, k.f, r_d_dot, r_d_ddot, out);
+    if (out.info.status != SolverStatus::kSolved) continue;
+    const QpProblem& qp = ctrl.qp();
+    EXPECT_TRUE(qp.zeta.isApprox(2.0 * v, 1e-12));  // damping theta_dot
+    EXPECT_LT(testing::kkt_residual(qp, ctrl.result()), 1e-7);
+    SolverResult other;
+    nlopt->setup(qp.n(), qp.m_eq(), qp.m_in(), other);
+    nlopt->solve(qp, other);
+    ASSERT_EQ(other.info.status, SolverStatus::kSolved) << other.info.diagnosis;
+    EXPECT_LT((other.x - out.theta_ddot).norm(), 1e-5 * (1.0 + out.theta_ddot.norm()));
+    EXPECT_TRUE(out.theta_dot.isApprox(v + 0.01 * out.theta_ddot, 1e-12));
+    ++compared;
+  }
+  EXPECT_GE(compared, 15);
+}
+
+}  // namespace
+}  // namespace redres

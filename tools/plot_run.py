@@ -12,6 +12,7 @@ Per run:
                             collision shapes, (b) desired path and trajectory, (c) theta_dot, (d) theta
   fig6_joint_angles.png     each theta with its limits and its safety region
   fig7_joint_velocities.png each theta_dot with its velocity limits and the merged bounds
+  fig_joint_accelerations.png  (robots with acceleration limits) each commanded theta_ddot with its limits
   fig9b_position_error.png  the position error over time (and the orientation error, for pose tasks)
   fig_collision_distances.png  (runs with obstacle_avoidance or self_collision) the smallest distances over time,
                             with each plugin's safety and influence distances
@@ -541,6 +542,26 @@ def fig_velocities(run_dir, data, n, name):
                  "rad/s", draw)
 
 
+def fig_accelerations(run_dir, data, n, name):
+    """The commanded accelerations (theta_ddot_j) against the robot's acceleration limits (acc_lo_j, acc_hi_j), for
+    robots that give them; runs of other robots, and runs of redres before it recorded theta_ddot, draw nothing."""
+    columns = data.dtype.names
+    if "theta_ddot_1" not in columns or "acc_hi_1" not in columns:
+        return
+    t = data["t"]
+
+    def draw(ax, j):
+        ax.plot(t, data[f"theta_ddot_{j}"], "b", lw=0.8, label=rf"$\ddot\theta_{j}$ commanded")
+        ax.plot(t, data[f"acc_hi_{j}"], "r", lw=1, label="acceleration limits")
+        ax.plot(t, data[f"acc_lo_{j}"], "r", lw=1)
+        span = max(np.abs(data[f"acc_hi_{j}"]).max(), np.abs(data[f"acc_lo_{j}"]).max())
+        ax.set_ylim(-1.15 * span, 1.15 * span)
+        return rf"$\ddot\theta_{j}$ and limits"
+
+    joint_panels(run_dir, n, name, "commanded joint accelerations and acceleration limits", "fig_joint_accelerations.png",
+                 "rad/s$^2$", draw)
+
+
 def fig_error(run_dir, data, name):
     """The position error, and for pose tasks the orientation error (the angle of R_d R') below it."""
     pose = "orientation_error" in data.dtype.names
@@ -611,6 +632,7 @@ def plot_run(run_dir, quiet):
     fig_task(run_dir, data, summary, load_frames(run_dir, summary), n, name)
     fig_angles(run_dir, data, summary, n, name)
     fig_velocities(run_dir, data, n, name)
+    fig_accelerations(run_dir, data, n, name)
     fig_error(run_dir, data, name)
     fig_distances(run_dir, data, summary, name)
     if not quiet:

@@ -81,6 +81,11 @@ expect_animation("spatial --animate, no ffmpeg" ${WORK_DIR}/python animation.gif
                  run ${spatial} --out ${WORK_DIR}/spatial --animate)
 expect_animation("[output] animate = true, no ffmpeg" ${WORK_DIR}/python animation.gif
                  run ${planar} --set output.animate=true --out ${WORK_DIR}/planar-key)
+# --plots on a robot with acceleration limits draws the commanded accelerations against them.
+redres(${WORK_DIR}/python run ${spatial} --out ${WORK_DIR}/spatial-plots --plots --quiet)
+if(NOT code EQUAL 0 OR NOT EXISTS ${WORK_DIR}/spatial-plots/fig_joint_accelerations.png)
+  message(FATAL_ERROR "--plots on the Panda made no fig_joint_accelerations.png (${code}):\n${out}\n${err}")
+endif()
 # With ffmpeg on the system, an MP4, which replaces the GIF an earlier run left.
 find_program(ffmpeg ffmpeg)
 if(ffmpeg)

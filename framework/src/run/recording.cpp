@@ -64,6 +64,8 @@ RowRecorder::RowRecorder(const Scenario& s, const Controller& ctrl, std::vector<
   }
   standard_columns_ = recorders_.empty() ? width : recorders_.front().first;
   orientation_rows_ = robot_->has_orientation_rows();
+  acc_lo_.resize(n_);
+  acc_hi_.resize(n_);
   spatial_orientation_ = orientation_rows_ && robot_->kind() == ChainKind::kSpatial;
   for (int r = 0; r < m_; ++r) (r < position_rows_ ? all_position_rows_ : all_orientation_rows_) &= robot_->tracks(r);
 }
@@ -138,6 +140,14 @@ const double* RowRecorder::write(int k, double t, const Eigen::VectorXd& theta, 
       case StepValue::kLawUpper: put(vhi); break;
       case StepValue::kStatus: row[c++] = static_cast<double>(static_cast<int>(out.info.status)); break;
       case StepValue::kThetaDdot: put(out.theta_ddot); break;
+      case StepValue::kAccelerationLower:
+        if (!robot_->has_acceleration_limits()) break;
+        robot_->acceleration_limits(kin.theta, acc_lo_, acc_hi_);
+        put(acc_lo_);
+        break;
+      case StepValue::kAccelerationUpper:
+        if (robot_->has_acceleration_limits()) put(acc_hi_);  // evaluated with the lower ones
+        break;
     }
   }
   for (const Recorder& r : recorders_) r.output->record(r.data, row + r.first);

@@ -61,6 +61,7 @@ class RowRecorder {
   int n_ = 0, m_ = 0, position_rows_ = 0;
   bool orientation_rows_ = false, spatial_orientation_ = false, all_position_rows_ = true, all_orientation_rows_ = true;
   Eigen::Vector3d wd_prev_ = Eigen::Vector3d::Zero(), w_prev_ = Eigen::Vector3d::Zero();
+  Eigen::VectorXd acc_lo_, acc_hi_;  // the acceleration laws at theta (robots with acceleration limits)
 };
 
 /// The run's log of step outcomes, kept in its RunResult.

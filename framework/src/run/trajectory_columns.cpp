@@ -44,6 +44,10 @@ const std::vector<TrajectoryColumnGroup>& trajectory_column_groups() {
        "the commanded acceleration: (theta_dot - theta_dot_prev) / tau at the velocity level, x at the acceleration "
        "level (where `lo_`, `hi_` and `theta_dot_` are then x's bounds in rad/s^2 and the velocity command)",
        V::kThetaDdot},
+      {"acc_lo_", C::kPerJointIfAccelerationLimits, "rad/s^2 or m/s^2",
+       "robots with acceleration limits only: the robot's acceleration-limit laws at theta, lower (not scaled)",
+       V::kAccelerationLower},
+      {"acc_hi_", C::kPerJointIfAccelerationLimits, "rad/s^2 or m/s^2", "the same, upper", V::kAccelerationUpper},
   };
   return groups;
 }
@@ -62,6 +66,10 @@ std::vector<std::string> standard_trajectory_columns(const RobotModel& robot) {
         break;
       case ColumnCount::kIfOrientation:
         if (robot.has_orientation_rows()) cols.push_back(name);
+        break;
+      case ColumnCount::kPerJointIfAccelerationLimits:
+        if (!robot.has_acceleration_limits()) break;
+        for (int j = 1; j <= robot.dof(); ++j) cols.push_back(name + std::to_string(j));
         break;
     }
   }
@@ -82,6 +90,10 @@ std::string trajectory_columns_markdown() {
       case ColumnCount::kPerJoint:
         columns = "`" + name + "1` .. `" + name + "n`";
         count = "n";
+        break;
+      case ColumnCount::kPerJointIfAccelerationLimits:
+        columns = "`" + name + "1` .. `" + name + "n`";
+        count = "n or 0";
         break;
       case ColumnCount::kPerReference:
         columns = "`" + name + "<row>`";

@@ -18,7 +18,8 @@ enum class ColumnCount {
   kOne,           //!< one column, named `name`
   kPerJoint,      //!< n columns, `name`1 .. `name`n
   kPerReference,  //!< one per reference row, `name`<row> (x, y, phi; x, y, z, wx, wy, wz)
-  kIfOrientation  //!< one column, only for tasks with orientation rows
+  kIfOrientation,  //!< one column, only for tasks with orientation rows
+  kPerJointIfAccelerationLimits  //!< n columns, only for robots with acceleration limits on every joint
 };
 
 /// Which value of a step fills a group.
@@ -38,7 +39,9 @@ enum class StepValue {
   kLawLower,
   kLawUpper,
   kStatus,
-  kThetaDdot
+  kThetaDdot,
+  kAccelerationLower,
+  kAccelerationUpper
 };
 
 /// One group of standard columns.

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "alloc_counter.hpp"
 #include "qp_util.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/constraints/joint_acceleration_limits.hpp"
@@ -427,6 +428,53 @@ type = "joint_acceleration_limits"
     ++compared;
   }
   EXPECT_GE(compared, 15);
+}
+
+// The per-step path of the new machinery allocates nothing: the acceleration and jerk constraints with relaxed steps
+// (the 10x helix), braked steps (every solve failing), measured velocities, and the acceleration level.
+TEST(MotionRealTime, StepsWithLimitsBrakingAndTheAccelerationLevelAllocateNothing) {
+  if (!testing::allocation_counting_available()) {
+    GTEST_SKIP() << "AddressSanitizer owns malloc here; the release build runs this check";
+  }
+  struct Case {
+    const char* config;
+    std::vector<std::string> overrides;
+    SolverStatus expect;  // a status the case must see
+  };
+  const std::vector<Case> cases = {
+      {"configs/panda_helix_fast.toml", {}, SolverStatus::kRelaxed},
+      {"configs/panda_helix_fast.toml",
+       {"solver.engine=\"projection\"", "solver.max_iterations=1", "solver.tolerance=1e-14",
+        "solver.on_infeasible=\"brake\""},
+       SolverStatus::kBraked},
+      {"configs/panda_helix_acceleration.toml", {}, SolverStatus::kSolved},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.config);
+    Scenario s = load_scenario(source_path(c.config), c.overrides);
+    const auto ctrl = Controller::from_scenario(s);
+    StepOutput out = ctrl->make_output();
+    Eigen::VectorXd theta = s.theta0, velocity = Eigen::VectorXd::Zero(s.robot->dof());
+    ctrl->step(theta, 0.0, out);
+    long allocations = 0;
+    int seen = 0;
+    for (int k = 1; k < 1500; ++k) {
+      {
+        const testing::AllocationCounter counter;
+        if (k % 2 == 0) {
+          ctrl->step(theta, velocity, k * s.tau, out);
+        } else {
+          ctrl->step(theta, k * s.tau, out);
+        }
+        allocations += counter.count();
+      }
+      seen += out.info.status == c.expect ? 1 : 0;
+      theta += s.tau * out.theta_dot;
+      velocity = out.theta_dot;
+    }
+    EXPECT_GT(seen, 0) << "the case makes " << to_string(c.expect) << " steps";
+    EXPECT_EQ(allocations, 0);
+  }
 }
 
 }  // namespace

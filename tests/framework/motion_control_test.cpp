@@ -430,6 +430,43 @@ type = "joint_acceleration_limits"
   EXPECT_GE(compared, 15);
 }
 
+// Runs of robots without motion limits (the paper's among them) keep their policy and their numbers: theta(T) as the
+// code before the motion limits computed it, recorded from its release build. Bit for bit in an optimised build
+// (NDEBUG, what CI's release job and `redres run` use); an unoptimised one may round differently, so 1e-12 there.
+TEST(VelocityLevel, RunsWithoutMotionLimitsAreUnchangedBitForBit) {
+  struct Reference {
+    const char* config;
+    std::vector<double> final_theta;
+  };
+  const std::vector<Reference> references = {
+      {"configs/paper_r_tvcmm.toml",
+       {0x1.d3c39c5757276p-1, 0x1.63f145fd6ea07p-4, 0x1.c2b49cd03c64ap-3, 0x1.84a996c5a720cp-2, 0x1.fff084deeaadfp-3,
+        0x1.268cef5e1d28fp-4}},
+      {"configs/paper_r_obstacle.toml",
+       {0x1.d3c5a50691e1cp-1, 0x1.63f145fd647ddp-4, 0x1.c282f85e76b2fp-3, 0x1.84d13a18a6007p-2, 0x1.ffabaabd9fe0bp-3,
+        0x1.2707ef6bb7a98p-4}},
+      {"configs/iiwa_pose_circle.toml",
+       {0x1.3c3c49bb3d9a8p-11, 0x1.0c1502476d6a6p-1, -0x1.b7e2f2a5986aap-11, -0x1.921fa5f1f86bfp+0,
+        0x1.fbef7984dd610p-12, 0x1.0c1546db50909p+0, -0x1.7f66eb6ea08e4p-12}},
+  };
+  for (const Reference& ref : references) {
+    SCOPED_TRACE(ref.config);
+    Scenario s = load_scenario(source_path(ref.config));
+    EXPECT_FALSE(s.robot->has_acceleration_limits());
+    EXPECT_EQ(s.on_infeasible, OnInfeasible::kHold);
+    const RunResult run = simulate(s);
+    const Eigen::VectorXd theta = recorded_theta(*s.robot, run.trajectory, run.trajectory.size() - 1);
+    ASSERT_EQ(theta.size(), static_cast<Eigen::Index>(ref.final_theta.size()));
+    for (Eigen::Index j = 0; j < theta.size(); ++j) {
+#ifdef NDEBUG
+      EXPECT_EQ(theta(j), ref.final_theta[static_cast<std::size_t>(j)]) << "joint " << j + 1;
+#else
+      EXPECT_NEAR(theta(j), ref.final_theta[static_cast<std::size_t>(j)], 1e-12) << "joint " << j + 1;
+#endif
+    }
+  }
+}
+
 // The per-step path of the new machinery allocates nothing: the acceleration and jerk constraints with relaxed steps
 // (the 10x helix), braked steps (every solve failing), measured velocities, and the acceleration level.
 TEST(MotionRealTime, StepsWithLimitsBrakingAndTheAccelerationLevelAllocateNothing) {

@@ -344,8 +344,12 @@ void Controller::brake(StepOutput& out) {
     s_min = std::max(s_min, s1);
     s_max = std::min(s_max, s2);
   };
+  // A joint whose limits are not finite here (a law outside its range) or whose velocity is not finite sets nothing.
+  const auto usable_joint = [&](int j) {
+    return b(j) != 0.0 && std::isfinite(b(j)) && std::isfinite(lim_lo_(j)) && std::isfinite(lim_hi_(j));
+  };
   for (int j = 0; j < robot_->dof(); ++j) {
-    if (b(j) == 0.0) continue;
+    if (!usable_joint(j)) continue;
     const double before = s_lo;
     within(j, lim_lo_(j), lim_hi_(j), s_lo, s_hi);
     if (s_lo > before) decides = j;
@@ -361,7 +365,7 @@ void Controller::brake(StepOutput& out) {
     double lo = s_lo, hi = s_hi;
     int jerk_decides = decides;
     for (int j = 0; j < robot_->dof(); ++j) {
-      if (b(j) == 0.0) continue;
+      if (!usable_joint(j)) continue;
       // The acceleration (s - 1) b_j / tau within a_prev + tau [j^-, j^+].
       const double a_prev = (prev_(j) - prev2_(j)) / tau;
       const double before = lo;
@@ -377,6 +381,9 @@ void Controller::brake(StepOutput& out) {
     }
   }
   out.theta_dot = s * b;
+  for (int j = 0; j < robot_->dof(); ++j) {
+    if (!std::isfinite(out.theta_dot(j))) out.theta_dot(j) = 0.0;  // never a non-finite command
+  }
   out.theta_ddot = (out.theta_dot - b) / tau;
   out.task_row_error = 0.0;
   note_.assign(out.info.diagnosis);

@@ -23,6 +23,7 @@
 #include "redres/run/comparison.hpp"
 #include "redres/run/run_output.hpp"
 #include "redres/run/scenario.hpp"
+#include "redres/run/start_check.hpp"
 #include "stop_signals.hpp"
 
 namespace redres::cli {
@@ -101,10 +102,19 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet,
   return o;
 }
 
+// The checked start (run/start_check.hpp): every problem of theta(0) at once, exit code 2, before anything is
+// written.
+StartReport checked_start(Scenario& s, const std::string& file) {
+  StartReport report = check_start(s);
+  if (!report.ok()) throw std::runtime_error(file + ": the start is not usable:\n" + report.text());
+  return report;
+}
+
 // `redres run`: one scenario, its files, and the figures or the animation asked for.
 int run_scenario(const RunOptions& options) {
   const RunOptions* const opts = &options;
   Scenario scenario = load_scenario(opts->scenarios.front(), opts->overrides);
+  (void)checked_start(scenario, opts->scenarios.front());
   RecordOptions record = scenario.record;
   if (!opts->record.empty()) {
     try {
@@ -152,11 +162,15 @@ int run_scenario(const RunOptions& options) {
 // `redres validate`: loads a scenario (every check of a run's set-up) and says what it holds.
 int validate_scenario(const RunOptions& options) {
   const RunOptions* const opts = &options;
-  const Scenario s = load_scenario(opts->scenarios.front(), opts->overrides);
+  Scenario s = load_scenario(opts->scenarios.front(), opts->overrides);
+  const StartReport start = checked_start(s, opts->scenarios.front());
   std::cout << opts->scenarios.front() << ": ok: '" << s.name << "', robot " << s.robot->name() << " ("
             << s.robot->dof() << " joints), " << s.steps() << " steps of " << s.tau << " s, path "
             << s.path->description() << ", " << s.scheme->objectives().size() << " objective(s), "
             << s.scheme->constraints().size() << " constraint(s), engine " << s.engine->name() << "\n";
+  std::cout << "start: within limits, no collision, task rows' smallest singular value " << start.sigma_min
+            << " (w = " << start.w << "), path " << start.path_offset << " m from the end effector (checked in "
+            << start.seconds << " s)\n";
   return kExitOk;
 }
 
@@ -172,6 +186,7 @@ int compare_scenarios(const RunOptions& options) {
   std::vector<std::string> dirs;
   for (const auto& file : opts->scenarios) {
     scenarios.push_back(load_scenario(file, opts->overrides));
+    (void)checked_start(scenarios.back(), file);
     const std::string stem = std::filesystem::path(file).stem().string();
     std::string name = stem;
     for (int k = 2; std::find(dirs.begin(), dirs.end(), name) != dirs.end(); ++k) {

@@ -444,12 +444,20 @@ TEST(OnInfeasibleCli, TheDiagnosisGoesToStderrWithQuietAndTheExitCodeFollowsTheP
   const auto dir = file.parent_path();
   const std::string base = "run '" + file.string() + "' --out '" + (dir / "out").string() + "' --quiet";
   for (const char* policy : {"hold", "stop"}) {
-    const int code = run_cli(base + " --set solver.on_infeasible=" + policy, dir / "stdout", dir / "stderr");
-    const std::string err = slurp(dir / "stderr");
+    // The stretched start is singular for the task: refused before the run (exit 2), with a way out.
+    int code = run_cli(base + " --set solver.on_infeasible=" + policy, dir / "stdout", dir / "stderr");
+    std::string err = slurp(dir / "stderr");
+    EXPECT_EQ(code, 2) << policy << ": " << err;
+    EXPECT_NE(err.find("is singular for the task"), std::string::npos) << err;
+    EXPECT_NE(err.find("relax"), std::string::npos) << err;
+    // Bent, it is not singular (the check passes), but a circle in 0.1 s is beyond its velocity limits: exit 1.
+    code = run_cli(base + " --set solver.on_infeasible=" + policy + " --set 'theta0=[0, 0.5, 0.5, 0.5]' --set duration=0.1",
+                   dir / "stdout", dir / "stderr");
+    err = slurp(dir / "stderr");
     EXPECT_EQ(code, 1) << policy << ": " << err;
     EXPECT_EQ(slurp(dir / "stdout"), "") << policy;
     EXPECT_NE(err.find("failed step"), std::string::npos) << err;
-    EXPECT_NE(err.find("first failure: t = 0.01 s: numerical_error"), std::string::npos) << err;
+    EXPECT_NE(err.find("first failure: t = 0.02 s: infeasible"), std::string::npos) << err;
     EXPECT_NE(err.find("on_infeasible = \"" + std::string(policy) + "\""), std::string::npos) << err;
   }
   const int code = run_cli(base + " --set solver.on_infeasible=relax", dir / "stdout", dir / "stderr");

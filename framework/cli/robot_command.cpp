@@ -65,6 +65,13 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
                       {"velocity_law", jt.velocity_limit->describe()},
                       {"velocity_limits", {lo(j), hi(j)}}});
   }
+  nlohmann::json shapes = nlohmann::json::array();
+  for (const auto& shape : model.link_shapes()) {
+    shapes.push_back({{"joint", shape.link + 1},
+                      {"joint_name", model.joint(shape.link).name},
+                      {"shape", shape.spec.describe()},
+                      {"position", to_vector(shape.pose.translation())}});
+  }
   nlohmann::json J = nlohmann::json::array();
   for (Eigen::Index r = 0; r < k.J.rows(); ++r) J.push_back(to_vector(k.J.row(r).transpose()));
   return {{"name", model.name()},
@@ -74,6 +81,7 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
           {"reference", model.reference_names()},
           {"source", model.source()},
           {"joints", joints},
+          {"collision_shapes", shapes},
           {"theta", to_vector(k.theta)},
           {"f", to_vector(k.f)},
           {"J", J},
@@ -118,6 +126,12 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
   for (int j = 0; j < model.dof(); ++j) {
     o << std::setw(5) << j + 1 << "  " << std::setprecision(9) << std::setw(14) << lo(j) << "  " << std::setw(14)
       << hi(j) << "\n";
+  }
+  o << "\ncollision shapes (" << model.link_shapes().size() << "), in their link's frame\n";
+  if (model.link_shapes().empty()) o << "  none\n";
+  for (const auto& shape : model.link_shapes()) {
+    o << std::setw(5) << shape.link + 1 << "  " << std::left << std::setw(12) << model.joint(shape.link).name
+      << std::right << "  " << shape.spec.describe() << "\n";
   }
 }
 

@@ -12,6 +12,7 @@
 #include "common/text.hpp"
 #include "model/transforms.hpp"
 #include "parsers/urdf.hpp"
+#include "redres/model/mesh.hpp"
 #include "redres/config/plugin_loader.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
 
@@ -308,6 +309,8 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
 // (`replace = true`, the default) or add to the URDF's.
 struct RobotReading {
   RobotSpec spec;
+  std::string collision_model = "capsule";  // what a mesh collision element becomes (per link: [[links]])
+  PackagePaths packages;                     // `packages`: where package://NAME/ is
   bool from_urdf = false;
   std::filesystem::path urdf;
   std::string base_link, tip_link;
@@ -368,6 +371,7 @@ struct LinkEntry {
   std::string name;
   bool replace = true;
   std::vector<ShapeSpec> collision;
+  std::string collision_model;  // empty: the robot's
   static const Schema<LinkEntry>& schema() {
     using C = LinkEntry;
     static const Schema<C> s{{
@@ -375,6 +379,11 @@ struct LinkEntry {
         field("replace", &C::replace, "", "the shapes replace the URDF's collision elements (false: add to them)"),
         field("collision", &C::collision, "", "the link's shapes, in the link's frame (capsules need `length`)")
             .listed_default("[] (none)"),
+        field("collision_model", &C::collision_model, "",
+              "what this link's mesh collision elements become: \"capsule\" or \"none\" (default: the robot's)",
+              rule<std::string>("\"capsule\" or \"none\"",
+                                [](const std::string& v) { return v == "capsule" || v == "none"; }))
+            .listed_default("the robot's `collision_model`"),
     }};
     return s;
   }
@@ -390,15 +399,19 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
       },
       "link", "link",
       " that moves with the chain from '" + c.base_link + "' to '" + c.tip_link + "' in " + c.urdf.string());
+  std::vector<std::string> problems;  // every mesh that cannot be used, reported together
+  const std::filesystem::path base_dir = c.urdf.parent_path();
   for (const UrdfLink& link : c.chain.links) {
     JointSpec& jt = c.spec.joints[static_cast<std::size_t>(link.joint)];
     const auto e = link_entries.find(link.name);
     bool replace = false;
+    std::string model = c.collision_model;
     if (e != link_entries.end()) {
       const TableReader entry(e->second.file_ptr(), e->second.raw(), "link '" + link.name + "'");
       LinkEntry links;
       read_config(entry, LinkEntry::schema(), links);
       replace = links.replace;
+      if (!links.collision_model.empty()) model = links.collision_model;
       for (std::size_t k = 0; k < links.collision.size(); ++k) {
         const ShapeSpec& shape = links.collision[k];
         if (shape.shape == ShapeSpec::Kind::kCapsule && !shape.length && !shape.from) {
@@ -414,13 +427,28 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
       entry.finish();
     }
     if (replace) continue;
-    if (!link.meshes.empty()) {
-      r.fail("urdf", "link '" + link.name + "' in " + c.urdf.string() + " has a mesh collision element ('" +
-                         link.meshes.front() +
-                         "'), which redres does not read: give the link's shapes in a [[links]] entry (replace = "
-                         "true), e.g. capsules");
-    }
     for (const ShapeSpec& shape : link.shapes) jt.collision.push_back(shape.placed(link.pose));
+    if (model == "none") continue;
+    // Mesh collision elements: a capsule fitted to each mesh, every piece of it (a file's meshes, e.g. an OBJ's
+    // material groups, or a convex decomposition's pieces) together.
+    for (const UrdfMesh& mesh : link.meshes) {
+      try {
+        const MeshData data = read_mesh(resolve_mesh(mesh.filename, base_dir, c.packages), mesh.scale);
+        std::vector<Eigen::Vector3d> all;
+        all.reserve(data.vertex_count());
+        for (const auto& piece : data.pieces) all.insert(all.end(), piece.begin(), piece.end());
+        jt.collision.push_back(fit_capsule(all).placed(link.pose * mesh.pose));
+      } catch (const std::exception& ex) {
+        problems.push_back("link '" + link.name + "': " + ex.what());
+      }
+    }
+  }
+  if (!problems.empty()) {
+    std::string all = std::to_string(problems.size()) + " mesh" + (problems.size() == 1 ? "" : "es") +
+                      " of " + c.urdf.string() + " cannot be used:";
+    for (const std::string& p : problems) all += "\n  " + p;
+    all += "\n(give a link's shapes in a [[links]] entry, or set its `collision_model = \"none\"`)";
+    r.fail("urdf", all);
   }
 }
 
@@ -483,6 +511,26 @@ const Schema<RobotReading>& RobotReading::schema() {
       entry<C>("tip_link", "string", "", "none; required with `urdf`",
                "the URDF link the chain ends at (required with `urdf`)",
                [](const TableReader& r, C& c) { only_with_urdf(r, c, "tip_link", ""); }),
+      entry<C>("collision_model", "\"capsule\" or \"none\"", "", "\"capsule\"",
+               "what a URDF's mesh collision elements become: a capsule fitted to each mesh (all its pieces "
+               "together) or nothing; a [[links]] entry may set its own (docs/robot_format.md, \"Meshes\")",
+               [](const TableReader& r, C& c) {
+                 if (!r.has("collision_model")) return;
+                 only_with_urdf(r, c, "collision_model", "");
+                 c.collision_model = r.choice("collision_model", {"capsule", "none"});
+               }),
+      entry<C>("packages", "table { NAME = \"dir\" }", "", "none",
+               "where a URDF's package://NAME/ paths are, relative to this file (before REDRES_PACKAGE_PATH, "
+               "ROS_PACKAGE_PATH and the URDF's own directory)",
+               [](const TableReader& r, C& c) {
+                 if (!r.has("packages")) return;
+                 only_with_urdf(r, c, "packages", "");
+                 const TableReader t = r.table("packages");
+                 for (const auto& [key, value] : t.raw()) {
+                   const std::string name(key.str());
+                   c.packages.named[name] = t.path(name);
+                 }
+               }),
       entry<C>("name", "string", "", "the URDF's; required without `urdf`", "the robot's name",
                [](const TableReader& r, C& c) {
                  if (c.from_urdf) {

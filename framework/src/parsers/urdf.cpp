@@ -225,7 +225,18 @@ void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometr
         check_length(who, "<cylinder> length", cyl.length, true);
         break;
       }
-      case urdf::Geometry::MESH: out.meshes.push_back(static_cast<const urdf::Mesh&>(*c->geometry).filename); continue;
+      case urdf::Geometry::MESH: {
+        const auto& mesh = static_cast<const urdf::Mesh&>(*c->geometry);
+        UrdfMesh m;
+        m.filename = mesh.filename;
+        m.scale = Eigen::Vector3d(mesh.scale.x, mesh.scale.y, mesh.scale.z);
+        if (!m.scale.allFinite() || (m.scale.array() <= 0.0).any()) {
+          throw UrdfError(who + ": <mesh> scale expected > 0 on every axis");
+        }
+        m.pose = pose;
+        out.meshes.push_back(std::move(m));
+        continue;
+      }
     }
     out.shapes.push_back(s);
   }

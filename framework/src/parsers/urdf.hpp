@@ -40,13 +40,20 @@ struct UrdfJoint {
   double effort = 0.0;                                       //!< effort limit (N m or N); 0 if not given
 };
 
+/// A mesh collision element: the file as the URDF names it, its scale, and its pose in the joint's link frame.
+struct UrdfMesh {
+  std::string filename;                                    //!< as written (package://..., file://..., or a path)
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();         //!< the <mesh scale="...">
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< the mesh's frame in the link's frame
+};
+
 /// A link of the chain that moves with a joint: its shapes, placed in that joint's link frame.
 struct UrdfLink {
   std::string name;                                        //!< the link's name
   int joint = 0;                                           //!< index of the moving joint it rides on (0-based)
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< the link's frame in that joint's link frame
   std::vector<ShapeSpec> shapes;                           //!< its sphere, box and cylinder collision elements
-  std::vector<std::string> meshes;                         //!< the file names of its mesh collision elements
+  std::vector<UrdfMesh> meshes;                            //!< its mesh collision elements
 };
 
 /// The chain from `base_link` to `tip_link`.

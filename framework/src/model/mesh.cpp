@@ -1,0 +1,197 @@
+#include "redres/model/mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <assimp/Importer.hpp>
+#include <Eigen/Eigenvalues>
+
+namespace redres {
+
+std::size_t MeshData::vertex_count() const {
+  std::size_t n = 0;
+  for (const auto& p : pieces) n += p.size();
+  return n;
+}
+
+std::vector<std::filesystem::path> PackagePaths::from_environment() {
+  std::vector<std::filesystem::path> dirs;
+  for (const char* var : {"REDRES_PACKAGE_PATH", "ROS_PACKAGE_PATH"}) {
+    const char* value = std::getenv(var);
+    if (value == nullptr) continue;
+    std::stringstream in(value);
+    std::string item;
+    while (std::getline(in, item, ':')) {
+      if (!item.empty()) dirs.emplace_back(item);
+    }
+  }
+  return dirs;
+}
+
+std::filesystem::path resolve_mesh(const std::string& uri, const std::filesystem::path& base_dir,
+                                   const PackagePaths& packages) {
+  namespace fs = std::filesystem;
+  const std::string package = "package://", file = "file://";
+  std::vector<fs::path> tried;
+  const auto found = [&tried](const fs::path& p) {
+    tried.push_back(p);
+    std::error_code ec;
+    return fs::is_regular_file(p, ec);
+  };
+  if (uri.rfind(package, 0) == 0) {
+    const std::string rest = uri.substr(package.size());
+    const auto slash = rest.find('/');
+    if (slash == std::string::npos || slash == 0) {
+      throw std::runtime_error("mesh '" + uri + "': expected package://NAME/path");
+    }
+    const std::string name = rest.substr(0, slash), inside = rest.substr(slash + 1);
+    if (const auto it = packages.named.find(name); it != packages.named.end()) {
+      if (found(it->second / inside)) return tried.back();
+    }
+    for (const fs::path& dir : PackagePaths::from_environment()) {
+      if (found(dir / name / inside)) return tried.back();
+    }
+    if (found(base_dir / name / inside)) return tried.back();
+  } else if (uri.rfind(file, 0) == 0) {
+    if (found(fs::path(uri.substr(file.size())))) return tried.back();
+  } else {
+    const fs::path p(uri);
+    if (found(p.is_absolute() ? p : base_dir / p)) return tried.back();
+  }
+  std::string where;
+  for (const fs::path& p : tried) where += (where.empty() ? "" : ", ") + p.string();
+  throw std::runtime_error("mesh '" + uri + "' not found (looked at " + where +
+                           "; a package's directory can be given in the robot file's `packages` table or "
+                           "REDRES_PACKAGE_PATH)");
+}
+
+namespace {
+
+void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent, const Eigen::Vector3d& scale,
+             MeshData& out, int depth) {
+  if (depth > 64) throw std::runtime_error("mesh '" + out.file.string() + "': its scene is nested too deeply");
+  const aiMatrix4x4 at = parent * node.mTransformation;
+  for (unsigned k = 0; k < node.mNumMeshes; ++k) {
+    const aiMesh& mesh = *scene.mMeshes[node.mMeshes[k]];
+    std::vector<Eigen::Vector3d> piece;
+    piece.reserve(mesh.mNumVertices);
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      const aiVector3D p = at * mesh.mVertices[v];
+      const Eigen::Vector3d q(scale.x() * p.x, scale.y() * p.y, scale.z() * p.z);
+      if (!q.allFinite()) throw std::runtime_error("mesh '" + out.file.string() + "': a vertex is not finite");
+      piece.push_back(q);
+    }
+    if (!piece.empty()) out.pieces.push_back(std::move(piece));
+  }
+  for (unsigned c = 0; c < node.mNumChildren; ++c) collect(scene, *node.mChildren[c], at, scale, out, depth + 1);
+}
+
+// The smallest circle enclosing 2-D points (Welzl's algorithm, iterative, points shuffled with a fixed seed).
+struct Circle {
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  double r = 0.0;
+  [[nodiscard]] bool holds(const Eigen::Vector2d& p) const { return (p - c).norm() <= r * (1.0 + 1e-12) + 1e-15; }
+};
+
+Circle circle_of(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return {(a + b) / 2.0, (a - b).norm() / 2.0}; }
+
+Circle circle_of(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const Eigen::Vector2d ab = b - a, ac = c - a;
+  const double d = 2.0 * (ab.x() * ac.y() - ab.y() * ac.x());
+  if (std::abs(d) < 1e-300) {  // collinear: the widest pair
+    Circle best = circle_of(a, b);
+    for (const Circle& k : {circle_of(a, c), circle_of(b, c)}) {
+      if (k.r > best.r) best = k;
+    }
+    return best;
+  }
+  const double b2 = ab.squaredNorm(), c2 = ac.squaredNorm();
+  const Eigen::Vector2d u((ac.y() * b2 - ab.y() * c2) / d, (ab.x() * c2 - ac.x() * b2) / d);
+  return {a + u, u.norm()};
+}
+
+Circle enclosing_circle(std::vector<Eigen::Vector2d> p) {
+  std::mt19937 rng(7);
+  std::shuffle(p.begin(), p.end(), rng);
+  Circle c{p.front(), 0.0};
+  for (std::size_t i = 1; i < p.size(); ++i) {
+    if (c.holds(p[i])) continue;
+    c = {p[i], 0.0};
+    for (std::size_t j = 0; j < i; ++j) {
+      if (c.holds(p[j])) continue;
+      c = circle_of(p[i], p[j]);
+      for (std::size_t k = 0; k < j; ++k) {
+        if (!c.holds(p[k])) c = circle_of(p[i], p[j], p[k]);
+      }
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
+MeshData read_mesh(const std::filesystem::path& file, const Eigen::Vector3d& scale) {
+  if (!scale.allFinite() || (scale.array() <= 0.0).any()) {
+    throw std::runtime_error("mesh '" + file.string() + "': expected a scale > 0 on every axis");
+  }
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(file.string(), aiProcess_JoinIdenticalVertices);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    throw std::runtime_error("mesh '" + file.string() + "': Assimp could not read it: " + importer.GetErrorString());
+  }
+  MeshData out;
+  out.file = file;
+  collect(*scene, *scene->mRootNode, aiMatrix4x4(), scale, out, 0);
+  if (out.pieces.empty()) throw std::runtime_error("mesh '" + file.string() + "' holds no vertex");
+  return out;
+}
+
+ShapeSpec fit_capsule(const std::vector<Eigen::Vector3d>& vertices) {
+  if (vertices.empty()) throw std::invalid_argument("fit_capsule: expected at least one vertex");
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& v : vertices) mean += v;
+  mean /= static_cast<double>(vertices.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& v : vertices) cov += (v - mean) * (v - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const Eigen::Vector3d axis = eig.eigenvectors().col(2).normalized();  // the largest eigenvalue's
+  const Eigen::Vector3d e1 = eig.eigenvectors().col(1).normalized(), e2 = axis.cross(e1).normalized();
+  std::vector<Eigen::Vector2d> across;
+  across.reserve(vertices.size());
+  for (const auto& v : vertices) across.emplace_back((v - mean).dot(e1), (v - mean).dot(e2));
+  const Circle circle = enclosing_circle(across);
+  const double r = circle.r * (1.0 + 1e-12) + 1e-12;  // every vertex inside, rounding included
+  // Each vertex at axial t, distance rho from the axis, is inside for segment ends a <= t + s and b >= t - s,
+  // s = sqrt(r^2 - rho^2): the shortest segment is a = min(t + s), b = max(t - s).
+  double a = 1e300, b = -1e300;
+  for (std::size_t k = 0; k < vertices.size(); ++k) {
+    const double t = (vertices[k] - mean).dot(axis);
+    const double rho = (across[k] - circle.c).norm();
+    const double s = std::sqrt(std::max(0.0, r * r - rho * rho));
+    a = std::min(a, t + s);
+    b = std::max(b, t - s);
+  }
+  const bool sphere = a >= b;  // short: every vertex is within r of one point between them
+  const Eigen::Vector3d centre = mean + circle.c.x() * e1 + circle.c.y() * e2;
+  ShapeSpec shape;
+  shape.radius = r;
+  if (sphere) {
+    shape.shape = ShapeSpec::Kind::kSphere;
+    const Eigen::Vector3d p = centre + 0.5 * (a + b) * axis;
+    shape.xyz = {p.x(), p.y(), p.z()};
+    return shape;
+  }
+  shape.shape = ShapeSpec::Kind::kCapsule;
+  const Eigen::Vector3d p = centre + a * axis, q = centre + b * axis;
+  shape.from = std::array<double, 3>{p.x(), p.y(), p.z()};
+  shape.to = std::array<double, 3>{q.x(), q.y(), q.z()};
+  return shape;
+}
+
+}  // namespace redres

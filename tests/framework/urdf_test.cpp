@@ -217,7 +217,7 @@ TEST(Urdf, BadUrdfsAreErrorsNamingTheFileAndTheElement) {
       {"mesh",
        replace(good, R"(<box size="0.1 0.02 0.02"/>)", R"(<mesh filename="l2.stl"/>)"),
        "",
-       {"link 'l2'", "mesh collision element ('l2.stl')", "[[links]]"}},
+       {"link 'l2'", "mesh 'l2.stl' not found", "[[links]]", "collision_model"}},
       {"continuous without limits",
        replace(good, R"(name="a" type="revolute")", R"(name="a" type="continuous")"),
        "",

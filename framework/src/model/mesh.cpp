@@ -9,8 +9,8 @@
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
-#include <assimp/Importer.hpp>
 #include <Eigen/Eigenvalues>
+#include <assimp/Importer.hpp>
 
 namespace redres {
 
@@ -180,7 +180,7 @@ ShapeSpec fit_capsule(const std::vector<Eigen::Vector3d>& vertices) {
   const bool sphere = a >= b;  // short: every vertex is within r of one point between them
   const Eigen::Vector3d centre = mean + circle.c.x() * e1 + circle.c.y() * e2;
   ShapeSpec shape;
-  shape.radius = r;
+  shape.radius = r * (1.0 + 1e-12) + 1e-15;  // the ends put their extreme vertices on the surface: keep them inside
   if (sphere) {
     shape.shape = ShapeSpec::Kind::kSphere;
     const Eigen::Vector3d p = centre + 0.5 * (a + b) * axis;

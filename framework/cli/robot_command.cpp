@@ -65,6 +65,18 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
                       {"velocity_law", jt.velocity_limit->describe()},
                       {"velocity_limits", {lo(j), hi(j)}}});
   }
+  nlohmann::json inertias = nlohmann::json::array();
+  for (int j = 0; j < model.dof(); ++j) {
+    const auto& in = model.joint(j).inertia;
+    if (!in) {
+      inertias.push_back(nullptr);
+      continue;
+    }
+    const Eigen::Matrix3d& I = in->tensor;
+    inertias.push_back({{"mass", in->mass},
+                        {"com", to_vector(in->com)},
+                        {"tensor", {I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)}}});
+  }
   nlohmann::json shapes = nlohmann::json::array();
   for (const auto& shape : model.link_shapes()) {
     shapes.push_back({{"joint", shape.link + 1},
@@ -82,6 +94,7 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
           {"source", model.source()},
           {"joints", joints},
           {"collision_shapes", shapes},
+          {"inertias", inertias},
           {"theta", to_vector(k.theta)},
           {"f", to_vector(k.f)},
           {"J", J},
@@ -127,6 +140,18 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
     o << std::setw(5) << j + 1 << "  " << std::setprecision(9) << std::setw(14) << lo(j) << "  " << std::setw(14)
       << hi(j) << "\n";
   }
+  o << "\njoint  mass (kg)   centre of mass (m), inertia about it (kg m^2: ixx iyy izz ixy ixz iyz), link frame\n";
+  int with_inertia = 0;
+  for (int j = 0; j < model.dof(); ++j) {
+    const auto& in = model.joint(j).inertia;
+    if (!in) continue;
+    ++with_inertia;
+    const Eigen::Matrix3d& I = in->tensor;
+    o << std::setw(5) << j + 1 << "  " << std::setprecision(6) << std::setw(9) << in->mass << "   " << row(in->com)
+      << "  " << std::setprecision(6) << I(0, 0) << " " << I(1, 1) << " " << I(2, 2) << " " << I(0, 1) << " " << I(0, 2)
+      << " " << I(1, 2) << "\n";
+  }
+  if (with_inertia == 0) o << "  none given\n";
   o << "\ncollision shapes (" << model.link_shapes().size() << "), in their link's frame\n";
   if (model.link_shapes().empty()) o << "  none\n";
   for (const auto& shape : model.link_shapes()) {

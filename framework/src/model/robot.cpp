@@ -10,6 +10,8 @@
 #include <map>
 #include <optional>
 #include <set>
+
+#include <Eigen/Eigenvalues>
 #include <sstream>
 
 namespace redres {
@@ -212,6 +214,41 @@ void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta,
     lo[j] = b.lower;
     hi[j] = b.upper;
   }
+}
+
+Inertia Inertia::moved(const Eigen::Isometry3d& pose) const {
+  Inertia out;
+  out.mass = mass;
+  out.com = pose * com;
+  out.tensor = pose.linear() * tensor * pose.linear().transpose();
+  return out;
+}
+
+Inertia Inertia::combined(const Inertia& other) const {
+  Inertia out;
+  out.mass = mass + other.mass;
+  if (!(out.mass > 0.0)) return out;
+  out.com = (mass * com + other.mass * other.com) / out.mass;
+  const auto shifted = [&out](const Inertia& b) {
+    const Eigen::Vector3d d = b.com - out.com;
+    return Eigen::Matrix3d(b.tensor + b.mass * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose()));
+  };
+  out.tensor = shifted(*this) + shifted(other);
+  return out;
+}
+
+std::string Inertia::invalid() const {
+  if (!(std::isfinite(mass) && mass > 0.0)) return "expected a mass > 0, got " + std::to_string(mass);
+  if (!com.allFinite() || !tensor.allFinite()) return "expected a finite centre of mass and inertia";
+  const double scale = tensor.cwiseAbs().maxCoeff();
+  if ((tensor - tensor.transpose()).cwiseAbs().maxCoeff() > 1e-12 * (1.0 + scale)) return "expected a symmetric tensor";
+  const Eigen::Vector3d p = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(tensor).eigenvalues();
+  const double tol = 1e-9 * (1.0 + scale);
+  if (p.minCoeff() < -tol) return "expected a positive semi-definite inertia tensor (a principal moment is negative)";
+  if (p(0) + p(1) < p(2) - tol) {
+    return "expected principal moments that meet the triangle inequality (I1 + I2 >= I3), as every body's do";
+  }
+  return "";
 }
 
 namespace {

@@ -12,8 +12,8 @@
 #include "common/text.hpp"
 #include "model/transforms.hpp"
 #include "parsers/urdf.hpp"
-#include "redres/model/mesh.hpp"
 #include "redres/config/plugin_loader.hpp"
+#include "redres/model/mesh.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
 
 namespace redres {
@@ -143,6 +143,24 @@ void read_effort(const TableReader& r, JointSpec& jt) {
   jt.effort_limit = e;
 }
 
+// A joint's `inertia` table: the mass properties of the link it moves, in that link's frame.
+void read_inertia(const TableReader& r, JointSpec& jt) {
+  const TableReader t = r.table("inertia");
+  const TableReader in(t.file_ptr(), t.raw(), "joint '" + jt.name + "' inertia");
+  Inertia body;
+  body.mass = in.number("mass");
+  const std::vector<double> com = in.has("com") ? in.numbers("com", 3) : std::vector<double>{0.0, 0.0, 0.0};
+  body.com = Eigen::Vector3d(com[0], com[1], com[2]);
+  const double ixx = in.number("ixx"), iyy = in.number("iyy"), izz = in.number("izz");
+  const double ixy = in.has("ixy") ? in.number("ixy") : 0.0, ixz = in.has("ixz") ? in.number("ixz") : 0.0;
+  const double iyz = in.has("iyz") ? in.number("iyz") : 0.0;
+  body.tensor << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
+  in.finish();
+  if (const std::string bad = body.invalid(); !bad.empty()) r.fail("inertia", bad);
+  jt.inertia = body;
+  jt.inertia_source = r.location("inertia").str();
+}
+
 // The optional motion limits of a joint beyond its velocity: acceleration and jerk laws, and the effort limit (a
 // URDF joint's [[joints]] override; a [[joints]] entry of a TOML chain reads them key by key).
 void read_motion_limits(const TableReader& r, JointSpec& jt) {
@@ -153,6 +171,7 @@ void read_motion_limits(const TableReader& r, JointSpec& jt) {
   if (r.has("jerk_limit"))
     read_law(r, "jerk_limit", "jerk-limit", "rad/s^3 or m/s^3", jt, jt.jerk_limit, jt.jerk_limit_source);
   if (r.has("effort_limit")) read_effort(r, jt);
+  if (r.has("inertia")) read_inertia(r, jt);
 }
 
 // The entries of the array of tables `key` (absent: none), by their `name`: each must name a `noun` that `known`
@@ -282,6 +301,12 @@ const Schema<JointReading>& JointReading::schema() {
                [](const TableReader& r, C& c) {
                  if (r.has("effort_limit")) read_effort(r, c.jt);
                }),
+      entry<C>("inertia", "table {mass, com, ixx, iyy, izz, ixy, ixz, iyz}", "kg, m, kg m^2", "none",
+               "the mass properties of the link the joint moves, in the link's frame: mass > 0, centre of mass "
+               "`com` (default [0, 0, 0]), the inertia tensor about it (ixy, ixz, iyz default 0)",
+               [](const TableReader& r, C& c) {
+                 if (r.has("inertia")) read_inertia(r, c.jt);
+               }),
   }};
   return s;
 }
@@ -310,7 +335,7 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
 struct RobotReading {
   RobotSpec spec;
   std::string collision_model = "capsule";  // what a mesh collision element becomes (per link: [[links]])
-  PackagePaths packages;                     // `packages`: where package://NAME/ is
+  PackagePaths packages;                    // `packages`: where package://NAME/ is
   bool from_urdf = false;
   std::filesystem::path urdf;
   std::string base_link, tip_link;
@@ -426,6 +451,10 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
       }
       entry.finish();
     }
+    if (link.inertia && jt.inertia_source.empty()) {  // the link's mass properties, in the joint's link frame
+      const Inertia placed = link.inertia->moved(link.pose);
+      jt.inertia = jt.inertia ? jt.inertia->combined(placed) : placed;
+    }
     if (replace) continue;
     for (const ShapeSpec& shape : link.shapes) jt.collision.push_back(shape.placed(link.pose));
     if (model == "none") continue;
@@ -444,8 +473,8 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
     }
   }
   if (!problems.empty()) {
-    std::string all = std::to_string(problems.size()) + " mesh" + (problems.size() == 1 ? "" : "es") +
-                      " of " + c.urdf.string() + " cannot be used:";
+    std::string all = std::to_string(problems.size()) + " mesh" + (problems.size() == 1 ? "" : "es") + " of " +
+                      c.urdf.string() + " cannot be used:";
     for (const std::string& p : problems) all += "\n  " + p;
     all += "\n(give a link's shapes in a [[links]] entry, or set its `collision_model = \"none\"`)";
     r.fail("urdf", all);

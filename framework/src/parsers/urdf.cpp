@@ -192,6 +192,18 @@ void check_pose(const std::string& who, const char* what, const urdf::Pose& p) {
 void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometry3d& at, const std::string& messages,
                 UrdfLink& out) {
   const std::string who = names.link(link.name);
+  // The mass properties ride with the shapes; a massless <inertial> (a frame with no body) adds nothing.
+  if (link.inertial && link.inertial->mass != 0.0) {
+    const urdf::Inertial& in = *link.inertial;
+    check_pose(who, "<inertial> <origin>", in.origin);
+    Inertia body;
+    body.mass = in.mass;
+    body.tensor << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    const Eigen::Isometry3d frame = at * pose_of(in.origin);
+    if (const std::string bad = body.invalid(); !bad.empty()) throw UrdfError(who + ": <inertial>: " + bad);
+    const Inertia placed = body.moved(frame);  // com at the origin of the inertial frame
+    out.inertia = out.inertia ? out.inertia->combined(placed) : placed;
+  }
   for (const urdf::CollisionSharedPtr& c : link.collision_array) {
     if (!c) continue;
     if (!c->geometry) {

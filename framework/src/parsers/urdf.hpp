@@ -7,6 +7,7 @@
 /// urdfdom is included only by urdf.cpp.
 
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include <Eigen/Geometry>
 
 #include "redres/model/collision.hpp"
+#include "redres/model/robot.hpp"
 
 namespace redres {
 
@@ -54,6 +56,7 @@ struct UrdfLink {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< the link's frame in that joint's link frame
   std::vector<ShapeSpec> shapes;                           //!< its sphere, box and cylinder collision elements
   std::vector<UrdfMesh> meshes;                            //!< its mesh collision elements
+  std::optional<Inertia> inertia;  //!< its <inertial> and those riding on it, in the link's frame; none if none
 };
 
 /// The chain from `base_link` to `tip_link`.

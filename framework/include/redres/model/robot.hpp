@@ -55,6 +55,22 @@ enum class DhConvention { kStandard, kModified, kJointFrames };
 enum class TaskRows { kPosition, kPose };
 
 /// One joint as described in the robot file.
+/// The mass properties of a rigid body: mass, centre of mass and inertia tensor about the centre of mass, both in the
+/// body's (link's) frame.
+struct Inertia {
+  double mass = 0.0;                                 //!< kg, > 0
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();     //!< centre of mass (m)
+  Eigen::Matrix3d tensor = Eigen::Matrix3d::Zero();  //!< about the centre of mass (kg m^2), symmetric, PSD
+  /// The same body seen from a frame in which its frame is `pose`.
+  [[nodiscard]] Inertia moved(const Eigen::Isometry3d& pose) const;
+  /// This body and `other` (in the same frame) as one: masses add, the tensors meet at the common centre of mass
+  /// (parallel-axis theorem).
+  [[nodiscard]] Inertia combined(const Inertia& other) const;
+  /// Why it is not a physical body ("" when it is): mass > 0 and finite, the tensor symmetric, positive
+  /// semi-definite and meeting the triangle inequalities of its principal moments.
+  [[nodiscard]] std::string invalid() const;
+};
+
 struct JointSpec {
   std::string name;                                          //!< unique joint name
   JointType type = JointType::kRevolute;                     //!< revolute (rad) or prismatic (m; spatial chains only)
@@ -76,6 +92,10 @@ struct JointSpec {
   std::shared_ptr<const VelocityLimitLaw> jerk_limit;
   std::string jerk_limit_source;       //!< where the jerk law was given ("file:line:col")
   std::optional<double> effort_limit;  //!< the largest torque or force (N m or N), > 0; from the URDF's `effort`
+  /// The mass properties of the link this joint moves (with everything riding on it), in the link frame; from the
+  /// URDF's <inertial> elements or the robot file's `inertia`. Empty when not given.
+  std::optional<Inertia> inertia;
+  std::string inertia_source;  //!< "file:line:col" of the robot file's `inertia` (empty: from the URDF or none)
   /// Collision shapes of the link that joint j moves, in the link frame (the joint's frame after its motion, before
   /// the fixed transform to the next joint). A capsule with neither `length` nor `from`/`to` runs along the link:
   /// from the joint's origin to the next joint's origin (the end effector's, for the last joint).

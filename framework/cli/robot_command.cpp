@@ -152,6 +152,11 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
       << " " << I(1, 2) << "\n";
   }
   if (with_inertia == 0) o << "  none given\n";
+  for (int j = 0; j < model.dof(); ++j) {
+    if (!model.joint(j).inertia_warning.empty()) {
+      o << "  warning: joint " << j + 1 << ": " << model.joint(j).inertia_warning << " (kept as given)\n";
+    }
+  }
   o << "\ncollision shapes (" << model.link_shapes().size() << "), in their link's frame\n";
   if (model.link_shapes().empty()) o << "  none\n";
   for (const auto& shape : model.link_shapes()) {

@@ -96,6 +96,13 @@ TEST(Inertia, TheUrdfsInertialsRideWithTheirMovingLink) {
   EXPECT_NEAR(panda.joint(6).inertia->mass, 0.2 + 0.81 + 0.1 + 0.1, 1e-12);
   // Link 1's inertial sits at its <origin> (0, -0.04, -0.05) in the link frame.
   EXPECT_LE((panda.joint(0).inertia->com - Eigen::Vector3d(0.0, -0.04, -0.05)).norm(), 1e-12);
+  // The xArm6's published link 2 tensor breaks the triangle inequality: kept as given, with a warning.
+  const RobotModel xarm = load_robot(source_path("robots/xarm6.toml"));
+  ASSERT_TRUE(xarm.joint(1).inertia);
+  EXPECT_EQ(xarm.joint(1).inertia->mass, 1.71);
+  EXPECT_NE(xarm.joint(1).inertia_warning.find("triangle"), std::string::npos) << xarm.joint(1).inertia_warning;
+  EXPECT_NE(xarm.joint(1).inertia_warning.find("link2"), std::string::npos) << xarm.joint(1).inertia_warning;
+  EXPECT_EQ(xarm.joint(0).inertia_warning, "");
   // A robot file without inertias has none.
   const RobotModel dh = load_robot(source_path("robots/franka_panda.toml"));
   EXPECT_FALSE(dh.joint(0).inertia);

@@ -73,7 +73,7 @@ const std::vector<Bad>& corpus() {
       {"joints_zero_axis.toml", "6:8", {"joint 'j1': key 'axis': expected a non-zero axis vector"}},
       {"joints_with_dh_key.toml",
        "6:1",
-       {"unknown key 'd' in joint 'j1'", "axis, collision, effort_limit, jerk_limit, limits, name, origin"}},
+       {"unknown key 'd' in joint 'j1'", "axis, collision, effort_limit, inertia, jerk_limit, limits, name, origin"}},
       {"dh_with_axis.toml",
        "6:1",
        {"unknown key 'axis' in joint 'j1'", "a, acceleration_limit, alpha, collision, d, effort_limit"}},

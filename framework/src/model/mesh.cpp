@@ -1,5 +1,7 @@
 #include "redres/model/mesh.hpp"
 
+#include "common/input_file.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -140,8 +142,14 @@ MeshData read_mesh(const std::filesystem::path& file, const Eigen::Vector3d& sca
   if (!scale.allFinite() || (scale.array() <= 0.0).any()) {
     throw std::runtime_error("mesh '" + file.string() + "': expected a scale > 0 on every axis");
   }
+  // Read within the input bounds (a regular file of at most 16 MiB, common/input_file.hpp), then parsed from memory
+  // with the extension as the format's hint: a device or a huge file named by a URDF is refused before Assimp sees it.
+  const std::string data = read_input_file(file, "mesh file");
+  std::string hint = file.extension().string();
+  if (!hint.empty()) hint.erase(0, 1);
   Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(file.string(), aiProcess_JoinIdenticalVertices);
+  const aiScene* scene =
+      importer.ReadFileFromMemory(data.data(), data.size(), aiProcess_JoinIdenticalVertices, hint.c_str());
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw std::runtime_error("mesh '" + file.string() + "': Assimp could not read it: " + importer.GetErrorString());
   }

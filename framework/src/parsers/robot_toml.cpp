@@ -454,6 +454,7 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
     if (link.inertia && jt.inertia_source.empty()) {  // the link's mass properties, in the joint's link frame
       const Inertia placed = link.inertia->moved(link.pose);
       jt.inertia = jt.inertia ? jt.inertia->combined(placed) : placed;
+      for (const std::string& w : link.warnings) jt.inertia_warning += (jt.inertia_warning.empty() ? "" : "; ") + w;
     }
     if (replace) continue;
     for (const ShapeSpec& shape : link.shapes) jt.collision.push_back(shape.placed(link.pose));

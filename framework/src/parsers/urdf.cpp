@@ -200,7 +200,10 @@ void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometr
     body.mass = in.mass;
     body.tensor << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
     const Eigen::Isometry3d frame = at * pose_of(in.origin);
-    if (const std::string bad = body.invalid(); !bad.empty()) throw UrdfError(who + ": <inertial>: " + bad);
+    if (!(std::isfinite(in.mass) && in.mass > 0.0)) throw UrdfError(who + ": <inertial>: expected a mass >= 0");
+    // A maker's tensor that no rigid body has (rounded figures break the triangle inequality) does not stop the
+    // robot from loading: its kinematics do not need it. It is kept as given, with a warning.
+    if (const std::string bad = body.invalid(); !bad.empty()) out.warnings.push_back(who + ": <inertial>: " + bad);
     const Inertia placed = body.moved(frame);  // com at the origin of the inertial frame
     out.inertia = out.inertia ? out.inertia->combined(placed) : placed;
   }

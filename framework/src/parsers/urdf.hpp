@@ -56,7 +56,8 @@ struct UrdfLink {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< the link's frame in that joint's link frame
   std::vector<ShapeSpec> shapes;                           //!< its sphere, box and cylinder collision elements
   std::vector<UrdfMesh> meshes;                            //!< its mesh collision elements
-  std::optional<Inertia> inertia;  //!< its <inertial> and those riding on it, in the link's frame; none if none
+  std::optional<Inertia> inertia;     //!< its <inertial> and those riding on it, in the link's frame; none if none
+  std::vector<std::string> warnings;  //!< what is wrong with them (kept as given)
 };
 
 /// The chain from `base_link` to `tip_link`.

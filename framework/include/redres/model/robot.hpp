@@ -95,7 +95,8 @@ struct JointSpec {
   /// The mass properties of the link this joint moves (with everything riding on it), in the link frame; from the
   /// URDF's <inertial> elements or the robot file's `inertia`. Empty when not given.
   std::optional<Inertia> inertia;
-  std::string inertia_source;  //!< "file:line:col" of the robot file's `inertia` (empty: from the URDF or none)
+  std::string inertia_source;   //!< "file:line:col" of the robot file's `inertia` (empty: from the URDF or none)
+  std::string inertia_warning;  //!< what is wrong with a URDF's <inertial> kept as given (empty: nothing)
   /// Collision shapes of the link that joint j moves, in the link frame (the joint's frame after its motion, before
   /// the fixed transform to the next joint). A capsule with neither `length` nor `from`/`to` runs along the link:
   /// from the joint's origin to the next joint's origin (the end effector's, for the last joint).

@@ -1,9 +1,12 @@
 // `redres robot FILE`: the model's summary and its kinematics at theta (by default the home configuration).
 
+#include <algorithm>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
 
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
@@ -17,6 +20,7 @@ namespace {
 
 struct RobotOptions {
   std::string file;
+  std::string base_link, tip_link;
   std::string theta;
   bool json = false;
 };
@@ -65,6 +69,12 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
                       {"velocity_law", jt.velocity_limit->describe()},
                       {"velocity_limits", {lo(j), hi(j)}}});
   }
+  const auto pose = [](const Eigen::Isometry3d& p) {
+    const Eigen::Vector3d rpy = p.linear().eulerAngles(2, 1, 0).reverse();
+    return nlohmann::json{{"xyz", to_vector(p.translation())}, {"rpy", to_vector(rpy)}};
+  };
+  nlohmann::json frames = nlohmann::json::array();
+  for (const auto& f : k.link_frames) frames.push_back(pose(f));
   nlohmann::json inertias = nlohmann::json::array();
   for (int j = 0; j < model.dof(); ++j) {
     const auto& in = model.joint(j).inertia;
@@ -95,6 +105,9 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
           {"joints", joints},
           {"collision_shapes", shapes},
           {"inertias", inertias},
+          {"base_pose", pose(model.base())},
+          {"end_effector_pose", pose(k.ee_pose)},
+          {"link_frames", frames},
           {"theta", to_vector(k.theta)},
           {"f", to_vector(k.f)},
           {"J", J},
@@ -120,14 +133,28 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
   o << "robot   " << model.name() << " (" << to_string(model.kind()) << ", " << model.dof() << " joints, task rows "
     << rows << ")\n";
   if (!model.source().empty()) o << "source  " << model.source() << "\n";
-  o << "\njoint  name          type        theta^-      theta^+      velocity-limit law\n";
+  int width = 12;  // the name column fits the longest name
+  for (int j = 0; j < model.dof(); ++j) width = std::max(width, static_cast<int>(model.joint(j).name.size()));
+  o << "\njoint  " << std::left << std::setw(width) << "name" << std::right
+    << "  type        theta^-      theta^+      velocity-limit law\n";
   for (int j = 0; j < model.dof(); ++j) {
     const JointSpec& jt = model.joint(j);
-    o << std::setw(5) << j + 1 << "  " << std::left << std::setw(12) << jt.name << "  " << std::setw(10)
+    o << std::setw(5) << j + 1 << "  " << std::left << std::setw(width) << jt.name << "  " << std::setw(10)
       << to_string(jt.type) << std::right << std::fixed << std::setprecision(6) << std::setw(11) << jt.lower << "  "
       << std::setw(11) << jt.upper << "  " << jt.velocity_limit->describe() << "\n";
   }
   o << "\nat theta " << row(k.theta) << (at_home ? "  (home)" : "") << "\n";
+  const auto pose = [](const Eigen::Isometry3d& p) {
+    const Eigen::Vector3d rpy = p.linear().eulerAngles(2, 1, 0).reverse();  // roll, pitch, yaw (z-y-x)
+    return "xyz " + row(p.translation()) + "  rpy " + row(rpy);
+  };
+  o << "base          " << pose(model.base()) << "\n";
+  o << "end effector  " << pose(k.ee_pose) << "\n";
+  o << "link frames (joint j's frame after its motion, in the world)\n";
+  for (int j = 0; j < model.dof(); ++j) {
+    o << std::setw(5) << j + 1 << "  " << std::left << std::setw(width) << model.joint(j).name << std::right << "  "
+      << pose(k.link_frames[static_cast<std::size_t>(j)]) << "\n";
+  }
   o << "f        " << row(k.f) << "\n";
   o << "J\n";
   for (Eigen::Index r = 0; r < k.J.rows(); ++r) o << "  " << row(k.J.row(r).transpose()) << "\n";
@@ -160,7 +187,7 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
   o << "\ncollision shapes (" << model.link_shapes().size() << "), in their link's frame\n";
   if (model.link_shapes().empty()) o << "  none\n";
   for (const auto& shape : model.link_shapes()) {
-    o << std::setw(5) << shape.link + 1 << "  " << std::left << std::setw(12) << model.joint(shape.link).name
+    o << std::setw(5) << shape.link + 1 << "  " << std::left << std::setw(width) << model.joint(shape.link).name
       << std::right << "  " << shape.spec.describe() << "\n";
   }
 }
@@ -170,14 +197,24 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
 void add_robot_command(CLI::App& app, Action& action) {
   auto opts = std::make_shared<RobotOptions>();
   CLI::App* cmd = app.add_subcommand("robot", "Print a robot model's summary and its kinematics at theta");
-  cmd->add_option("FILE", opts->file, "robot TOML file")->required();
+  cmd->add_option("FILE", opts->file, "robot TOML file, or a URDF file (*.urdf) read as it comes")->required();
+  cmd->add_option("--base-link", opts->base_link, "with a URDF: the link the chain starts at (default: the root)");
+  cmd->add_option("--tip-link", opts->tip_link,
+                  "with a URDF: the link the chain ends at (default: the leaf with the most moving joints above it)");
   cmd->add_option("--theta", opts->theta,
                   "joint positions, comma-separated (formulas allowed, e.g. pi/4,pi/12); default: the home "
                   "configuration");
   cmd->add_flag("--json", opts->json, "print JSON instead of text");
   cmd->callback([opts, &action] {
     action = [opts] {
-      const RobotModel model = load_robot(opts->file);
+      const bool urdf = std::filesystem::path(opts->file).extension() == ".urdf";
+      if (!urdf && (!opts->base_link.empty() || !opts->tip_link.empty())) {
+        throw std::invalid_argument(
+            "--base-link and --tip-link are for a URDF file (*.urdf); a robot file names "
+            "them itself");
+      }
+      const RobotModel model =
+          urdf ? load_urdf_robot(opts->file, opts->base_link, opts->tip_link) : load_robot(opts->file);
       const bool at_home = opts->theta.empty();
       const Eigen::VectorXd theta = at_home ? model.home() : parse_theta(opts->theta, model);
       KinematicsData k(model);

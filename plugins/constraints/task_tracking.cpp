@@ -84,7 +84,8 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*
   }
   for (Eigen::Index i = 0; i < task; ++i) {
     const int r = task_rows[i];
-    d[i] = r_d_ddot[r] - jdv[r] + 2.0 * gain[i] * (r_d_dot[r] - jv[r]) + gain[i] * gain[i] * e[r];
+    // J holds the task rows only: its row i is reference row r.
+    d[i] = r_d_ddot[r] - jdv[i] + 2.0 * gain[i] * (r_d_dot[r] - jv[i]) + gain[i] * gain[i] * e[r];
   }
 }
 

@@ -8,6 +8,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 
 #include <console_bridge/console.h>
@@ -336,8 +337,12 @@ void check_name(const std::string& who, const std::string& name) {
 
 }  // namespace
 
-UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link,
-                          const std::string& tip_link) {
+namespace {
+
+// Parses `file` (bounded, checked as a tree) and calls f(model, names, messages) with the model, whose links are
+// unlinked again when f returns or throws.
+template <class F>
+auto with_parsed_urdf(const std::filesystem::path& file, F&& f) {
   const std::string where = file.string();
   std::string xml;
   try {
@@ -389,113 +394,153 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
     throw UrdfError(where + ": not a valid URDF (" +
                     (messages.empty() ? std::string("urdfdom gave no reason") : printable(messages)) + ")");
   }
+  return f(*model, names, messages);
+}
 
-  UrdfChain chain;
-  chain.robot_name = model->getName();
-  check_name(where + ": <robot>", chain.robot_name);
-  const urdf::LinkConstSharedPtr base = model->getLink(base_link);
-  if (!base) throw UrdfError(where + ": no link named '" + printable(base_link) + "' (base_link)");
-  urdf::LinkConstSharedPtr link = model->getLink(tip_link);
-  if (!link) throw UrdfError(where + ": no link named '" + printable(tip_link) + "' (tip_link)");
+}  // namespace
 
-  // Walk up from the tip to the base (the tree is checked: this ends); the joints met, reversed, are the chain.
-  std::vector<urdf::LinkConstSharedPtr> links{link};
-  while (link->name != base_link) {
-    if (links.size() > model->links_.size()) {  // the tree checks hold this off; kept so the walk always ends
-      throw UrdfError(where + ": walking up from link '" + printable(tip_link) + "' goes round a cycle of joints");
-    }
-    const urdf::JointConstSharedPtr joint = link->parent_joint;
-    if (!joint) {
-      throw UrdfError(where + ": link '" + printable(tip_link) + "' (tip_link) is not below link '" +
-                      printable(base_link) + "' (base_link): walking up from it reaches the root '" +
-                      printable(link->name) + "'");
-    }
-    link = model->getLink(joint->parent_link_name);
-    if (!link) throw UrdfError(names.joint(joint->name) + " names a missing parent link");
-    links.push_back(link);
-  }
-  std::reverse(links.begin(), links.end());  // base first
-
-  Eigen::Isometry3d fixed = Eigen::Isometry3d::Identity();  // fixed joints since the last moving one
-  for (std::size_t k = 1; k < links.size(); ++k) {
-    const urdf::JointConstSharedPtr joint = links[k]->parent_joint;
-    const std::string who = names.joint(joint->name);
-    check_name(who, joint->name);
-    check_name(names.link(links[k]->name), links[k]->name);
-    if (joint->mimic) throw UrdfError(who + " is a mimic joint; a chain of independent joints is expected");
-    check_pose(who, "<origin>", joint->parent_to_joint_origin_transform);
-    const Eigen::Isometry3d origin = pose_of(joint->parent_to_joint_origin_transform);
-    switch (joint->type) {
-      case urdf::Joint::FIXED: fixed = fixed * origin; break;
-      case urdf::Joint::REVOLUTE:
-      case urdf::Joint::CONTINUOUS:
-      case urdf::Joint::PRISMATIC: {
-        if (chain.joints.size() == kMaxJoints) {
-          throw UrdfError(who + ": the chain from '" + printable(base_link) + "' to '" + printable(tip_link) +
-                          "' has more than " + std::to_string(kMaxJoints) + " moving joints, the most a robot has");
-        }
-        UrdfJoint j;
-        j.name = joint->name;
-        j.prismatic = joint->type == urdf::Joint::PRISMATIC;
-        j.continuous = joint->type == urdf::Joint::CONTINUOUS;
-        j.origin = fixed * origin;
-        fixed = Eigen::Isometry3d::Identity();
-        j.axis = Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
-        if (!j.axis.allFinite() || !(j.axis.norm() > 1e-9)) {
-          throw UrdfError(who + ": <axis> expected a finite, non-zero vector, got [" + num(j.axis.x()) + ", " +
-                          num(j.axis.y()) + ", " + num(j.axis.z()) + "]");
-        }
-        j.axis.normalize();
-        if (joint->limits) {
-          j.lower = joint->limits->lower;
-          j.upper = joint->limits->upper;
-          j.velocity = joint->limits->velocity;
-          j.effort = joint->limits->effort;
-          if (!(std::isfinite(j.effort) && j.effort >= 0.0 && j.effort <= 1e7)) {
-            throw UrdfError(who + ": <limit> effort expected 0 <= effort <= 1e7 " + (j.prismatic ? "N" : "N m") +
-                            ", got " + num(j.effort));
-          }
-          const double bound = *physical_bound(j.prismatic ? "m" : "rad");
-          const char* unit = j.prismatic ? " m" : " rad";
-          if (!j.continuous && !(std::abs(j.lower) <= bound && std::abs(j.upper) <= bound)) {
-            throw UrdfError(who + ": <limit> lower and upper expected |x| <= " + num(bound) + unit +
-                            " (a physical range), got " + num(j.lower) + " and " + num(j.upper));
-          }
-          if (!(std::abs(j.velocity) <= *physical_bound("rad/s or m/s")) || j.velocity < 0.0) {
-            throw UrdfError(who + ": <limit> velocity expected 0 <= v <= " + num(*physical_bound("rad/s or m/s")) +
-                            (j.prismatic ? " m/s" : " rad/s") + ", got " + num(j.velocity));
-          }
-        }
-        chain.joints.push_back(j);
-        break;
+std::pair<std::string, std::string> default_urdf_chain(const std::filesystem::path& file) {
+  return with_parsed_urdf(file, [&file](const urdf::ModelInterface& model, const Namer&, const std::string&) {
+    const urdf::LinkConstSharedPtr root = model.getRoot();
+    if (!root) throw UrdfError(file.string() + ": no root link");
+    // The leaf below the root with the most moving joints above it (ties: the most links), walked with a stack.
+    std::string tip = root->name;
+    int best_moving = -1, best_depth = -1;
+    std::vector<std::tuple<const urdf::Link*, int, int>> stack{{root.get(), 0, 0}};
+    while (!stack.empty()) {
+      const auto [link, moving, depth] = stack.back();
+      stack.pop_back();
+      if (moving > best_moving || (moving == best_moving && depth > best_depth)) {
+        best_moving = moving;
+        best_depth = depth;
+        tip = link->name;
       }
-      default:
-        throw UrdfError(who + " is a " +
-                        (joint->type == urdf::Joint::FLOATING ? std::string("floating")
-                         : joint->type == urdf::Joint::PLANAR ? std::string("planar")
-                                                              : std::string("unknown")) +
-                        " joint; a chain of revolute, continuous, prismatic and fixed joints is expected");
+      for (const urdf::JointSharedPtr& j : link->child_joints) {
+        if (!j) continue;
+        const urdf::LinkConstSharedPtr child = model.getLink(j->child_link_name);
+        if (!child) continue;
+        const bool moves =
+            j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS || j->type == urdf::Joint::PRISMATIC;
+        stack.emplace_back(child.get(), moving + (moves ? 1 : 0), depth + 1);
+      }
     }
-    if (chain.joints.empty()) continue;  // still on the base: these links do not move
-    UrdfLink l;
-    l.name = links[k]->name;
-    l.joint = static_cast<int>(chain.joints.size()) - 1;
-    l.pose = fixed;
-    add_shapes(names, *links[k], Eigen::Isometry3d::Identity(), messages, l);
-    // Side branches hanging from this link by fixed joints (a hand, a camera) ride on it; joints that could move
-    // in them are taken at position 0 (they are not part of the chain).
-    for (const urdf::JointSharedPtr& child : links[k]->child_joints) {
-      if (k + 1 < links.size() && child->child_link_name == links[k + 1]->name) continue;  // the chain itself
-      add_branch(names, *model, *child, Eigen::Isometry3d::Identity(), messages, l);
+    return std::make_pair(root->name, tip);
+  });
+}
+
+UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link,
+                          const std::string& tip_link) {
+  return with_parsed_urdf(file, [&](const urdf::ModelInterface& model_ref, const Namer& names,
+                                    const std::string& messages) {
+    const std::string where = file.string();
+    const urdf::ModelInterface* model = &model_ref;
+    UrdfChain chain;
+    chain.robot_name = model->getName();
+    check_name(where + ": <robot>", chain.robot_name);
+    const urdf::LinkConstSharedPtr base = model->getLink(base_link);
+    if (!base) throw UrdfError(where + ": no link named '" + printable(base_link) + "' (base_link)");
+    urdf::LinkConstSharedPtr link = model->getLink(tip_link);
+    if (!link) throw UrdfError(where + ": no link named '" + printable(tip_link) + "' (tip_link)");
+
+    // Walk up from the tip to the base (the tree is checked: this ends); the joints met, reversed, are the chain.
+    std::vector<urdf::LinkConstSharedPtr> links{link};
+    while (link->name != base_link) {
+      if (links.size() > model->links_.size()) {  // the tree checks hold this off; kept so the walk always ends
+        throw UrdfError(where + ": walking up from link '" + printable(tip_link) + "' goes round a cycle of joints");
+      }
+      const urdf::JointConstSharedPtr joint = link->parent_joint;
+      if (!joint) {
+        throw UrdfError(where + ": link '" + printable(tip_link) + "' (tip_link) is not below link '" +
+                        printable(base_link) + "' (base_link): walking up from it reaches the root '" +
+                        printable(link->name) + "'");
+      }
+      link = model->getLink(joint->parent_link_name);
+      if (!link) throw UrdfError(names.joint(joint->name) + " names a missing parent link");
+      links.push_back(link);
     }
-    chain.links.push_back(std::move(l));
-  }
-  if (chain.joints.empty()) {
-    throw UrdfError(where + ": no moving joint between '" + printable(base_link) + "' and '" + printable(tip_link) +
-                    "'");
-  }
-  chain.tip = fixed;
-  return chain;
+    std::reverse(links.begin(), links.end());  // base first
+
+    Eigen::Isometry3d fixed = Eigen::Isometry3d::Identity();  // fixed joints since the last moving one
+    for (std::size_t k = 1; k < links.size(); ++k) {
+      const urdf::JointConstSharedPtr joint = links[k]->parent_joint;
+      const std::string who = names.joint(joint->name);
+      check_name(who, joint->name);
+      check_name(names.link(links[k]->name), links[k]->name);
+      if (joint->mimic) throw UrdfError(who + " is a mimic joint; a chain of independent joints is expected");
+      check_pose(who, "<origin>", joint->parent_to_joint_origin_transform);
+      const Eigen::Isometry3d origin = pose_of(joint->parent_to_joint_origin_transform);
+      switch (joint->type) {
+        case urdf::Joint::FIXED: fixed = fixed * origin; break;
+        case urdf::Joint::REVOLUTE:
+        case urdf::Joint::CONTINUOUS:
+        case urdf::Joint::PRISMATIC: {
+          if (chain.joints.size() == kMaxJoints) {
+            throw UrdfError(who + ": the chain from '" + printable(base_link) + "' to '" + printable(tip_link) +
+                            "' has more than " + std::to_string(kMaxJoints) + " moving joints, the most a robot has");
+          }
+          UrdfJoint j;
+          j.name = joint->name;
+          j.prismatic = joint->type == urdf::Joint::PRISMATIC;
+          j.continuous = joint->type == urdf::Joint::CONTINUOUS;
+          j.origin = fixed * origin;
+          fixed = Eigen::Isometry3d::Identity();
+          j.axis = Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
+          if (!j.axis.allFinite() || !(j.axis.norm() > 1e-9)) {
+            throw UrdfError(who + ": <axis> expected a finite, non-zero vector, got [" + num(j.axis.x()) + ", " +
+                            num(j.axis.y()) + ", " + num(j.axis.z()) + "]");
+          }
+          j.axis.normalize();
+          if (joint->limits) {
+            j.lower = joint->limits->lower;
+            j.upper = joint->limits->upper;
+            j.velocity = joint->limits->velocity;
+            j.effort = joint->limits->effort;
+            if (!(std::isfinite(j.effort) && j.effort >= 0.0 && j.effort <= 1e7)) {
+              throw UrdfError(who + ": <limit> effort expected 0 <= effort <= 1e7 " + (j.prismatic ? "N" : "N m") +
+                              ", got " + num(j.effort));
+            }
+            const double bound = *physical_bound(j.prismatic ? "m" : "rad");
+            const char* unit = j.prismatic ? " m" : " rad";
+            if (!j.continuous && !(std::abs(j.lower) <= bound && std::abs(j.upper) <= bound)) {
+              throw UrdfError(who + ": <limit> lower and upper expected |x| <= " + num(bound) + unit +
+                              " (a physical range), got " + num(j.lower) + " and " + num(j.upper));
+            }
+            if (!(std::abs(j.velocity) <= *physical_bound("rad/s or m/s")) || j.velocity < 0.0) {
+              throw UrdfError(who + ": <limit> velocity expected 0 <= v <= " + num(*physical_bound("rad/s or m/s")) +
+                              (j.prismatic ? " m/s" : " rad/s") + ", got " + num(j.velocity));
+            }
+          }
+          chain.joints.push_back(j);
+          break;
+        }
+        default:
+          throw UrdfError(who + " is a " +
+                          (joint->type == urdf::Joint::FLOATING ? std::string("floating")
+                           : joint->type == urdf::Joint::PLANAR ? std::string("planar")
+                                                                : std::string("unknown")) +
+                          " joint; a chain of revolute, continuous, prismatic and fixed joints is expected");
+      }
+      if (chain.joints.empty()) continue;  // still on the base: these links do not move
+      UrdfLink l;
+      l.name = links[k]->name;
+      l.joint = static_cast<int>(chain.joints.size()) - 1;
+      l.pose = fixed;
+      add_shapes(names, *links[k], Eigen::Isometry3d::Identity(), messages, l);
+      // Side branches hanging from this link by fixed joints (a hand, a camera) ride on it; joints that could move
+      // in them are taken at position 0 (they are not part of the chain).
+      for (const urdf::JointSharedPtr& child : links[k]->child_joints) {
+        if (k + 1 < links.size() && child->child_link_name == links[k + 1]->name) continue;  // the chain itself
+        add_branch(names, *model, *child, Eigen::Isometry3d::Identity(), messages, l);
+      }
+      chain.links.push_back(std::move(l));
+    }
+    if (chain.joints.empty()) {
+      throw UrdfError(where + ": no moving joint between '" + printable(base_link) + "' and '" + printable(tip_link) +
+                      "'");
+    }
+    chain.tip = fixed;
+    return chain;
+  });
 }
 
 }  // namespace redres

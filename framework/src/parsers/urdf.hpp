@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -59,6 +60,11 @@ struct UrdfLink {
   std::optional<Inertia> inertia;     //!< its <inertial> and those riding on it, in the link's frame; none if none
   std::vector<std::string> warnings;  //!< what is wrong with them (kept as given)
 };
+
+/// The root link of a URDF and the leaf below it with the most moving joints above it (ties: the most links): the
+/// chain `redres robot FILE.urdf` shows when no --base-link or --tip-link is given. Throws UrdfError as
+/// read_urdf_chain() does.
+[[nodiscard]] std::pair<std::string, std::string> default_urdf_chain(const std::filesystem::path& file);
 
 /// The chain from `base_link` to `tip_link`.
 struct UrdfChain {

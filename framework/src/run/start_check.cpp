@@ -30,13 +30,10 @@ std::string vector_text(const Eigen::VectorXd& v) {
   return s.str();
 }
 
-// The smallest singular value of the task rows of J at theta.
+// The smallest singular value of the task rows' Jacobian at theta (KinematicsData::J holds the task rows only).
 double task_sigma_min(const RobotModel& robot, const Eigen::VectorXd& theta, KinematicsData& k) {
   compute_kinematics(robot, theta, k, KinematicsLevel::kGradient);
-  const std::vector<int>& rows = robot.task_rows();
-  Eigen::MatrixXd js(static_cast<Eigen::Index>(rows.size()), robot.dof());
-  for (std::size_t i = 0; i < rows.size(); ++i) js.row(static_cast<Eigen::Index>(i)) = k.J.row(rows[i]);
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(js);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(k.J);
   return svd.singularValues().size() > 0 ? svd.singularValues().minCoeff() : 0.0;
 }
 
@@ -100,10 +97,10 @@ StartReport check_start(Scenario& s) {
     for (std::size_t c = 0; c < constraints.size(); ++c) {
       const Constraint& k = *constraints[c];
       if (!k.active() || !k.violated(data.constraints[c].get())) continue;
-      report.problems.push_back({"collision",
-                                 "is in collision: constraint '" + k.name() + "': " +
-                                     k.describe_violation(data.constraints[c].get()),
-                                 "move `theta0` (or the obstacle) so that the bodies are apart"});
+      report.problems.push_back(
+          {"collision",
+           "is in collision: constraint '" + k.name() + "': " + k.describe_violation(data.constraints[c].get()),
+           "move `theta0` (or the obstacle) so that the bodies are apart"});
     }
     // The path at t = 0 against the end effector.
     const int p = robot.position_rows();
@@ -133,13 +130,12 @@ StartReport check_start(Scenario& s) {
     const Eigen::VectorXd near = nearby_regular(robot, theta, k, sigma);
     std::string suggestion = "on_infeasible = \"relax\" lets the run start there";
     if (sigma >= kSingularTolerance) {
-      suggestion = "a nearby configuration that is not: theta0 = " + vector_text(near) +
-                   " (smallest singular value " + num(sigma) + "); or " + suggestion;
+      suggestion = "a nearby configuration that is not: theta0 = " + vector_text(near) + " (smallest singular value " +
+                   num(sigma) + "); or " + suggestion;
     }
     report.problems.push_back({"singular",
                                "is singular for the task: the task rows' Jacobian has smallest singular value " +
-                                   num(report.sigma_min) + " (< " + num(kSingularTolerance) + "), w = " +
-                                   num(report.w),
+                                   num(report.sigma_min) + " (< " + num(kSingularTolerance) + "), w = " + num(report.w),
                                suggestion});
   }
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

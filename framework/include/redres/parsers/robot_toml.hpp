@@ -4,11 +4,18 @@
 /// file names one (`urdf = "..."`), and builds the RobotModel. Keys: docs/robot_format.md.
 
 #include <filesystem>
+#include <string>
 
 #include "redres/config/config.hpp"
 #include "redres/model/robot.hpp"
 
 namespace redres {
+
+/// Loads a bare URDF file as a robot: the chain from `base_link` to `tip_link`, by default from the root link to the
+/// leaf below it with the most moving joints, its meshes fitted with capsules, everything else as a robot file with
+/// only `urdf`, `base_link` and `tip_link` would give (docs/robot_format.md).
+[[nodiscard]] RobotModel load_urdf_robot(const std::filesystem::path& urdf, const std::string& base_link = "",
+                                         const std::string& tip_link = "");
 
 /// Loads a robot TOML file. Every problem is a ConfigError starting "file:line:col:".
 [[nodiscard]] RobotModel load_robot(const std::filesystem::path& file);

@@ -200,7 +200,8 @@ void add_robot_command(CLI::App& app, Action& action) {
   cmd->add_option("FILE", opts->file, "robot TOML file, or a URDF file (*.urdf) read as it comes")->required();
   cmd->add_option("--base-link", opts->base_link, "with a URDF: the link the chain starts at (default: the root)");
   cmd->add_option("--tip-link", opts->tip_link,
-                  "with a URDF: the link the chain ends at (default: the leaf with the most moving joints above it)");
+                  "with a URDF: the link the chain ends at (default: the one with the most revolute joints above it, a "
+                  "gripper's fingers left out)");
   cmd->add_option("--theta", opts->theta,
                   "joint positions, comma-separated (formulas allowed, e.g. pi/4,pi/12); default: the home "
                   "configuration");

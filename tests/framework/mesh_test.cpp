@@ -225,6 +225,24 @@ TEST(Mesh, TheMakersPandaHasCapsulesAroundItsMeshesAndTheSameKinematics) {
   }
 }
 
+// A bare URDF: from the root to the arm's tip (the most revolute joints; the gripper's fingers, prismatic and mimic,
+// left out; then the deepest link: the Panda's grasp target, 0.105 m below the flange), or the links asked for.
+TEST(Mesh, ABareUrdfLoadsFromTheRootToTheArmsTip) {
+  const fs::path urdf = source_path("robots/franka_panda_description/panda.urdf");
+  const RobotModel robot = load_urdf_robot(urdf);
+  ASSERT_EQ(robot.dof(), 7);
+  EXPECT_EQ(robot.joint(6).name, "panda_joint7");
+  KinematicsData k(robot);
+  compute_kinematics(robot, Eigen::VectorXd::Zero(7), k, KinematicsLevel::kPosition);
+  EXPECT_NEAR(k.ee_pose.translation().z(), 0.926 - 0.105, 1e-12);
+  const RobotModel flange = load_urdf_robot(urdf, "panda_link0", "panda_link8");
+  KinematicsData kf(flange);
+  compute_kinematics(flange, Eigen::VectorXd::Zero(7), kf, KinematicsLevel::kPosition);
+  EXPECT_NEAR(kf.ee_pose.translation().z(), 0.926, 1e-12);
+  EXPECT_EQ(load_urdf_robot(source_path("robots/xarm6_description/xarm6_robot.urdf")).dof(), 6);
+  EXPECT_THROW((void)load_urdf_robot(urdf, "panda_link0", "no_such_link"), std::exception);
+}
+
 TEST(Mesh, TheMakersXarm6LoadsWithACapsulePerLink) {
   const RobotModel robot = load_robot(source_path("robots/xarm6.toml"));
   EXPECT_EQ(robot.dof(), 6);

@@ -403,25 +403,27 @@ std::pair<std::string, std::string> default_urdf_chain(const std::filesystem::pa
   return with_parsed_urdf(file, [&file](const urdf::ModelInterface& model, const Namer&, const std::string&) {
     const urdf::LinkConstSharedPtr root = model.getRoot();
     if (!root) throw UrdfError(file.string() + ": no root link");
-    // The leaf below the root with the most moving joints above it (ties: the most links), walked with a stack.
+    // The link below the root with the most revolute joints above it; of those, the fewest prismatic or mimic
+    // joints (a gripper's fingers are not the arm), then the most links (a tool frame on the flange). Walked with a
+    // stack.
     std::string tip = root->name;
-    int best_moving = -1, best_depth = -1;
-    std::vector<std::tuple<const urdf::Link*, int, int>> stack{{root.get(), 0, 0}};
+    std::tuple<int, int, int> best{-1, 0, -1};  // revolute, -(prismatic or mimic), depth
+    std::vector<std::tuple<const urdf::Link*, int, int, int>> stack{{root.get(), 0, 0, 0}};
     while (!stack.empty()) {
-      const auto [link, moving, depth] = stack.back();
+      const auto [link, revolute, other, depth] = stack.back();
       stack.pop_back();
-      if (moving > best_moving || (moving == best_moving && depth > best_depth)) {
-        best_moving = moving;
-        best_depth = depth;
+      if (const std::tuple<int, int, int> here{revolute, -other, depth}; here > best) {
+        best = here;
         tip = link->name;
       }
       for (const urdf::JointSharedPtr& j : link->child_joints) {
         if (!j) continue;
         const urdf::LinkConstSharedPtr child = model.getLink(j->child_link_name);
         if (!child) continue;
-        const bool moves =
-            j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS || j->type == urdf::Joint::PRISMATIC;
-        stack.emplace_back(child.get(), moving + (moves ? 1 : 0), depth + 1);
+        const bool mimic = j->mimic != nullptr;
+        const bool turns = !mimic && (j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS);
+        const bool slides = mimic || j->type == urdf::Joint::PRISMATIC;
+        stack.emplace_back(child.get(), revolute + (turns ? 1 : 0), other + (slides ? 1 : 0), depth + 1);
       }
     }
     return std::make_pair(root->name, tip);

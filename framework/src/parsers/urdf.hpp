@@ -61,7 +61,8 @@ struct UrdfLink {
   std::vector<std::string> warnings;  //!< what is wrong with them (kept as given)
 };
 
-/// The root link of a URDF and the leaf below it with the most moving joints above it (ties: the most links): the
+/// The root link of a URDF and the link below it with the most revolute joints above it (then the fewest prismatic or
+/// mimic joints, a gripper's, then the most links): the
 /// chain `redres robot FILE.urdf` shows when no --base-link or --tip-link is given. Throws UrdfError as
 /// read_urdf_chain() does.
 [[nodiscard]] std::pair<std::string, std::string> default_urdf_chain(const std::filesystem::path& file);

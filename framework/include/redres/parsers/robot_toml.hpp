@@ -12,8 +12,9 @@
 namespace redres {
 
 /// Loads a bare URDF file as a robot: the chain from `base_link` to `tip_link`, by default from the root link to the
-/// leaf below it with the most moving joints, its meshes fitted with capsules, everything else as a robot file with
-/// only `urdf`, `base_link` and `tip_link` would give (docs/robot_format.md).
+/// link below it with the most revolute joints (default_urdf_chain: a gripper's fingers are left out), its meshes
+/// fitted with capsules, everything else as a robot file with only `urdf`, `base_link` and `tip_link` would give
+/// (docs/robot_format.md).
 [[nodiscard]] RobotModel load_urdf_robot(const std::filesystem::path& urdf, const std::string& base_link = "",
                                          const std::string& tip_link = "");
 

@@ -377,6 +377,57 @@ active = false
   }
 }
 
+// The same for a task that names a subset of the rows (x and z): KinematicsData::J holds those rows only, and the
+// acceleration-level rows must read J theta_dot and J_dot theta_dot by task row, not by reference row.
+TEST(AccelerationLevel, JdotThetaDotOfASubsetTaskReadsItsOwnRows) {
+  std::string text = read_text(source_path("robots/franka_panda.toml"));
+  const std::string position = "task = \"position\"";
+  text.replace(text.find(position), position.size(), "task = [\"x\", \"z\"]");
+  const RobotModel robot = load_robot(TableReader::root(parse_toml_string(text, "panda_xz.toml")));
+  ASSERT_EQ(robot.task_dim(), 2);
+  const auto scheme = scheme_of(R"(
+[scheme]
+level = "acceleration"
+[[objectives]]
+type = "min_acceleration_norm"
+[[constraints]]
+type = "task_tracking"
+[[constraints]]
+type = "joint_acceleration_limits"
+active = false
+[[constraints]]
+type = "joint_jerk_limits"
+active = false
+)",
+                                robot);
+  auto engine = make_engine("newton");
+  std::mt19937 rng(52);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 5; ++trial) {
+    Controller ctrl(robot, *scheme, *engine, nullptr, 1.0, 0.01);
+    StepOutput out = ctrl.make_output();
+    const Eigen::VectorXd theta = random_inside(robot, rng, 0.1);
+    Eigen::VectorXd v(robot.dof());
+    for (int j = 0; j < robot.dof(); ++j) v(j) = u(rng);
+    KinematicsData k(robot), kp(robot), km(robot);
+    compute_kinematics(robot, theta, k, KinematicsLevel::kJacobian);
+    const double h = 1e-6;
+    compute_kinematics(robot, theta + h * v, kp, KinematicsLevel::kJacobian);
+    compute_kinematics(robot, theta - h * v, km, KinematicsLevel::kJacobian);
+    const Eigen::VectorXd jdv = (kp.J - km.J) * v / (2.0 * h);  // the task rows x, z
+    ASSERT_EQ(jdv.size(), 2);
+    // r_d_dot's reference rows x, y, z: the task's velocity in x and z, anything in y (not a task row).
+    const Eigen::VectorXd jv = k.J * v;
+    Eigen::VectorXd r_d_dot(3), zero = Eigen::VectorXd::Zero(3);
+    r_d_dot << jv(0), 7.0, jv(1);
+    ctrl.step(theta, 0.0, k.f, zero, zero, out);
+    ctrl.set_applied(v);
+    ctrl.step(theta, 0.01, k.f, r_d_dot, zero, out);
+    EXPECT_LT((ctrl.qp().d + jdv).norm(), 1e-7 * (1.0 + jdv.norm()))
+        << ctrl.qp().d.transpose() << " vs " << -jdv.transpose();
+  }
+}
+
 // MAN at the acceleration level (W = I, zeta = damping theta_dot, J x = d, bounds on x) at random states: the
 // controller's answer meets the KKT conditions and equals NLopt's.
 TEST(AccelerationLevel, MinimumAccelerationNormAgreesWithAnIndependentSolve) {

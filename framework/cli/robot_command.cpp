@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -11,6 +12,7 @@
 
 #include "commands.hpp"
 #include "redres/common/formula.hpp"
+#include "redres/model/collision.hpp"
 #include "redres/model/kinematics.hpp"
 #include "redres/parsers/robot_toml.hpp"
 
@@ -58,6 +60,39 @@ Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model) {
 
 std::vector<double> to_vector(const Eigen::Ref<const Eigen::VectorXd>& v) { return {v.data(), v.data() + v.size()}; }
 
+// The nearest distance of every self-collision pair of links (i < j) at the kinematics in k: over their shapes, each
+// placed at its link frame. Sorted nearest first.
+struct PairDistance {
+  int i = 0, j = 0;
+  double distance = 0.0;
+};
+std::vector<PairDistance> self_distances(const RobotModel& model, const KinematicsData& k) {
+  std::vector<ShapeSpec> specs;
+  for (const auto& shape : model.link_shapes()) specs.push_back(shape.spec);
+  std::vector<PairDistance> out;
+  if (specs.empty()) return out;
+  const DistanceQuery query(specs);
+  const auto& shapes = model.link_shapes();
+  std::map<std::pair<int, int>, double> nearest;
+  for (std::size_t a = 0; a < shapes.size(); ++a) {
+    for (std::size_t b = a + 1; b < shapes.size(); ++b) {
+      const int i = std::min(shapes[a].link, shapes[b].link), j = std::max(shapes[a].link, shapes[b].link);
+      if (!model.self_collision_pair(i, j)) continue;
+      const Eigen::Isometry3d Ta = k.link_frames[static_cast<std::size_t>(shapes[a].link)] * shapes[a].pose;
+      const Eigen::Isometry3d Tb = k.link_frames[static_cast<std::size_t>(shapes[b].link)] * shapes[b].pose;
+      const ShapeDistance d = query.distance(static_cast<int>(a), Ta, static_cast<int>(b), Tb);
+      if (!d.ok) continue;
+      const auto key = std::make_pair(i, j);
+      const auto it = nearest.find(key);
+      if (it == nearest.end() || d.distance < it->second) nearest[key] = d.distance;
+    }
+  }
+  for (const auto& [key, d] : nearest) out.push_back({key.first, key.second, d});
+  std::sort(out.begin(), out.end(),
+            [](const PairDistance& a, const PairDistance& b) { return a.distance < b.distance; });
+  return out;
+}
+
 nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const Eigen::VectorXd& lo,
                        const Eigen::VectorXd& hi) {
   nlohmann::json joints = nlohmann::json::array();
@@ -75,6 +110,10 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
   };
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& f : k.link_frames) frames.push_back(pose(f));
+  nlohmann::json self_pairs = nlohmann::json::array();
+  for (const PairDistance& p : self_distances(model, k)) {
+    self_pairs.push_back({{"joints", {p.i + 1, p.j + 1}}, {"distance", p.distance}});
+  }
   nlohmann::json inertias = nlohmann::json::array();
   for (int j = 0; j < model.dof(); ++j) {
     const auto& in = model.joint(j).inertia;
@@ -104,6 +143,7 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
           {"source", model.source()},
           {"joints", joints},
           {"collision_shapes", shapes},
+          {"self_collision_distances", self_pairs},
           {"inertias", inertias},
           {"base_pose", pose(model.base())},
           {"end_effector_pose", pose(k.ee_pose)},
@@ -189,6 +229,14 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
   for (const auto& shape : model.link_shapes()) {
     o << std::setw(5) << shape.link + 1 << "  " << std::left << std::setw(width) << model.joint(shape.link).name
       << std::right << "  " << shape.spec.describe() << "\n";
+  }
+  const std::vector<PairDistance> pairs = self_distances(model, k);
+  if (!pairs.empty()) {
+    o << "\nself-collision pairs at theta, nearest first (m; < 0: overlapping)\n";
+    for (const PairDistance& p : pairs) {
+      o << "  " << std::left << std::setw(width) << model.joint(p.i).name << "  " << std::setw(width)
+        << model.joint(p.j).name << std::right << "  " << std::setprecision(6) << p.distance << "\n";
+    }
   }
 }
 

@@ -1,0 +1,52 @@
+// `redres robot` (issue 26): a bare URDF read as it comes, and what every robot prints: poses, link frames, inertias,
+// collision shapes and the self-collision distances at theta, the JSON with the same.
+
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_util.hpp"
+#include "redres/model/kinematics.hpp"
+#include "redres/parsers/robot_toml.hpp"
+
+namespace redres {
+namespace {
+
+TEST(RobotCommand, ABareUrdfPrintsItsFramesShapesAndInertias) {
+  const Cli r = redres("robot robots/franka_panda_description/panda.urdf");
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* part : {"end effector  xyz", "link frames", "collision shapes (10)", "mass (kg)",
+                           "self-collision pairs at theta", "panda_joint7"}) {
+    EXPECT_NE(r.out.find(part), std::string::npos) << part << " in\n" << r.out;
+  }
+  const Cli tip = redres("robot robots/franka_panda_description/panda.urdf --tip-link no_such_link");
+  EXPECT_EQ(tip.code, 2) << tip.out;
+  EXPECT_NE(tip.out.find("no_such_link"), std::string::npos) << tip.out;
+  const Cli toml = redres("robot robots/franka_panda.toml --tip-link x");
+  EXPECT_EQ(toml.code, 2) << toml.out;
+}
+
+TEST(RobotCommand, TheJsonGivesPosesAndTheSelfDistancesNearestFirst) {
+  const Cli r = redres("robot robots/franka_panda_meshes.toml --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["link_frames"].size(), 7u);
+  ASSERT_EQ(j["inertias"].size(), 7u);
+  EXPECT_DOUBLE_EQ(j["inertias"][0]["mass"].get<double>(), 2.7);
+  const auto& pairs = j["self_collision_distances"];
+  ASSERT_GT(pairs.size(), 5u);
+  for (std::size_t k = 1; k < pairs.size(); ++k) {
+    EXPECT_LE(pairs[k - 1]["distance"].get<double>(), pairs[k]["distance"].get<double>());
+  }
+  // The end-effector pose is the kinematics' at home.
+  const RobotModel robot = load_robot(source_path("robots/franka_panda_meshes.toml"));
+  KinematicsData k(robot);
+  compute_kinematics(robot, robot.home(), k, KinematicsLevel::kPosition);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(j["end_effector_pose"]["xyz"][a].get<double>(), k.ee_pose.translation()(a), 1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace redres

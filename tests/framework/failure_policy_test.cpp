@@ -451,8 +451,9 @@ TEST(OnInfeasibleCli, TheDiagnosisGoesToStderrWithQuietAndTheExitCodeFollowsTheP
     EXPECT_NE(err.find("is singular for the task"), std::string::npos) << err;
     EXPECT_NE(err.find("relax"), std::string::npos) << err;
     // Bent, it is not singular (the check passes), but a circle in 0.1 s is beyond its velocity limits: exit 1.
-    code = run_cli(base + " --set solver.on_infeasible=" + policy + " --set 'theta0=[0, 0.5, 0.5, 0.5]' --set duration=0.1",
-                   dir / "stdout", dir / "stderr");
+    code = run_cli(
+        base + " --set solver.on_infeasible=" + policy + " --set 'theta0=[0, 0.5, 0.5, 0.5]' --set duration=0.1",
+        dir / "stdout", dir / "stderr");
     err = slurp(dir / "stderr");
     EXPECT_EQ(code, 1) << policy << ": " << err;
     EXPECT_EQ(slurp(dir / "stdout"), "") << policy;
@@ -464,6 +465,23 @@ TEST(OnInfeasibleCli, TheDiagnosisGoesToStderrWithQuietAndTheExitCodeFollowsTheP
   EXPECT_EQ(code, 0) << slurp(dir / "stderr");
   EXPECT_EQ(slurp(dir / "stderr"), "");
   EXPECT_EQ(slurp(dir / "stdout"), "");
+}
+
+// Under relax, a robot without acceleration limits holds where the elastic QP fails too: it cannot brake (nothing
+// bounds the deceleration), and a zero command is not reported as a braked step.
+TEST(OnInfeasible, RelaxHoldsWhereTheElasticQpFailsOnARobotWithoutAccelerationLimits) {
+  Scenario s = load_scenario(source_path("configs/paper_r_tvcmm.toml"),
+                             {"duration=0.2", "solver.engine=\"projection\"", "solver.max_iterations=1",
+                              "solver.tolerance=1e-14", "solver.on_infeasible=\"relax\""});
+  ASSERT_FALSE(s.robot->has_acceleration_limits());
+  const RunResult run = simulate(s);
+  EXPECT_GT(run.failures, 0);
+  EXPECT_EQ(run.braked_steps, 0);
+  EXPECT_EQ(run.held_steps, run.failures - 1);  // every failed step but the last row's (not integrated) held
+  const std::size_t c = run.trajectory.column("solver_status");
+  for (std::size_t r = 0; r < run.trajectory.size(); ++r) {
+    EXPECT_NE(run.trajectory(r, c), static_cast<double>(static_cast<int>(SolverStatus::kBraked))) << "row " << r;
+  }
 }
 
 }  // namespace

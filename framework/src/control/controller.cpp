@@ -221,12 +221,7 @@ void Controller::solve(double t, StepOutput& out) {
       break;
     }
     engine_->reset();  // the next step starts cold
-    if (policy_ == FailurePolicy::kBrake || (policy_ == FailurePolicy::kRelax && robot_->has_acceleration_limits())) {
-      brake(out);
-    } else {
-      out.theta_dot.setZero();
-      out.theta_ddot = -base() / ctx_.tau;
-    }
+    give_up(out);
     return;
   }
   engine_->solve_valid(qp_, result_);           // build() checked every entry it wrote
@@ -245,13 +240,16 @@ void Controller::solve(double t, StepOutput& out) {
     const double error = (r_d_.head(p) - kin_.f.head(p)).norm();
     if (error > recover_error_) relaxed = relax(out);  // behind the target: catch up within the limits
   }
-  if (relaxed) return;
-  if (policy_ == FailurePolicy::kHold) {
-    out.theta_dot.setZero();
-    out.theta_ddot = -base() / ctx_.tau;
+  if (!relaxed) give_up(out);
+}
+
+void Controller::give_up(StepOutput& out) {
+  if (policy_ != FailurePolicy::kHold && robot_->has_acceleration_limits()) {
+    brake(out);
     return;
   }
-  brake(out);
+  out.theta_dot.setZero();  // hold: nothing bounds the deceleration, or the caller chose it
+  out.theta_ddot = -base() / ctx_.tau;
 }
 
 void Controller::set_relaxation(double weight) {

@@ -147,10 +147,11 @@ class Controller {
 
  private:
   void solve(double t, StepOutput& out);
-  void begin_step();                                            // the previous step's command becomes theta_dot_prev
-  void end_step(const StepOutput& out);                         // this step's command and status, for the next
-  bool relax(StepOutput& out);                                  // the elastic QP; false when it fails too
-  void brake(StepOutput& out);                                  // the braking command
+  void begin_step();                     // the previous step's command becomes theta_dot_prev
+  void end_step(const StepOutput& out);  // this step's command and status, for the next
+  bool relax(StepOutput& out);           // the elastic QP; false when it fails too
+  void brake(StepOutput& out);           // the braking command
+  void give_up(StepOutput& out);         // a step that stays failed: brakes (acceleration limits, not kHold) or holds
   void apply(const Eigen::VectorXd& x, StepOutput& out);        // x (the QP's) into theta_dot and theta_ddot
   [[nodiscard]] const Eigen::VectorXd& base() const noexcept {  // the velocity before this step
     return ctx_.level == SchemeLevel::kVelocity ? prev_ : v_;

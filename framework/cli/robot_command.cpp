@@ -1,6 +1,7 @@
 // `redres robot FILE`: the model's summary and its kinematics at theta (by default the home configuration).
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -60,6 +61,12 @@ Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model) {
 
 std::vector<double> to_vector(const Eigen::Ref<const Eigen::VectorXd>& v) { return {v.data(), v.data() + v.size()}; }
 
+// Roll, pitch, yaw of a pose's rotation, in the convention of robot files and URDFs (rpy_of).
+Eigen::Vector3d rpy(const Eigen::Isometry3d& p) {
+  const std::array<double, 3> a = rpy_of(p.linear());
+  return {a[0], a[1], a[2]};
+}
+
 // The nearest distance of every self-collision pair of links (i < j) at the kinematics in k: over their shapes, each
 // placed at its link frame. Sorted nearest first.
 struct PairDistance {
@@ -105,8 +112,7 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
                       {"velocity_limits", {lo(j), hi(j)}}});
   }
   const auto pose = [](const Eigen::Isometry3d& p) {
-    const Eigen::Vector3d rpy = p.linear().eulerAngles(2, 1, 0).reverse();
-    return nlohmann::json{{"xyz", to_vector(p.translation())}, {"rpy", to_vector(rpy)}};
+    return nlohmann::json{{"xyz", to_vector(p.translation())}, {"rpy", to_vector(rpy(p))}};
   };
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& f : k.link_frames) frames.push_back(pose(f));
@@ -184,10 +190,7 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
       << std::setw(11) << jt.upper << "  " << jt.velocity_limit->describe() << "\n";
   }
   o << "\nat theta " << row(k.theta) << (at_home ? "  (home)" : "") << "\n";
-  const auto pose = [](const Eigen::Isometry3d& p) {
-    const Eigen::Vector3d rpy = p.linear().eulerAngles(2, 1, 0).reverse();  // roll, pitch, yaw (z-y-x)
-    return "xyz " + row(p.translation()) + "  rpy " + row(rpy);
-  };
+  const auto pose = [](const Eigen::Isometry3d& p) { return "xyz " + row(p.translation()) + "  rpy " + row(rpy(p)); };
   o << "base          " << pose(model.base()) << "\n";
   o << "end effector  " << pose(k.ee_pose) << "\n";
   o << "link frames (joint j's frame after its motion, in the world)\n";

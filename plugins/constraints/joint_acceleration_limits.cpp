@@ -10,21 +10,17 @@ namespace {
 const Rule<double> kFraction = rule<double>("in (0, 1]", [](double v) { return v > 0.0 && v <= 1.0; });
 
 struct Data final : PluginData {
-  explicit Data(int n) : a_lo(n), a_hi(n), lo(n), hi(n), zero(Eigen::VectorXd::Zero(n)) {}
-  Eigen::VectorXd a_lo, a_hi, lo, hi, zero;
+  explicit Data(int n) : a_lo(n), a_hi(n), j_lo(n), j_hi(n), lo(n), hi(n), zero(Eigen::VectorXd::Zero(n)) {}
+  Eigen::VectorXd a_lo, a_hi, j_lo, j_hi, lo, hi, zero;
 };
-
-// The first joint without the law `law`, for the constructors' messages.
-void require_laws(const RobotModel& robot, std::shared_ptr<const VelocityLimitLaw> JointSpec::*law, const char* key,
-                  const char* type) {
-  for (int j = 0; j < robot.dof(); ++j) {
-    if (robot.joint(j).*law) continue;
-    throw std::invalid_argument(std::string(type) + " needs a `" + key + "` on every joint of robot '" + robot.name() +
-                                "'; joint " + std::to_string(j + 1) + " ('" + robot.joint(j).name +
-                                "') has none (give it in the robot file's [[joints]] entry)");
-  }
-}
 }  // namespace
+
+void require_motion_limit(const RobotModel& robot, int missing, const char* key, const char* type) {
+  if (missing < 0) return;
+  throw std::invalid_argument(std::string(type) + " needs a `" + key + "` on every joint of robot '" + robot.name() +
+                              "'; joint " + std::to_string(missing + 1) + " ('" + robot.joint(missing).name +
+                              "') has none (give it in the robot file's [[joints]] entry)");
+}
 
 double stopping_speed(double d, double a, double c) noexcept {
   d = std::max(d, 0.0);
@@ -41,8 +37,8 @@ const Schema<JointAccelerationLimitsConfig>& JointAccelerationLimitsConfig::sche
 }
 
 JointAccelerationLimits::JointAccelerationLimits(const Config& config, const RobotModel& robot)
-    : Configured(kType, config), n_(robot.dof()) {
-  require_laws(robot, &JointSpec::acceleration_limit, "acceleration_limit", kType);
+    : Configured(kType, config), n_(robot.dof()), jerk_(robot.has_jerk_limits()) {
+  require_motion_limit(robot, robot.first_without_acceleration_limit(), "acceleration_limit", kType);
 }
 
 std::unique_ptr<PluginData> JointAccelerationLimits::make_data() const { return std::make_unique<Data>(n_); }
@@ -55,8 +51,7 @@ void JointAccelerationLimits::add_to(const Context& ctx, QpBuilder& builder, Plu
   robot.acceleration_limits(theta, d.a_lo, d.a_hi);
   // With jerk limits, full deceleration is reached only after a ramp of |a| / |j|: the joint is taken to move on at v'
   // for that long too (conservative: it already decelerates on the ramp).
-  const bool jerk = robot.has_jerk_limits();
-  if (jerk) robot.jerk_limits(theta, d.lo, d.hi);
+  if (jerk_) robot.jerk_limits(theta, d.j_lo, d.j_hi);
   const bool velocity_level = ctx.level == SchemeLevel::kVelocity;
   // A Context without the state between steps (one a caller builds) reads as an arm at rest.
   const Eigen::VectorXd* state = velocity_level ? ctx.theta_dot_prev : ctx.theta_dot;
@@ -72,7 +67,7 @@ void JointAccelerationLimits::add_to(const Context& ctx, QpBuilder& builder, Plu
       const double carry = velocity_level ? 0.0 : 0.5 * tau * v(j);
       const double up = robot.upper_limits()(j) - theta(j) - carry;
       const double down = theta(j) - robot.lower_limits()(j) + carry;
-      const double ramp_up = jerk ? -a_lo / d.hi(j) : 0.0, ramp_down = jerk ? a_hi / -d.lo(j) : 0.0;
+      const double ramp_up = jerk_ ? -a_lo / d.j_hi(j) : 0.0, ramp_down = jerk_ ? a_hi / -d.j_lo(j) : 0.0;
       hi = std::max(std::min(hi, stopping_speed(up, -a_lo, c + ramp_up)), lo);  // never more than a^- to brake
       lo = std::min(std::max(lo, -stopping_speed(down, a_hi, c + ramp_down)), hi);
     }

@@ -24,12 +24,7 @@ const Schema<JointJerkLimitsConfig>& JointJerkLimitsConfig::schema() {
 
 JointJerkLimits::JointJerkLimits(const Config& config, const RobotModel& robot)
     : Configured(kType, config), n_(robot.dof()) {
-  for (int j = 0; j < robot.dof(); ++j) {
-    if (robot.joint(j).jerk_limit) continue;
-    throw std::invalid_argument(std::string(kType) + " needs a `jerk_limit` on every joint of robot '" + robot.name() +
-                                "'; joint " + std::to_string(j + 1) + " ('" + robot.joint(j).name +
-                                "') has none (give it in the robot file's [[joints]] entry)");
-  }
+  require_motion_limit(robot, robot.first_without_jerk_limit(), "jerk_limit", kType);
 }
 
 std::unique_ptr<PluginData> JointJerkLimits::make_data() const { return std::make_unique<Data>(n_); }
@@ -43,7 +38,6 @@ void JointJerkLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData*
   const Eigen::VectorXd& prev2 = ctx.theta_dot_prev2 != nullptr ? *ctx.theta_dot_prev2 : d.zero;
   const Eigen::VectorXd& v = ctx.level == SchemeLevel::kVelocity || ctx.theta_dot == nullptr ? prev : *ctx.theta_dot;
   const double tau = ctx.tau, scale = config_.scale;
-  const RobotModel& robot = *ctx.robot;
   for (int j = 0; j < n_; ++j) {
     const double a_prev = (prev(j) - prev2(j)) / tau;
     const double j_lo = scale * d.j_lo(j), j_hi = scale * d.j_hi(j);
@@ -52,7 +46,7 @@ void JointJerkLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData*
     // ... and, towards a velocity limit, an acceleration that the jerk limit can still bring to zero before the
     // velocity reaches it: v' + a^2 / (2 |j^-|) <= v^+ after the step, i.e. a <= stopping_speed(v^+ - v, |j^-|, tau)
     // (yielding to a_prev + tau j^-, the hardest the jerk limit lets it turn).
-    const VelocityBounds vb = robot.joint(j).velocity_limit->bounds(ctx.theta()(j));
+    const VelocityBounds vb = ctx.velocity_bounds(j);  // evaluated once for the step by the Controller
     a_hi = std::max(std::min(a_hi, stopping_speed(vb.upper - v(j), -j_lo, tau)), a_lo);
     a_lo = std::min(std::max(a_lo, -stopping_speed(v(j) - vb.lower, j_hi, tau)), a_hi);
     d.lo(j) = ctx.velocity_to_x(v(j) + tau * a_lo, j);

@@ -15,17 +15,8 @@ JointVelocityLimits::JointVelocityLimits(const Config& config, const RobotModel&
     : Configured(kType, config) {}
 
 void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
-  const RobotModel& robot = *ctx.robot;
-  const Eigen::VectorXd& theta = ctx.theta();
   const double scale = config_.scale;
-  if (ctx.level == SchemeLevel::kAcceleration) {  // the velocity after the step keeps them
-    for (int j = 0; j < robot.dof(); ++j) {
-      const VelocityBounds b = robot.joint(j).velocity_limit->bounds(theta(j));
-      builder.intersect_bound(j, ctx.velocity_to_x(scale * b.lower, j), ctx.velocity_to_x(scale * b.upper, j));
-    }
-    return;
-  }
-  if (ctx.velocity_lower != nullptr && ctx.velocity_upper != nullptr) {
+  if (ctx.level == SchemeLevel::kVelocity && ctx.velocity_lower != nullptr && ctx.velocity_upper != nullptr) {
     if (scale == 1.0) {
       builder.intersect_bounds(*ctx.velocity_lower, *ctx.velocity_upper);
       return;
@@ -35,9 +26,11 @@ void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder, PluginD
     builder.intersect_bounds(builder.scratch(), builder.scratch2());
     return;
   }
-  for (int j = 0; j < robot.dof(); ++j) {
-    const VelocityBounds b = robot.joint(j).velocity_limit->bounds(theta(j));
-    builder.intersect_bound(j, scale * b.lower, scale * b.upper);
+  // Joint by joint: a caller's Context without the laws' values, or the acceleration level, where the velocity after
+  // the step keeps them.
+  for (int j = 0; j < ctx.robot->dof(); ++j) {
+    const VelocityBounds b = ctx.velocity_bounds(j);
+    builder.intersect_bound(j, ctx.velocity_to_x(scale * b.lower, j), ctx.velocity_to_x(scale * b.upper, j));
   }
 }
 

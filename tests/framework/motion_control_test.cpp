@@ -330,12 +330,8 @@ TEST(AccelerationLevel, TheTaskHoldsOnASmoothPath) {
   }
 }
 
-// At theta with velocity v, r_d = f, r_d_dot = J v, r_d_ddot = 0: the task rows' d is -J_dot v; against central
-// differences of J along v.
-TEST(AccelerationLevel, JdotThetaDotMatchesCentralDifferences) {
-  const auto robot = panda();
-  const int n = robot->dof();
-  const auto scheme = scheme_of(R"(
+// An acceleration-level scheme of the task rows alone (the robot's motion limits off).
+const char* const kTaskOnly = R"(
 [scheme]
 level = "acceleration"
 [[objectives]]
@@ -348,8 +344,23 @@ active = false
 [[constraints]]
 type = "joint_jerk_limits"
 active = false
-)",
-                                *robot);
+)";
+
+// J_dot v by central differences of the task rows' J along v.
+Eigen::VectorXd jdot_v(const RobotModel& robot, const Eigen::VectorXd& theta, const Eigen::VectorXd& v) {
+  KinematicsData kp(robot), km(robot);
+  const double h = 1e-6;
+  compute_kinematics(robot, theta + h * v, kp, KinematicsLevel::kJacobian);
+  compute_kinematics(robot, theta - h * v, km, KinematicsLevel::kJacobian);
+  return (kp.J - km.J) * v / (2.0 * h);
+}
+
+// At theta with velocity v, r_d = f, r_d_dot = J v, r_d_ddot = 0: the task rows' d is -J_dot v; against central
+// differences of J along v.
+TEST(AccelerationLevel, JdotThetaDotMatchesCentralDifferences) {
+  const auto robot = panda();
+  const int n = robot->dof();
+  const auto scheme = scheme_of(kTaskOnly, *robot);
   auto engine = make_engine("newton");
   std::mt19937 rng(25);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -359,12 +370,9 @@ active = false
     const Eigen::VectorXd theta = random_inside(*robot, rng, 0.1);
     Eigen::VectorXd v(n);
     for (int j = 0; j < n; ++j) v(j) = u(rng);
-    KinematicsData k(*robot), kp(*robot), km(*robot);
+    KinematicsData k(*robot);
     compute_kinematics(*robot, theta, k, KinematicsLevel::kJacobian);
-    const double h = 1e-6;
-    compute_kinematics(*robot, theta + h * v, kp, KinematicsLevel::kJacobian);
-    compute_kinematics(*robot, theta - h * v, km, KinematicsLevel::kJacobian);
-    const Eigen::VectorXd jdv = (kp.J - km.J) * v / (2.0 * h);
+    const Eigen::VectorXd jdv = jdot_v(*robot, theta, v);
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(robot->reference_dim());
     ctrl.step(theta, 0.0, k.f, zero, zero, out);
     ctrl.set_applied(v);  // the velocity at the next step
@@ -385,21 +393,7 @@ TEST(AccelerationLevel, JdotThetaDotOfASubsetTaskReadsItsOwnRows) {
   text.replace(text.find(position), position.size(), "task = [\"x\", \"z\"]");
   const RobotModel robot = load_robot(TableReader::root(parse_toml_string(text, "panda_xz.toml")));
   ASSERT_EQ(robot.task_dim(), 2);
-  const auto scheme = scheme_of(R"(
-[scheme]
-level = "acceleration"
-[[objectives]]
-type = "min_acceleration_norm"
-[[constraints]]
-type = "task_tracking"
-[[constraints]]
-type = "joint_acceleration_limits"
-active = false
-[[constraints]]
-type = "joint_jerk_limits"
-active = false
-)",
-                                robot);
+  const auto scheme = scheme_of(kTaskOnly, robot);
   auto engine = make_engine("newton");
   std::mt19937 rng(52);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -409,12 +403,9 @@ active = false
     const Eigen::VectorXd theta = random_inside(robot, rng, 0.1);
     Eigen::VectorXd v(robot.dof());
     for (int j = 0; j < robot.dof(); ++j) v(j) = u(rng);
-    KinematicsData k(robot), kp(robot), km(robot);
+    KinematicsData k(robot);
     compute_kinematics(robot, theta, k, KinematicsLevel::kJacobian);
-    const double h = 1e-6;
-    compute_kinematics(robot, theta + h * v, kp, KinematicsLevel::kJacobian);
-    compute_kinematics(robot, theta - h * v, km, KinematicsLevel::kJacobian);
-    const Eigen::VectorXd jdv = (kp.J - km.J) * v / (2.0 * h);  // the task rows x, z
+    const Eigen::VectorXd jdv = jdot_v(robot, theta, v);  // the task rows x, z
     ASSERT_EQ(jdv.size(), 2);
     // r_d_dot's reference rows x, y, z: the task's velocity in x and z, anything in y (not a task row).
     const Eigen::VectorXd jv = k.J * v;

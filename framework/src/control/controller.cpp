@@ -273,8 +273,7 @@ void Controller::set_failure_policy(FailurePolicy policy, double relax_weight, d
         robot_->name() + "''s acceleration limits forbid; use 'brake' (its default) or 'relax'");
   }
   if (policy == FailurePolicy::kBrake && !limits) {
-    int j = 0;
-    while (j < robot_->dof() && robot_->joint(j).acceleration_limit) ++j;
+    const int j = robot_->first_without_acceleration_limit();
     throw std::invalid_argument(
         "Controller::set_failure_policy: 'brake' decelerates within the joints' acceleration "
         "limits, and joint " +

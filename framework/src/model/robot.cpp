@@ -273,12 +273,19 @@ void law_bounds(const std::vector<JointSpec>& joints, std::shared_ptr<const Velo
 }
 }  // namespace
 
-bool RobotModel::has_acceleration_limits() const noexcept {
-  return std::all_of(spec_.joints.begin(), spec_.joints.end(), [](const JointSpec& j) { return j.acceleration_limit; });
+namespace {
+int first_without(const std::vector<JointSpec>& joints, std::shared_ptr<const VelocityLimitLaw> JointSpec::*law) {
+  const auto it = std::find_if(joints.begin(), joints.end(), [law](const JointSpec& j) { return !(j.*law); });
+  return it == joints.end() ? -1 : static_cast<int>(it - joints.begin());
+}
+}  // namespace
+
+int RobotModel::first_without_acceleration_limit() const noexcept {
+  return first_without(spec_.joints, &JointSpec::acceleration_limit);
 }
 
-bool RobotModel::has_jerk_limits() const noexcept {
-  return std::all_of(spec_.joints.begin(), spec_.joints.end(), [](const JointSpec& j) { return j.jerk_limit; });
+int RobotModel::first_without_jerk_limit() const noexcept {
+  return first_without(spec_.joints, &JointSpec::jerk_limit);
 }
 
 void RobotModel::acceleration_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,

@@ -66,6 +66,7 @@ RowRecorder::RowRecorder(const Scenario& s, const Controller& ctrl, std::vector<
   orientation_rows_ = robot_->has_orientation_rows();
   acc_lo_.resize(n_);
   acc_hi_.resize(n_);
+  acc_limits_ = robot_->has_acceleration_limits();
   spatial_orientation_ = orientation_rows_ && robot_->kind() == ChainKind::kSpatial;
   for (int r = 0; r < m_; ++r) (r < position_rows_ ? all_position_rows_ : all_orientation_rows_) &= robot_->tracks(r);
 }
@@ -141,12 +142,12 @@ const double* RowRecorder::write(int k, double t, const Eigen::VectorXd& theta, 
       case StepValue::kStatus: row[c++] = static_cast<double>(static_cast<int>(out.info.status)); break;
       case StepValue::kThetaDdot: put(out.theta_ddot); break;
       case StepValue::kAccelerationLower:
-        if (!robot_->has_acceleration_limits()) break;
+        if (!acc_limits_) break;
         robot_->acceleration_limits(kin.theta, acc_lo_, acc_hi_);
         put(acc_lo_);
         break;
       case StepValue::kAccelerationUpper:
-        if (robot_->has_acceleration_limits()) put(acc_hi_);  // evaluated with the lower ones
+        if (acc_limits_) put(acc_hi_);  // evaluated with the lower ones
         break;
     }
   }

@@ -62,6 +62,7 @@ class RowRecorder {
   bool orientation_rows_ = false, spatial_orientation_ = false, all_position_rows_ = true, all_orientation_rows_ = true;
   Eigen::Vector3d wd_prev_ = Eigen::Vector3d::Zero(), w_prev_ = Eigen::Vector3d::Zero();
   Eigen::VectorXd acc_lo_, acc_hi_;  // the acceleration laws at theta (robots with acceleration limits)
+  bool acc_limits_ = false;          // the robot has them: the acc_lo_/acc_hi_ columns are recorded
 };
 
 /// The run's log of step outcomes, kept in its RunResult.

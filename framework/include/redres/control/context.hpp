@@ -55,6 +55,12 @@ struct Context {
   [[nodiscard]] double velocity_to_x(double v_next, int j) const {
     return level == SchemeLevel::kVelocity ? v_next : (v_next - (*theta_dot)(j)) / tau;
   }
+  /// Joint j's velocity-limit law at theta: as the Controller evaluated it once for the step (velocity_lower/upper),
+  /// or from the law where a caller's Context carries none.
+  [[nodiscard]] VelocityBounds velocity_bounds(int j) const {
+    if (velocity_lower != nullptr && velocity_upper != nullptr) return {(*velocity_lower)(j), (*velocity_upper)(j)};
+    return robot->joint(j).velocity_limit->bounds(theta()(j));
+  }
   /// Whether this step starts a run (no previous command yet).
   [[nodiscard]] bool first_step() const noexcept { return step_index == 0; }
 };

@@ -214,8 +214,11 @@ class RobotModel {
   void velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
                        Eigen::Ref<Eigen::VectorXd> upper) const;
   /// Whether every joint has an acceleration limit (a jerk limit).
-  [[nodiscard]] bool has_acceleration_limits() const noexcept;
-  [[nodiscard]] bool has_jerk_limits() const noexcept;
+  [[nodiscard]] bool has_acceleration_limits() const noexcept { return first_without_acceleration_limit() < 0; }
+  [[nodiscard]] bool has_jerk_limits() const noexcept { return first_without_jerk_limit() < 0; }
+  /// The first joint (0-based) without an acceleration (jerk) limit, or -1 when every joint has one: for messages.
+  [[nodiscard]] int first_without_acceleration_limit() const noexcept;
+  [[nodiscard]] int first_without_jerk_limit() const noexcept;
   /// Acceleration (jerk) limits of every joint at theta, into lower/upper (size n); a joint without a law gets
   /// -inf, +inf. Allocation-free.
   void acceleration_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,

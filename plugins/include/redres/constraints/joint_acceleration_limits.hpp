@@ -40,7 +40,12 @@ class JointAccelerationLimits final : public Configured<Constraint, JointAcceler
  private:
   void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
   int n_;
+  bool jerk_;  // the robot gives jerk limits: braking counts the ramp to full deceleration
 };
+
+/// Throws std::invalid_argument naming joint `missing` (when >= 0) as lacking the robot file's `key`, which the
+/// constraint `type` needs on every joint (RobotModel::first_without_acceleration_limit() and the like).
+void require_motion_limit(const RobotModel& robot, int missing, const char* key, const char* type);
 
 /// The speed v' a joint may have at distance d >= 0 from a limit and still stop before it at deceleration a > 0,
 /// moving on at v' for the time c first: c v' + v'^2 / (2 a) = d.

@@ -67,8 +67,8 @@ Eigen::Vector3d rpy(const Eigen::Isometry3d& p) {
   return {a[0], a[1], a[2]};
 }
 
-// The nearest distance of every self-collision pair of links (i < j) at the kinematics in k: over their shapes, each
-// placed at its link frame. Sorted nearest first.
+// The nearest distance of every self-collision pair of bodies (i < j, RobotModel::bodies()) at the kinematics in k:
+// over their shapes, each placed at its link frame. Sorted nearest first.
 struct PairDistance {
   int i = 0, j = 0;
   double distance = 0.0;
@@ -83,8 +83,8 @@ std::vector<PairDistance> self_distances(const RobotModel& model, const Kinemati
   std::map<std::pair<int, int>, double> nearest;
   for (std::size_t a = 0; a < shapes.size(); ++a) {
     for (std::size_t b = a + 1; b < shapes.size(); ++b) {
-      const int i = std::min(shapes[a].link, shapes[b].link), j = std::max(shapes[a].link, shapes[b].link);
-      if (!model.self_collision_pair(i, j)) continue;
+      const int i = std::min(shapes[a].body, shapes[b].body), j = std::max(shapes[a].body, shapes[b].body);
+      if (!model.self_collision_bodies(i, j)) continue;
       const Eigen::Isometry3d Ta = k.link_frames[static_cast<std::size_t>(shapes[a].link)] * shapes[a].pose;
       const Eigen::Isometry3d Tb = k.link_frames[static_cast<std::size_t>(shapes[b].link)] * shapes[b].pose;
       const ShapeDistance d = query.distance(static_cast<int>(a), Ta, static_cast<int>(b), Tb);
@@ -118,7 +118,9 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
   for (const auto& f : k.link_frames) frames.push_back(pose(f));
   nlohmann::json self_pairs = nlohmann::json::array();
   for (const PairDistance& p : self_distances(model, k)) {
-    self_pairs.push_back({{"joints", {p.i + 1, p.j + 1}}, {"distance", p.distance}});
+    const auto& A = model.bodies()[static_cast<std::size_t>(p.i)];
+    const auto& B = model.bodies()[static_cast<std::size_t>(p.j)];
+    self_pairs.push_back({{"links", {A.name, B.name}}, {"joints", {A.link + 1, B.link + 1}}, {"distance", p.distance}});
   }
   nlohmann::json inertias = nlohmann::json::array();
   for (int j = 0; j < model.dof(); ++j) {
@@ -136,9 +138,13 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
   for (const auto& shape : model.link_shapes()) {
     shapes.push_back({{"joint", shape.link + 1},
                       {"joint_name", model.joint(shape.link).name},
+                      {"link", model.bodies()[static_cast<std::size_t>(shape.body)].name},
+                      {"side_branch", model.bodies()[static_cast<std::size_t>(shape.body)].branch},
                       {"shape", shape.spec.describe()},
                       {"position", to_vector(shape.pose.translation())}});
   }
+  nlohmann::json held = nlohmann::json::array();
+  for (const auto& [name, value] : model.spec().held_joints) held.push_back({{"name", name}, {"value", value}});
   nlohmann::json J = nlohmann::json::array();
   for (Eigen::Index r = 0; r < k.J.rows(); ++r) J.push_back(to_vector(k.J.row(r).transpose()));
   return {{"name", model.name()},
@@ -149,6 +155,7 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
           {"source", model.source()},
           {"joints", joints},
           {"collision_shapes", shapes},
+          {"held_joints", held},
           {"self_collision_distances", self_pairs},
           {"inertias", inertias},
           {"base_pose", pose(model.base())},
@@ -179,8 +186,9 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
   o << "robot   " << model.name() << " (" << to_string(model.kind()) << ", " << model.dof() << " joints, task rows "
     << rows << ")\n";
   if (!model.source().empty()) o << "source  " << model.source() << "\n";
-  int width = 12;  // the name column fits the longest name
+  int width = 12;  // the name column fits the longest name (of a joint or a link)
   for (int j = 0; j < model.dof(); ++j) width = std::max(width, static_cast<int>(model.joint(j).name.size()));
+  for (const auto& b : model.bodies()) width = std::max(width, static_cast<int>(b.name.size()));
   o << "\njoint  " << std::left << std::setw(width) << "name" << std::right
     << "  type        theta^-      theta^+      velocity-limit law\n";
   for (int j = 0; j < model.dof(); ++j) {
@@ -227,18 +235,31 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
       o << "  warning: joint " << j + 1 << ": " << model.joint(j).inertia_warning << " (kept as given)\n";
     }
   }
-  o << "\ncollision shapes (" << model.link_shapes().size() << "), in their link's frame\n";
-  if (model.link_shapes().empty()) o << "  none\n";
+  o << "\ncollision shapes (" << model.link_shapes().size() << "), in their joint's link frame\n";
+  if (model.link_shapes().empty())
+    o << "  none\n";
+  else
+    o << "joint  " << std::left << std::setw(width) << "joint name"
+      << "  " << std::setw(width) << "link" << std::right << "  shape\n";
   for (const auto& shape : model.link_shapes()) {
-    o << std::setw(5) << shape.link + 1 << "  " << std::left << std::setw(width) << model.joint(shape.link).name
-      << std::right << "  " << shape.spec.describe() << "\n";
+    const auto& body = model.bodies()[static_cast<std::size_t>(shape.body)];
+    o << std::setw(5) << shape.link + 1 << "  " << std::left << std::setw(width) << model.joint(shape.link).name << "  "
+      << std::setw(width) << body.name << std::right << "  " << shape.spec.describe()
+      << (body.branch ? "  (side branch)" : "") << "\n";
+  }
+  if (!model.spec().held_joints.empty()) {
+    o << "\nheld joints (side branches; `held_joints` in the robot file)\n";
+    for (const auto& [name, value] : model.spec().held_joints) {
+      o << "  " << std::left << std::setw(width) << name << std::right << "  " << std::setprecision(6) << value << "\n";
+    }
   }
   const std::vector<PairDistance> pairs = self_distances(model, k);
   if (!pairs.empty()) {
     o << "\nself-collision pairs at theta, nearest first (m; < 0: overlapping)\n";
     for (const PairDistance& p : pairs) {
-      o << "  " << std::left << std::setw(width) << model.joint(p.i).name << "  " << std::setw(width)
-        << model.joint(p.j).name << std::right << "  " << std::setprecision(6) << p.distance << "\n";
+      o << "  " << std::left << std::setw(width) << model.bodies()[static_cast<std::size_t>(p.i)].name << "  "
+        << std::setw(width) << model.bodies()[static_cast<std::size_t>(p.j)].name << std::right << "  "
+        << std::setprecision(6) << p.distance << "\n";
     }
   }
 }

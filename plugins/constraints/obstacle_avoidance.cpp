@@ -287,7 +287,7 @@ void ObstacleAvoidance::describe_pair_to(const PluginData* data, int pair, TextS
   if (pair < 0 || pair >= links_ * obstacles_ || data == nullptr) return;
   const int o = pair / links_, l = pair % links_;
   const auto& shape = robot_->link_shapes()[static_cast<std::size_t>(l)];
-  s << "link '" << robot_->joint(shape.link).name << "' ";
+  s << "link '" << robot_->bodies()[static_cast<std::size_t>(shape.body)].name << "' ";
   shape.spec.describe(s);
   s << " vs obstacle " << o + 1 << " ";
   config_.obstacles[static_cast<std::size_t>(o)].describe(s);

@@ -36,7 +36,7 @@ SelfCollision::SelfCollision(const Config& config, const RobotModel& robot)
   for (const auto& l : links) shapes_.push_back(l.spec);
   for (std::size_t i = 0; i < links.size(); ++i) {
     for (std::size_t j = i + 1; j < links.size(); ++j) {
-      if (robot.self_collision_pair(links[i].link, links[j].link)) {
+      if (robot.self_collision_bodies(links[i].body, links[j].body)) {
         pairs_.emplace_back(static_cast<int>(i), static_cast<int>(j));
       }
     }
@@ -95,9 +95,9 @@ void SelfCollision::describe_inequality_row_to(const PluginData* data, int row, 
   const auto& links = robot_->link_shapes();
   const auto& sa = links[static_cast<std::size_t>(pairs_[static_cast<std::size_t>(row)].first)];
   const auto& sb = links[static_cast<std::size_t>(pairs_[static_cast<std::size_t>(row)].second)];
-  s << "link '" << robot_->joint(sa.link).name << "' ";
+  s << "link '" << robot_->bodies()[static_cast<std::size_t>(sa.body)].name << "' ";
   sa.spec.describe(s);
-  s << " vs link '" << robot_->joint(sb.link).name << "' ";
+  s << " vs link '" << robot_->bodies()[static_cast<std::size_t>(sb.body)].name << "' ";
   sb.spec.describe(s);
   s.precision(4);
   s << " at distance " << pair_data(data).distances[row] << " m";

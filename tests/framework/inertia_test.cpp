@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "redres/model/kinematics.hpp"
 #include "redres/model/robot.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
@@ -104,8 +105,8 @@ TEST(Inertia, TheUrdfsInertialsRideWithTheirMovingLink) {
   EXPECT_NE(xarm.joint(1).inertia_warning.find("link2"), std::string::npos) << xarm.joint(1).inertia_warning;
   EXPECT_EQ(xarm.joint(0).inertia_warning, "");
   // A robot file without inertias has none.
-  const RobotModel dh = load_robot(source_path("robots/franka_panda.toml"));
-  EXPECT_FALSE(dh.joint(0).inertia);
+  const RobotModel iiwa = load_robot(source_path("robots/kuka_iiwa14.toml"));
+  EXPECT_FALSE(iiwa.joint(0).inertia);
 }
 
 TEST(Inertia, TheRobotFileGivesThemPerJointAndRefusesImpossibleOnes) {
@@ -138,5 +139,55 @@ velocity_limit = { type = "constant", lower = -1.0, upper = 1.0 }
   }
 }
 
+// robots/franka_panda.toml carries Franka's published mass properties, given in Craig's link frames and moved to the
+// file's (modified DH) link frames. Placed in the world, they must be where the same figures put on the URDF Panda's
+// link frames (robots/franka_panda_urdf.toml, whose link frames are Craig's) are: the arm's centre of mass and its
+// inertia about it agree at random configurations.
+TEST(Inertia, TheTomlPandaCarriesFrankasFiguresInItsOwnFrames) {
+  const RobotModel dh = load_robot(source_path("robots/franka_panda.toml"));
+  const RobotModel urdf = load_robot(source_path("robots/franka_panda_urdf.toml"));
+  ASSERT_EQ(dh.dof(), 7);
+  // Franka's figures (franka_description/robots/common/inertial.yaml): mass, com, ixx iyy izz ixy ixz iyz.
+  const double maker[7][10] = {
+      {4.970684, 0.003875, 0.002081, -0.04762, 0.70337, 0.70661, 0.0091170, -0.00013900, 0.0067720, 0.019169},
+      {0.646926, -0.003141, -0.02872, 0.003495, 0.0079620, 2.8110e-02, 2.5995e-02, -3.9250e-3, 1.0254e-02, 7.0400e-04},
+      {3.228604, 2.7518e-02, 3.9252e-02, -6.6502e-02, 3.7242e-02, 3.6155e-02, 1.0830e-02, -4.7610e-03, -1.1396e-02,
+       -1.2805e-02},
+      {3.587895, -5.317e-02, 1.04419e-01, 2.7454e-02, 2.5853e-02, 1.9552e-02, 2.8323e-02, 7.7960e-03, -1.3320e-03,
+       8.6410e-03},
+      {1.225946, -1.1953e-02, 4.1065e-02, -3.8437e-02, 3.5549e-02, 2.9474e-02, 8.6270e-03, -2.1170e-03, -4.0370e-03,
+       2.2900e-04},
+      {1.666555, 6.0149e-02, -1.4117e-02, -1.0517e-02, 1.9640e-03, 4.3540e-03, 5.4330e-03, 1.0900e-04, -1.1580e-03,
+       3.4100e-04},
+      {7.35522e-01, 1.0517e-02, -4.252e-03, 6.1597e-02, 1.2516e-02, 1.0027e-02, 4.8150e-03, -4.2800e-04, -1.1960e-03,
+       -7.4100e-04}};
+  KinematicsData kd(dh), ku(urdf);
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    Eigen::VectorXd theta(7);
+    for (int j = 0; j < 7; ++j) {
+      std::uniform_real_distribution<double> u(dh.joint(j).lower, dh.joint(j).upper);
+      theta(j) = u(rng);
+    }
+    compute_kinematics(dh, theta, kd);
+    compute_kinematics(urdf, theta, ku);
+    Inertia a, b;
+    for (int j = 0; j < 7; ++j) {
+      ASSERT_TRUE(dh.joint(j).inertia.has_value()) << j;
+      const Inertia from_file = dh.joint(j).inertia->moved(kd.link_frames[static_cast<std::size_t>(j)]);
+      Inertia own;
+      own.mass = maker[j][0];
+      own.com = Eigen::Vector3d(maker[j][1], maker[j][2], maker[j][3]);
+      own.tensor << maker[j][4], maker[j][7], maker[j][8], maker[j][7], maker[j][5], maker[j][9], maker[j][8],
+          maker[j][9], maker[j][6];
+      const Inertia from_maker = own.moved(ku.link_frames[static_cast<std::size_t>(j)]);
+      a = j == 0 ? from_file : a.combined(from_file);
+      b = j == 0 ? from_maker : b.combined(from_maker);
+    }
+    EXPECT_NEAR(a.mass, 16.062132, 1e-9);
+    EXPECT_LE((a.com - b.com).norm(), 1e-9) << "trial " << trial;
+    EXPECT_LE((a.tensor - b.tensor).cwiseAbs().maxCoeff(), 1e-9) << "trial " << trial;
+  }
+}
 }  // namespace
 }  // namespace redres

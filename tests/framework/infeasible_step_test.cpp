@@ -43,7 +43,7 @@ TEST(InfeasibleStep, TheIiwaPoseStepIsInfeasibleForEveryEngineNamingItsRows) {
     const std::string& d = info.diagnosis;
     EXPECT_EQ(d.rfind("the constraint rows cannot be met inside the bounds: equality row ", 0), 0u) << d;
     EXPECT_NE(d.find("(from 'task_tracking') misses by 3."), std::string::npos) << d;
-    EXPECT_NE(d.find("(from 'obstacle_avoidance': link 'lbr_iiwa_joint_6'"), std::string::npos) << d;
+    EXPECT_NE(d.find("(from 'obstacle_avoidance': link 'lbr_iiwa_link_6'"), std::string::npos) << d;
     EXPECT_EQ(d.find("cannot be met", d.find("cannot be met") + 1), std::string::npos) << "said once: " << d;
   }
 }

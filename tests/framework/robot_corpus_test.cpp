@@ -27,7 +27,7 @@ const std::vector<Bad>& corpus() {
       {"unknown_top_key.toml",
        "3:1",
        {"unknown key 'colour'",
-        "known keys: base, collision_exclude, collision_model, end_effector, home, joints, kind"}},
+        "known keys: base, collision_exclude, collision_model, end_effector, held_joints, home, joints, kind"}},
       {"unknown_joint_key.toml", "6:1", {"unknown key 'mass' in joint 'j1'", "length, limits, name"}},
       {"unknown_law_key.toml", "14:1", {"unknown key 'sigma'", "known keys: a, b, s, sigma_max, sigma_min, type"}},
       {"wrong_type_number.toml",

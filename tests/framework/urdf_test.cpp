@@ -5,6 +5,7 @@
 // is a ConfigError naming the robot file's `urdf` key, the URDF file and the element.
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -213,7 +214,7 @@ TEST(Urdf, BadUrdfsAreErrorsNamingTheFileAndTheElement) {
       {"mimic joint",
        replace(good, R"(<axis xyz="0 1 0"/>)", R"(<axis xyz="0 1 0"/><mimic joint="a"/>)"),
        "",
-       {"joint 'b' is a mimic joint"}},
+       {"joint 'b' is a mimic of joint 'a', which is on the chain", "not supported"}},
       {"mesh",
        replace(good, R"(<box size="0.1 0.02 0.02"/>)", R"(<mesh filename="l2.stl"/>)"),
        "",
@@ -227,7 +228,10 @@ TEST(Urdf, BadUrdfsAreErrorsNamingTheFileAndTheElement) {
        "",
        {"joint 'b'", "has no velocity limit"}},
       {"unknown joint override", good, "[[joints]]\nname = \"zz\"\n", {"no moving joint named 'zz'"}},
-      {"unknown link override", good, "[[links]]\nname = \"base\"\n", {"no link named 'base' that moves"}},
+      {"unknown link override",
+       good,
+       "[[links]]\nname = \"base\"\n",
+       {"no link named 'base' that moves", "those are 'l1', 'l2', 'tool'", "the file's links are 'base', 'l1'"}},
       {"unreadable collision geometry",
        replace(good, R"(<cylinder radius="0.03" length="0.2"/>)", R"(<cylinder radius="q"/>)"),
        "",
@@ -463,6 +467,215 @@ TEST(UrdfBounds, ALongSideBranchRidesOnItsLink) {
   for (const auto& s : robot.link_shapes()) ASSERT_EQ(s.link, 0);
   // The last sphere is 9,000 steps of 1 mm along y from l1's frame.
   EXPECT_NEAR(robot.link_shapes().back().pose.translation().y(), 9.0, 1e-9);
+}
+
+// A tree: a head on a revolute joint hanging from l1 (beside l2), a hand fixed to l2 with two fingers, the second a
+// mimic of the first. Each side-branch link is a body of its own, named by its link, its joints held.
+const char* const kTreeBranches = R"(  <link name="head">
+    <collision><origin xyz="0 0 0" rpy="0 0 0"/><geometry><sphere radius="0.05"/></geometry></collision>
+  </link>
+  <link name="hand">
+    <collision><origin xyz="0 0 0" rpy="0 0 0"/><geometry><sphere radius="0.02"/></geometry></collision>
+  </link>
+  <link name="finger1">
+    <collision><origin xyz="0 0 0.01" rpy="0 0 0"/><geometry><sphere radius="0.01"/></geometry></collision>
+  </link>
+  <link name="finger2">
+    <collision><origin xyz="0 0 0.01" rpy="0 0 0"/><geometry><sphere radius="0.01"/></geometry></collision>
+  </link>
+  <joint name="neck" type="revolute">
+    <parent link="l1"/><child link="head"/><origin xyz="0.2 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/>
+  </joint>
+  <joint name="wrist" type="fixed">
+    <parent link="l2"/><child link="hand"/><origin xyz="0 0 0.05" rpy="0 0 0"/>
+  </joint>
+  <joint name="f1" type="prismatic">
+    <parent link="hand"/><child link="finger1"/><origin xyz="0 0.01 0" rpy="0 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="0" upper="0.04" velocity="0.1" effort="1"/>
+  </joint>
+  <joint name="f2" type="prismatic">
+    <parent link="hand"/><child link="finger2"/><origin xyz="0 -0.01 0" rpy="0 0 0"/><axis xyz="0 -1 0"/>
+    <limit lower="0" upper="0.04" velocity="0.1" effort="1"/><mimic joint="f1" multiplier="1.5" offset="0.001"/>
+  </joint>
+</robot>)";
+
+// The pose of the first shape of body `name` in its joint's link frame.
+Eigen::Vector3d body_position(const RobotModel& robot, const std::string& name) {
+  const int b = robot.find_body(name);
+  for (const auto& s : robot.link_shapes()) {
+    if (s.body == b) return s.pose.translation();
+  }
+  ADD_FAILURE() << "no shape of body '" << name << "'";
+  return Eigen::Vector3d::Constant(std::nan(""));
+}
+
+TEST(UrdfTrees, SideBranchLinksAreBodiesNamedByTheirLinksWithTheirJointsHeld) {
+  const Files f("tree");
+  f.write("two.urdf", replace(kTwoLinkUrdf, "</robot>", kTreeBranches));
+  const RobotModel robot = load_robot(f.write("two.toml", kRobot));
+  ASSERT_EQ(robot.dof(), 2);
+  // The chain's links are named by their URDF links, not their joints.
+  EXPECT_EQ(robot.bodies()[static_cast<std::size_t>(robot.body_of_joint(0))].name, "l1");
+  EXPECT_EQ(robot.bodies()[static_cast<std::size_t>(robot.body_of_joint(1))].name, "l2");
+  for (const char* name : {"head", "hand", "finger1", "finger2", "tool"}) {
+    SCOPED_TRACE(name);
+    ASSERT_GE(robot.find_body(name), 0);
+  }
+  const auto body = [&](const char* name) { return robot.bodies()[static_cast<std::size_t>(robot.find_body(name))]; };
+  EXPECT_EQ(body("head").link, 0);
+  EXPECT_TRUE(body("head").branch);
+  EXPECT_EQ(body("hand").link, 1);
+  EXPECT_FALSE(body("hand").branch);  // fixed to l2: part of it
+  EXPECT_TRUE(body("finger1").branch);
+  EXPECT_FALSE(body("tool").branch);
+  // Held at 0 by default (the fingers' 0 is within their limits); the mimic follows: 1.5 * 0 + 0.001.
+  EXPECT_NEAR((body_position(robot, "head") - Eigen::Vector3d(0.2, 0.0, 0.1)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((body_position(robot, "finger1") - Eigen::Vector3d(0.0, 0.01, 0.06)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((body_position(robot, "finger2") - Eigen::Vector3d(0.0, -0.011, 0.06)).norm(), 0.0, 1e-15);
+  ASSERT_EQ(robot.spec().held_joints.size(), 3u);
+
+  // Self-collision: the head (a side branch on joint 1) is checked against l2 on the neighbouring joint; the hand,
+  // fixed to l2, is not checked against l1 (neighbours), nor against the fingers on its own joint.
+  const auto pair = [&](const char* a, const char* b) {
+    return robot.self_collision_bodies(robot.find_body(a), robot.find_body(b));
+  };
+  EXPECT_TRUE(pair("head", "l2"));
+  EXPECT_TRUE(pair("head", "hand"));
+  EXPECT_TRUE(pair("finger1", "l1"));
+  EXPECT_FALSE(pair("hand", "l1"));
+  EXPECT_FALSE(pair("l1", "l2"));
+  EXPECT_FALSE(pair("hand", "finger2"));
+  EXPECT_FALSE(pair("head", "l1"));
+
+  // Held positions from the robot file move the branch; a mimic follows its leader's; link names are addressable in
+  // [[links]] and collision_exclude.
+  const RobotModel held =
+      load_robot(f.write("held.toml", std::string(kRobot) + R"(held_joints = { neck = 0.5, f1 = 0.02 }
+collision_exclude = [["head", "l2"], ["finger1", "a"]]
+[[links]]
+name = "head"
+collision = [{ shape = "sphere", radius = 0.07, xyz = [0.0, 0.0, 0.03] }]
+)"));
+  const int head = held.find_body("head");
+  ASSERT_GE(head, 0);
+  int head_shapes = 0;
+  for (const auto& s : held.link_shapes()) {
+    if (s.body != head) continue;
+    ++head_shapes;
+    EXPECT_DOUBLE_EQ(*s.spec.radius, 0.07);
+    EXPECT_NEAR((s.pose.translation() - Eigen::Vector3d(0.2, 0.0, 0.13)).norm(), 0.0, 1e-15);
+  }
+  EXPECT_EQ(head_shapes, 1);
+  EXPECT_NEAR((body_position(held, "finger1") - Eigen::Vector3d(0.0, 0.03, 0.06)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((body_position(held, "finger2") - Eigen::Vector3d(0.0, -0.041, 0.06)).norm(), 0.0, 1e-15);
+  EXPECT_FALSE(held.self_collision_bodies(held.find_body("head"), held.find_body("l2")));
+  EXPECT_FALSE(held.self_collision_bodies(held.find_body("finger1"), held.find_body("l1")));  // 'a' moves l1
+  EXPECT_TRUE(held.self_collision_bodies(held.find_body("head"), held.find_body("hand")));
+}
+
+TEST(UrdfTrees, HeldJointsAreCheckedByNameLimitAndMimic) {
+  const Files f("held");
+  f.write("two.urdf", replace(kTwoLinkUrdf, "</robot>", kTreeBranches));
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {"held_joints = { nope = 0.1 }", {"held_joints", "no held joint named 'nope'", "'neck'", "'f1'"}},
+      {"held_joints = { f2 = 0.01 }", {"joint 'f2' is a mimic of joint 'f1'", "hold 'f1' instead"}},
+      {"held_joints = { neck = 2.0 }", {"expected joint 'neck' within its limits [-1, 1], got 2"}},
+      {"collision_exclude = [[\"head\", \"nowhere\"]]", {"got 'nowhere'", "'head'"}},
+  };
+  for (const auto& [extra, says] : cases) {
+    SCOPED_TRACE(extra);
+    const auto file = f.write("bad.toml", std::string(kRobot) + extra + "\n");
+    try {
+      (void)load_robot(file);
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(file.string() + ":4:", 0), 0u) << what;  // at the key, on line 4
+      for (const std::string& s : says)
+        EXPECT_NE(what.find(s), std::string::npos) << "missing '" << s << "' in: " << what;
+    }
+  }
+}
+
+// A mimic joint on the chain whose leader is off it (the tip is the second finger) is held like a fixed joint; one
+// whose leader is on the chain is refused.
+TEST(UrdfTrees, AMimicOnTheChainFollowsALeaderOffIt) {
+  const Files f("mimic");
+  f.write("two.urdf", replace(kTwoLinkUrdf, "</robot>", kTreeBranches));
+  const RobotModel robot = load_robot(f.write(
+      "tip.toml", "urdf = \"two.urdf\"\nbase_link = \"base\"\ntip_link = \"finger2\"\nheld_joints = { f1 = 0.02 }\n"));
+  EXPECT_EQ(robot.dof(), 2);
+  // The tip: hand 0.05 above l2, then finger2's origin, moved 1.5 * 0.02 + 0.001 along -y.
+  EXPECT_NEAR((robot.end_effector().translation() - Eigen::Vector3d(0.0, -0.041, 0.05)).norm(), 0.0, 1e-15);
+}
+
+TEST(UrdfTrees, EveryProblemOfTheJointsAndLinksIsReportedAtOnce) {
+  const Files f("problems");
+  std::string urdf = replace(kTwoLinkUrdf, R"(name="a" type="revolute")", R"(name="a" type="continuous")");
+  urdf = replace(urdf, R"(velocity="3")", R"(velocity="0")");
+  urdf = replace(urdf, R"(<box size="0.1 0.02 0.02"/>)", R"(<mesh filename="l2.stl"/>)");
+  f.write("two.urdf", urdf);
+  const auto file = f.write("two.toml", std::string(kRobot) + "[[links]]\nname = \"l9\"\n");
+  try {
+    (void)load_robot(file);
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    for (const char* s : {"4 problems in this robot file", "joint 'a' is continuous", "joint 'b'",
+                          "has no velocity limit", "no link named 'l9'", "the file's links are 'base', 'l1', 'l2',",
+                          "mesh 'l2.stl' not found", "two.toml:5:8: robot.links[0]: key 'name'"}) {
+      EXPECT_NE(what.find(s), std::string::npos) << "missing '" << s << "' in: " << what;
+    }
+  }
+}
+
+TEST(UrdfTrees, AMissingBaseOrTipLinkListsTheFilesLinks) {
+  const Files f("missing");
+  f.write("two.urdf", kTwoLinkUrdf);
+  for (const char* key : {"base_link", "tip_link"}) {
+    SCOPED_TRACE(key);
+    const std::string robot = replace(kRobot, std::string(key) + (key[0] == 'b' ? " = \"base\"" : " = \"tool\""),
+                                      std::string(key) + " = \"nope\"");
+    try {
+      (void)load_robot(f.write("two.toml", robot));
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("no link named 'nope'"), std::string::npos) << what;
+      EXPECT_NE(what.find("the file's 4 links: 'base', 'l1', 'l2', 'tool'"), std::string::npos) << what;
+    }
+  }
+}
+
+// The Panda's fingers as Franka describes them: panda_finger_joint2 mimics panda_finger_joint1. Holding joint 1 open
+// by 0.04 m moves the left finger's fitted capsule 0.04 m along the hand's y axis and the right one the other way.
+TEST(UrdfTrees, ThePandasFingersOpenTogether) {
+  const Files f("panda_fingers");
+  const std::string urdf = source_path("robots/franka_panda_description/panda.urdf").string();
+  const std::string head = "urdf = \"" + urdf + "\"\nbase_link = \"panda_link0\"\ntip_link = \"panda_link8\"\n";
+  const RobotModel closed = load_robot(f.write("closed.toml", head));
+  const RobotModel open = load_robot(f.write("open.toml", head + "held_joints = { panda_finger_joint1 = 0.04 }\n"));
+  const auto centre = [](const RobotModel& r, const char* link) -> Eigen::Vector3d {
+    const int b = r.find_body(link);
+    EXPECT_GE(b, 0) << link;
+    for (const auto& s : r.link_shapes()) {
+      if (s.body == b) return Eigen::Vector3d(s.pose.translation());
+    }
+    return Eigen::Vector3d::Constant(std::nan(""));
+  };
+  const Eigen::Vector3d left = centre(open, "panda_leftfinger") - centre(closed, "panda_leftfinger");
+  const Eigen::Vector3d right = centre(open, "panda_rightfinger") - centre(closed, "panda_rightfinger");
+  EXPECT_NEAR(left.norm(), 0.04, 1e-12);
+  EXPECT_NEAR((left + right).norm(), 0.0, 1e-12);
+  // Along the hand's y axis, in link 7's frame: the hand is turned -pi/4 about z from link 8.
+  EXPECT_NEAR(left.z(), 0.0, 1e-12);
+  EXPECT_NEAR(
+      left.normalized().dot(Eigen::Vector3d(std::cos(-M_PI / 4 + M_PI / 2), std::sin(-M_PI / 4 + M_PI / 2), 0.0)), 1.0,
+      1e-9);
+  ASSERT_EQ(open.spec().held_joints.size(), 2u);
+  EXPECT_TRUE(open.bodies()[static_cast<std::size_t>(open.find_body("panda_rightfinger"))].branch);
+  EXPECT_FALSE(open.bodies()[static_cast<std::size_t>(open.find_body("panda_hand"))].branch);
 }
 }  // namespace
 }  // namespace redres

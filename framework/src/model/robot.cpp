@@ -10,6 +10,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <unordered_map>
 
 #include <Eigen/Eigenvalues>
 #include <sstream>
@@ -140,6 +141,20 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
   base_angle_ = spec_.kind == ChainKind::kPlanar ? std::atan2(R(1, 0), R(0, 0)) : 0.0;
   const Eigen::Matrix3d& E = spec_.end_effector.linear();
   end_effector_angle_ = spec_.kind == ChainKind::kPlanar ? std::atan2(E(1, 0), E(0, 0)) : 0.0;
+  // The bodies: each joint's link, then the links riding on it that have shapes (by name, in the order met).
+  std::unordered_map<std::string, int> by_name;  // a URDF's side branch may have thousands of links
+  const auto body_index = [&by_name](const std::string& name) {
+    const auto it = by_name.find(name);
+    return it == by_name.end() ? -1 : it->second;
+  };
+  for (int j = 0; j < n; ++j) {
+    const std::string& name = joint(j).link_name.empty() ? joint(j).name : joint(j).link_name;
+    REDRES_REQUIRE(body_index(name) < 0, "RobotModel",
+                   "link names are unique (joint " + std::to_string(j + 1) + "'s link '" + name + "' is named twice)");
+    joint_body_.push_back(static_cast<int>(bodies_.size()));
+    by_name.emplace(name, static_cast<int>(bodies_.size()));
+    bodies_.push_back({name, j, false});
+  }
   for (int j = 0; j < n; ++j) {
     // The link frame of joint j is the joint's frame after its motion; the next joint's origin (or the end
     // effector's) is after(j) * before(j + 1) in it.
@@ -162,8 +177,27 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
       } catch (const FieldError& e) {
         throw std::invalid_argument("RobotModel: " + who + ": " + e.what());
       }
-      link_shapes_.push_back({j, shape, shape.pose()});
+      int body = joint_body_[static_cast<std::size_t>(j)];
+      if (!shape.body.empty() && shape.body != bodies_[static_cast<std::size_t>(body)].name) {
+        body = body_index(shape.body);
+        if (body < 0) {
+          body = static_cast<int>(bodies_.size());
+          by_name.emplace(shape.body, body);
+          const auto& branch = joint(j).branch_links;
+          bodies_.push_back({shape.body, j, std::find(branch.begin(), branch.end(), shape.body) != branch.end()});
+        }
+        REDRES_REQUIRE(bodies_[static_cast<std::size_t>(body)].link == j, "RobotModel",
+                       who + ": body '" + shape.body + "' rides on joint " +
+                           std::to_string(bodies_[static_cast<std::size_t>(body)].link + 1) + ", not this one");
+      }
+      link_shapes_.push_back({j, body, shape, shape.pose()});
     }
+  }
+  for (const auto& [a, b] : spec_.collision_exclude_bodies) {
+    const int ia = body_index(a), ib = body_index(b);
+    REDRES_REQUIRE(ia >= 0 && ib >= 0 && ia != ib, "RobotModel",
+                   "collision_exclude_bodies name two different bodies of the robot (got '" + a + "' and '" + b + "')");
+    excluded_bodies_.emplace_back(ia, ib);
   }
   for (const auto& [a, b] : spec_.collision_exclude) {
     REDRES_REQUIRE(a >= 0 && a < n && b >= 0 && b < n && a != b, "RobotModel",
@@ -296,6 +330,27 @@ void RobotModel::acceleration_limits(const Eigen::Ref<const Eigen::VectorXd>& th
 void RobotModel::jerk_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
                              Eigen::Ref<Eigen::VectorXd> upper) const {
   law_bounds(spec_.joints, &JointSpec::jerk_limit, theta, lower, upper, "RobotModel::jerk_limits");
+}
+
+int RobotModel::find_body(const std::string& name) const {
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    if (bodies_[b].name == name) return static_cast<int>(b);
+  }
+  return -1;
+}
+
+bool RobotModel::self_collision_bodies(int a, int b) const {
+  const Body& A = bodies_.at(static_cast<std::size_t>(a));
+  const Body& B = bodies_.at(static_cast<std::size_t>(b));
+  if (A.link == B.link) return false;
+  if (std::abs(A.link - B.link) == 1 && !A.branch && !B.branch) return false;
+  for (const auto& [i, j] : spec_.collision_exclude) {
+    if ((i == A.link && j == B.link) || (i == B.link && j == A.link)) return false;
+  }
+  for (const auto& [i, j] : excluded_bodies_) {
+    if ((i == a && j == b) || (i == b && j == a)) return false;
+  }
+  return true;
 }
 
 bool RobotModel::self_collision_pair(int i, int j) const {

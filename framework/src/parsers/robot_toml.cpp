@@ -179,12 +179,22 @@ void read_motion_limits(const TableReader& r, JointSpec& jt) {
 std::map<std::string, TableReader> named_entries(const TableReader& r, const char* key,
                                                  const std::function<bool(const std::string&)>& known,
                                                  const std::string& noun, const std::string& what,
-                                                 const std::string& where) {
+                                                 const std::string& where,
+                                                 std::vector<ConfigError>* problems = nullptr) {
   std::map<std::string, TableReader> out;
   if (!r.has(key)) return out;
   for (const TableReader& entry : r.tables(key)) {
     const std::string name = entry.string("name");
-    if (!known(name)) entry.fail("name", "no " + what + " named '" + name + "'" + where);
+    if (!known(name)) {
+      try {
+        entry.fail("name", "no " + what + " named '" + name + "'" + where);
+      } catch (const ConfigError& e) {
+        if (problems == nullptr) throw;
+        problems->push_back(e);
+        (void)entry.raw();  // the entry's other keys are not read: it names nothing
+        continue;
+      }
+    }
     if (!out.emplace(name, entry).second) entry.fail("name", "a second entry for " + noun + " '" + name + "'");
   }
   return out;
@@ -340,10 +350,32 @@ struct RobotReading {
   std::filesystem::path urdf;
   std::string base_link, tip_link;
   UrdfChain chain;
+  std::map<std::string, double> held;  // `held_joints`
+  // Problems found while reading the URDF's joints and links, reported together (throw_problems()).
+  std::vector<ConfigError> problems;
   static const Schema<RobotReading>& schema();
 };
 
-// The URDF's joints, with the [[joints]] overrides.
+// Runs f, keeping a ConfigError it throws among c.problems (so that the reading goes on to find the others).
+template <class F>
+void gather(RobotReading& c, F&& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    c.problems.push_back(e);
+  }
+}
+
+// Throws the problems gathered, all in one error at the first one's place.
+void throw_problems(const RobotReading& c) {
+  if (c.problems.empty()) return;
+  if (c.problems.size() == 1) throw c.problems.front();
+  std::string all = std::to_string(c.problems.size()) + " problems in this robot file:";
+  for (const ConfigError& e : c.problems) all += "\n  " + std::string(e.what());
+  throw ConfigError(c.problems.front().where(), all);
+}
+
+// The URDF's joints, with the [[joints]] overrides. Every joint's problems are gathered (gather()).
 void read_urdf_joints(const TableReader& r, RobotReading& c) {
   const std::map<std::string, TableReader> overrides = named_entries(
       r, "joints",
@@ -351,7 +383,8 @@ void read_urdf_joints(const TableReader& r, RobotReading& c) {
         return std::any_of(c.chain.joints.begin(), c.chain.joints.end(),
                            [&](const UrdfJoint& j) { return j.name == name; });
       },
-      "joint", "moving joint", " between '" + c.base_link + "' and '" + c.tip_link + "' in " + c.urdf.string());
+      "joint", "moving joint", " between '" + c.base_link + "' and '" + c.tip_link + "' in " + c.urdf.string(),
+      &c.problems);
   for (const UrdfJoint& uj : c.chain.joints) {
     JointSpec jt;
     jt.name = uj.name;
@@ -360,33 +393,36 @@ void read_urdf_joints(const TableReader& r, RobotReading& c) {
     jt.axis = uj.axis;
     jt.lower = uj.lower;
     jt.upper = uj.upper;
-    const auto o = overrides.find(uj.name);
-    const std::optional<TableReader> entry =
-        o == overrides.end()
-            ? std::nullopt
-            : std::optional<TableReader>(TableReader(o->second.file_ptr(), o->second.raw(), "joint '" + uj.name + "'"));
-    if (entry) (void)entry->has("name");
-    if (entry && entry->has("limits")) {
-      read_limits(*entry, jt);
-    } else if (uj.continuous) {
-      r.fail("urdf", "joint '" + uj.name + "' is continuous in " + c.urdf.string() +
-                         ", which gives it no position limits: give its `limits` in a [[joints]] entry");
-    } else if (!(uj.lower < uj.upper)) {
-      r.fail("urdf", "joint '" + uj.name + "' in " + c.urdf.string() + " has limits lower " + num(uj.lower) +
-                         " >= upper " + num(uj.upper) + ": fix the URDF or give its `limits` in a [[joints]] entry");
-    }
-    if (entry && entry->has("velocity_limit")) {
-      read_velocity_law(*entry, jt);
-    } else if (uj.velocity > 0.0) {
-      jt.velocity_limit = symmetric_constant_law(uj.velocity, c.urdf);
-    } else {
-      r.fail("urdf", "joint '" + uj.name + "' in " + c.urdf.string() +
-                         " has no velocity limit: give one in the URDF (<limit velocity=...>) or a `velocity_limit` "
-                         "in a [[joints]] entry");
-    }
-    if (uj.effort > 0.0) jt.effort_limit = uj.effort;
-    if (entry) read_motion_limits(*entry, jt);
-    if (entry) entry->finish();
+    gather(c, [&] {
+      const auto o = overrides.find(uj.name);
+      const std::optional<TableReader> entry =
+          o == overrides.end() ? std::nullopt
+                               : std::optional<TableReader>(
+                                     TableReader(o->second.file_ptr(), o->second.raw(), "joint '" + uj.name + "'"));
+      if (entry) (void)entry->has("name");
+      if (entry && entry->has("limits")) {
+        read_limits(*entry, jt);
+      } else if (uj.continuous) {
+        r.fail("urdf", uj.where +
+                           " is continuous, which gives it no position limits: give its `limits` in a "
+                           "[[joints]] entry");
+      } else if (!(uj.lower < uj.upper)) {
+        r.fail("urdf", uj.where + " has limits lower " + num(uj.lower) + " >= upper " + num(uj.upper) +
+                           ": fix the URDF or give its `limits` in a [[joints]] entry");
+      }
+      if (entry && entry->has("velocity_limit")) {
+        read_velocity_law(*entry, jt);
+      } else if (uj.velocity > 0.0) {
+        jt.velocity_limit = symmetric_constant_law(uj.velocity, c.urdf);
+      } else {
+        r.fail("urdf", uj.where +
+                           " has no velocity limit: give one in the URDF (<limit velocity=...>) or a `velocity_limit` "
+                           "in a [[joints]] entry");
+      }
+      if (uj.effort > 0.0) jt.effort_limit = uj.effort;
+      if (entry) read_motion_limits(*entry, jt);
+      if (entry) entry->finish();
+    });
     c.spec.joints.push_back(std::move(jt));
   }
 }
@@ -416,6 +452,10 @@ struct LinkEntry {
 
 // The collision shapes of the URDF's links, with the [[links]] entries.
 void read_urdf_links(const TableReader& r, RobotReading& c) {
+  std::string moving;  // the links that move with the chain, for the message naming a missing one
+  for (const UrdfLink& l : c.chain.links) moving += (moving.empty() ? "'" : ", '") + l.name + "'";
+  std::string all_links;
+  for (const std::string& l : c.chain.all_links) all_links += (all_links.empty() ? "'" : ", '") + l + "'";
   const std::map<std::string, TableReader> link_entries = named_entries(
       r, "links",
       [&](const std::string& name) {
@@ -423,42 +463,59 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
                            [&](const UrdfLink& l) { return l.name == name; });
       },
       "link", "link",
-      " that moves with the chain from '" + c.base_link + "' to '" + c.tip_link + "' in " + c.urdf.string());
+      " that moves with the chain from '" + c.base_link + "' to '" + c.tip_link + "' in " + c.urdf.string() +
+          " (those are " + moving + "; the file's links are " + all_links + ")",
+      &c.problems);
   std::vector<std::string> problems;  // every mesh that cannot be used, reported together
   const std::filesystem::path base_dir = c.urdf.parent_path();
   for (const UrdfLink& link : c.chain.links) {
+    if (c.spec.joints.size() <= static_cast<std::size_t>(link.joint)) break;
     JointSpec& jt = c.spec.joints[static_cast<std::size_t>(link.joint)];
+    if (jt.link_name.empty()) jt.link_name = link.name;  // the first link met on a joint is the one it moves
+    if (link.branch) jt.branch_links.push_back(link.name);
+    const std::size_t first_shape = jt.collision.size();
     const auto e = link_entries.find(link.name);
     bool replace = false;
     std::string model = c.collision_model;
-    if (e != link_entries.end()) {
-      const TableReader entry(e->second.file_ptr(), e->second.raw(), "link '" + link.name + "'");
-      LinkEntry links;
-      read_config(entry, LinkEntry::schema(), links);
-      replace = links.replace;
-      if (!links.collision_model.empty()) model = links.collision_model;
-      for (std::size_t k = 0; k < links.collision.size(); ++k) {
-        const ShapeSpec& shape = links.collision[k];
-        if (shape.shape == ShapeSpec::Kind::kCapsule && !shape.length && !shape.from) {
-          entry.fail("collision", "shape " + std::to_string(k + 1) +
-                                      ": a capsule of a URDF link needs `length` (with `xyz`, `rpy`) or `from` and "
-                                      "`to`, in the link's frame");
+    if (e != link_entries.end())
+      gather(c, [&] {
+        const TableReader entry(e->second.file_ptr(), e->second.raw(), "link '" + link.name + "'");
+        LinkEntry links;
+        read_config(entry, LinkEntry::schema(), links);
+        replace = links.replace;
+        if (!links.collision_model.empty()) model = links.collision_model;
+        for (std::size_t k = 0; k < links.collision.size(); ++k) {
+          const ShapeSpec& shape = links.collision[k];
+          if (shape.shape == ShapeSpec::Kind::kCapsule && !shape.length && !shape.from) {
+            entry.fail("collision", "shape " + std::to_string(k + 1) +
+                                        ": a capsule of a URDF link needs `length` (with `xyz`, `rpy`) or `from` and "
+                                        "`to`, in the link's frame");
+          }
+          if (shape.velocity) {
+            entry.fail("collision", "shape " + std::to_string(k + 1) + " has a velocity; only obstacles move");
+          }
+          jt.collision.push_back(shape.placed(link.pose));
         }
-        if (shape.velocity) {
-          entry.fail("collision", "shape " + std::to_string(k + 1) + " has a velocity; only obstacles move");
-        }
-        jt.collision.push_back(shape.placed(link.pose));
-      }
-      entry.finish();
-    }
+        entry.finish();
+      });
     if (link.inertia && jt.inertia_source.empty()) {  // the link's mass properties, in the joint's link frame
       const Inertia placed = link.inertia->moved(link.pose);
       jt.inertia = jt.inertia ? jt.inertia->combined(placed) : placed;
       for (const std::string& w : link.warnings) jt.inertia_warning += (jt.inertia_warning.empty() ? "" : "; ") + w;
     }
-    if (replace) continue;
+    // Every shape of this link belongs to it (a body of its own: RobotModel::bodies()).
+    const auto own = [&] {
+      for (std::size_t k = first_shape; k < jt.collision.size(); ++k) jt.collision[k].body = link.name;
+    };
+    if (replace) {
+      own();
+      continue;
+    }
     for (const ShapeSpec& shape : link.shapes) jt.collision.push_back(shape.placed(link.pose));
-    if (model == "none") continue;
+    if (model == "none") {
+      own();
+      continue;
+    }
     // Mesh collision elements: a capsule fitted to each mesh, every piece of it (a file's meshes, e.g. an OBJ's
     // material groups, or a convex decomposition's pieces) together.
     for (const UrdfMesh& mesh : link.meshes) {
@@ -469,17 +526,19 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
         for (const auto& piece : data.pieces) all.insert(all.end(), piece.begin(), piece.end());
         jt.collision.push_back(fit_capsule(all).placed(link.pose * mesh.pose));
       } catch (const std::exception& ex) {
-        problems.push_back("link '" + link.name + "': " + ex.what());
+        problems.push_back(link.where + ": " + ex.what());
       }
     }
+    own();
   }
   if (!problems.empty()) {
     std::string all = std::to_string(problems.size()) + " mesh" + (problems.size() == 1 ? "" : "es") + " of " +
                       c.urdf.string() + " cannot be used:";
     for (const std::string& p : problems) all += "\n  " + p;
     all += "\n(give a link's shapes in a [[links]] entry, or set its `collision_model = \"none\"`)";
-    r.fail("urdf", all);
+    gather(c, [&] { r.fail("urdf", all); });
   }
+  throw_problems(c);
 }
 
 // `key` of a robot file with a URDF only: refused in one without.
@@ -488,28 +547,68 @@ void only_with_urdf(const TableReader& r, const RobotReading& c, const char* key
   if (!c.from_urdf && r.raw().contains(key)) r.fail(key, std::string("is used only with `urdf`") + instead);
 }
 
-// `collision_exclude`: pairs of joints (their links) that self-collision does not check.
+// `collision_exclude`: pairs of joints (all their links) or of links by name (a URDF's links, side branches
+// included) that self-collision does not check.
 void read_collision_exclude(const TableReader& r, RobotSpec& spec) {
   if (!r.has("collision_exclude")) return;
   const toml::array* pairs = r.raw().get("collision_exclude")->as_array();
-  if (pairs == nullptr) r.fail("collision_exclude", "expected an array of joint-name pairs, e.g. [[\"j1\", \"j3\"]]");
+  if (pairs == nullptr) {
+    r.fail("collision_exclude", "expected an array of pairs of joint or link names, e.g. [[\"j1\", \"j3\"]]");
+  }
+  // The links that have shapes (bodies), by name; a joint stands for its link.
+  std::vector<std::string> links;
+  for (const JointSpec& jt : spec.joints) {
+    for (const ShapeSpec& shape : jt.collision) {
+      if (!shape.body.empty() && std::find(links.begin(), links.end(), shape.body) == links.end()) {
+        links.push_back(shape.body);
+      }
+    }
+  }
   for (const toml::node& p : *pairs) {
     const toml::array* pair = p.as_array();
-    const auto index = [&](std::size_t k) {
+    std::string names[2];
+    int joints[2] = {-1, -1};
+    for (std::size_t k = 0; k < 2; ++k) {
       const toml::node* el = pair != nullptr && pair->size() == 2 ? pair->get(k) : nullptr;
       const auto* name = el != nullptr ? el->as_string() : nullptr;
       if (name != nullptr) {
+        names[k] = name->get();
         for (std::size_t j = 0; j < spec.joints.size(); ++j) {
-          if (spec.joints[j].name == name->get()) return static_cast<int>(j);
+          if (spec.joints[j].name == names[k]) joints[k] = static_cast<int>(j);
         }
       }
-      throw ConfigError(location_of(r.file(), p),
-                        "key 'collision_exclude': expected pairs of two joint names of this robot, e.g. [\"j1\", "
-                        "\"j3\"]");
-    };
-    const int a = index(0), b = index(1);
-    if (a == b) throw ConfigError(location_of(r.file(), p), "key 'collision_exclude': a pair names one joint twice");
-    spec.collision_exclude.emplace_back(a, b);
+      const bool link = std::find(links.begin(), links.end(), names[k]) != links.end() ||
+                        std::any_of(spec.joints.begin(), spec.joints.end(), [&](const JointSpec& jt) {
+                          return !jt.link_name.empty() && jt.link_name == names[k];
+                        });
+      if (name == nullptr || (joints[k] < 0 && !link)) {
+        std::string known;
+        for (const JointSpec& jt : spec.joints) known += (known.empty() ? "'" : ", '") + jt.name + "'";
+        for (const std::string& l : links) known += ", '" + l + "'";
+        throw ConfigError(location_of(r.file(), p),
+                          "key 'collision_exclude': expected pairs of two joint or link names of this robot, e.g. "
+                          "[\"j1\", \"j3\"]" +
+                              (name != nullptr ? ", got '" + names[k] + "' (known: " + known + ")" : std::string()));
+      }
+    }
+    if (names[0] == names[1]) {
+      throw ConfigError(location_of(r.file(), p), "key 'collision_exclude': a pair names one joint or link twice");
+    }
+    if (joints[0] >= 0 && joints[1] >= 0) {
+      if (joints[0] == joints[1]) {
+        throw ConfigError(location_of(r.file(), p), "key 'collision_exclude': a pair names one joint twice");
+      }
+      spec.collision_exclude.emplace_back(joints[0], joints[1]);
+      continue;
+    }
+    // A link by name (or a joint, standing for the link it moves).
+    for (std::size_t k = 0; k < 2; ++k) {
+      if (joints[k] >= 0) {
+        const JointSpec& jt = spec.joints[static_cast<std::size_t>(joints[k])];
+        names[k] = jt.link_name.empty() ? jt.name : jt.link_name;
+      }
+    }
+    spec.collision_exclude_bodies.emplace_back(names[0], names[1]);
   }
 }
 
@@ -525,8 +624,15 @@ const Schema<RobotReading>& RobotReading::schema() {
                  c.urdf = r.path("urdf");
                  c.base_link = r.string("base_link");
                  c.tip_link = r.string("tip_link");
+                 if (r.raw().contains("held_joints")) {  // needed to place the side branches: read here
+                   const TableReader t = r.table("held_joints");
+                   for (const auto& [key, value] : t.raw()) {
+                     const std::string name(key.str());
+                     c.held[name] = t.number(name);
+                   }
+                 }
                  try {
-                   c.chain = read_urdf_chain(c.urdf, c.base_link, c.tip_link);
+                   c.chain = read_urdf_chain(c.urdf, c.base_link, c.tip_link, c.held);
                  } catch (const UrdfError& e) {
                    r.fail("urdf", e.what());
                  } catch (const ConfigError& e) {
@@ -534,6 +640,7 @@ const Schema<RobotReading>& RobotReading::schema() {
                    throw;
                  }
                  c.spec.end_effector = c.chain.tip;
+                 for (const UrdfHeldJoint& h : c.chain.held) c.spec.held_joints.emplace_back(h.name, h.value);
                }),
       entry<C>("base_link", "string", "", "none; required with `urdf`",
                "the URDF link the chain starts at (required with `urdf`)",
@@ -541,6 +648,35 @@ const Schema<RobotReading>& RobotReading::schema() {
       entry<C>("tip_link", "string", "", "none; required with `urdf`",
                "the URDF link the chain ends at (required with `urdf`)",
                [](const TableReader& r, C& c) { only_with_urdf(r, c, "tip_link", ""); }),
+      entry<C>("held_joints", "table { JOINT = number }", "rad or m", "0 (or the limit nearest 0)",
+               "the positions the URDF's side-branch joints (a head's, a gripper's fingers') are held at; a mimic "
+               "joint follows its leader (docs/robot_format.md, \"Trees\")",
+               [](const TableReader& r, C& c) {
+                 if (!r.has("held_joints")) return;
+                 only_with_urdf(r, c, "held_joints", "");
+                 const TableReader t = r.table("held_joints");
+                 std::string names;
+                 for (const UrdfHeldJoint& h : c.chain.held) names += (names.empty() ? "'" : ", '") + h.name + "'";
+                 for (const auto& [key, value] : t.raw()) {
+                   const std::string name(key.str());
+                   const auto it = std::find_if(c.chain.held.begin(), c.chain.held.end(),
+                                                [&](const UrdfHeldJoint& h) { return h.name == name; });
+                   if (it == c.chain.held.end()) {
+                     t.fail(name, "no held joint named '" + name + "' (the joints of side branches off the chain " +
+                                      "from '" + c.base_link + "' to '" + c.tip_link + "'" +
+                                      (names.empty() ? std::string(": there are none") : " are " + names) + ")");
+                   }
+                   if (!it->mimics.empty()) {
+                     t.fail(name, "joint '" + name + "' is a mimic of joint '" + it->mimics +
+                                      "' and follows it: hold '" + it->mimics + "' instead");
+                   }
+                   const double v = t.number(name);
+                   if (it->limited && (v < std::min(it->lower, it->upper) || v > std::max(it->lower, it->upper))) {
+                     t.fail(name, "expected joint '" + name + "' within its limits [" + num(it->lower) + ", " +
+                                      num(it->upper) + "], got " + num(v));
+                   }
+                 }
+               }),
       entry<C>("collision_model", "\"capsule\" or \"none\"", "", "\"capsule\"",
                "what a URDF's mesh collision elements become: a capsule fitted to each mesh (all its pieces "
                "together) or nothing; a [[links]] entry may set its own (docs/robot_format.md, \"Meshes\")",
@@ -662,8 +798,9 @@ const Schema<RobotReading>& RobotReading::schema() {
             }
           },
           "within the limits"),
-      entry<C>("collision_exclude", "array of joint-name pairs", "", "[] (none)",
-               "pairs of links that self-collision leaves out (neighbours always are)",
+      entry<C>("collision_exclude", "array of pairs of joint or link names", "", "[] (none)",
+               "pairs of links that self-collision leaves out (neighbours always are): a joint names every link it "
+               "moves, a URDF link's name that link alone",
                [](const TableReader& r, C& c) { read_collision_exclude(r, c.spec); }),
   }};
   return s;

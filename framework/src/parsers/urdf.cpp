@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <tuple>
 #include <unordered_map>
@@ -47,6 +48,7 @@ struct XmlOutline {
   };
   std::vector<Joint> joints;
   std::size_t links = 0;
+  std::vector<std::string> link_order;  // the links' names, in file order
 };
 
 // A linear scan of the XML before TinyXML sees it: the nesting depth and the element count are bounded (TinyXML
@@ -137,6 +139,7 @@ XmlOutline outline_xml(const std::string& where, const std::string& xml) {
   const auto text = [](const char* value) { return value != nullptr ? std::string(value) : std::string(); };
   for (const TiXmlElement* e = robot->FirstChildElement("link"); e != nullptr; e = e->NextSiblingElement("link")) {
     out.link_lines.emplace(text(e->Attribute("name")), static_cast<std::size_t>(e->Row()));
+    if (out.link_order.size() < kMaxUrdfLinks) out.link_order.push_back(text(e->Attribute("name")));
     ++out.links;
   }
   for (const TiXmlElement* e = robot->FirstChildElement("joint"); e != nullptr; e = e->NextSiblingElement("joint")) {
@@ -162,6 +165,19 @@ struct Namer {
   const XmlOutline& outline;
   [[nodiscard]] std::string link(const std::string& name) const { return at(outline.link_lines, "link", name); }
   [[nodiscard]] std::string joint(const std::string& name) const { return at(outline.joint_lines, "joint", name); }
+  // "the file's 12 links: 'base', 'l1', ..." (the first 60 by name).
+  [[nodiscard]] std::string link_list() const {
+    std::string s = "the file's " + std::to_string(outline.links) + " link" + (outline.links == 1 ? "" : "s") + ":";
+    std::size_t k = 0;
+    for (const std::string& name : outline.link_order) {
+      if (k++ == 60) {
+        s += " ... (" + std::to_string(outline.link_order.size() - 60) + " more)";
+        break;
+      }
+      s += (k == 1 ? " '" : ", '") + printable(name) + "'";
+    }
+    return s;
+  }
 
  private:
   std::string at(const std::map<std::string, std::size_t>& lines, const char* kind, const std::string& name) const {
@@ -258,25 +274,131 @@ void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometr
   }
 }
 
-// The side branch below `joint` (its joints taken at position 0), its frames placed from `at`: walked with a stack
-// of its own, so that a branch of 10,000 fixed links is as safe as one of 3 (the graph is a tree: checked first).
-void add_branch(const Namer& names, const urdf::ModelInterface& model, const urdf::Joint& joint,
-                const Eigen::Isometry3d& at, const std::string& messages, UrdfLink& out) {
-  std::vector<std::pair<const urdf::Joint*, Eigen::Isometry3d>> stack{{&joint, at}};
+void check_name(const std::string& who, const std::string& name) {
+  if (!is_printable_name(name)) {
+    throw UrdfError(who + ": the name is not UTF-8 without control characters (it reads '" + printable(name) + "')");
+  }
+}
+
+// The motion of a URDF joint at position q (rad or m): a turn about its axis, or a slide along it; a floating or planar
+// joint (held) does not move.
+Eigen::Isometry3d joint_motion(const urdf::Joint& j, double q) {
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d axis(j.axis.x, j.axis.y, j.axis.z);
+  if (q == 0.0 || !axis.allFinite() || !(axis.norm() > 1e-9)) return m;
+  axis.normalize();
+  switch (j.type) {
+    case urdf::Joint::REVOLUTE:
+    case urdf::Joint::CONTINUOUS: m.linear() = Eigen::AngleAxisd(q, axis).toRotationMatrix(); break;
+    case urdf::Joint::PRISMATIC: m.translation() = q * axis; break;
+    default: break;
+  }
+  return m;
+}
+
+bool movable(const urdf::Joint& j) {
+  return j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS || j.type == urdf::Joint::PRISMATIC;
+}
+
+// Where the joints off the chain are held: the robot file's values, 0 (or the limit nearest it), a mimic's leader's.
+struct Holder {
+  const Namer& names;
+  const urdf::ModelInterface& model;
+  const std::map<std::string, double>& given;
+  const std::set<std::string>& chain_joints;  // the chain's moving joints
+  UrdfChain& out;
+
+  // The position `j` is held at (recorded in out.held once, with a mimic's leader).
+  double value(const urdf::Joint& j) {
+    UrdfHeldJoint h = describe(j);
+    if (j.mimic) {
+      const std::string& leader = j.mimic->joint_name;
+      h.mimics = leader;
+      if (chain_joints.count(leader) != 0) {
+        throw UrdfError(h.where + " is a mimic of joint '" + printable(leader) +
+                        "', which is on the chain: a joint that moves with a chain joint is not supported (a chain of "
+                        "independent joints is expected; choose a tip_link above joint '" +
+                        printable(leader) + "' or below this one)");
+      }
+      const urdf::JointConstSharedPtr l = model.getJoint(leader);
+      if (!l)
+        throw UrdfError(h.where + " is a mimic of joint '" + printable(leader) + "', which the file does not have");
+      UrdfHeldJoint lead = describe(*l);
+      lead.value = own(*l);
+      record(lead);
+      h.value = j.mimic->multiplier * lead.value + j.mimic->offset;
+      if (!std::isfinite(h.value)) throw UrdfError(h.where + ": <mimic> gives a position that is not finite");
+    } else {
+      h.value = own(j);
+    }
+    record(h);
+    return h.value;
+  }
+
+ private:
+  UrdfHeldJoint describe(const urdf::Joint& j) const {
+    UrdfHeldJoint h;
+    h.name = j.name;
+    h.where = names.joint(j.name);
+    h.limited = j.type != urdf::Joint::CONTINUOUS && j.limits != nullptr && movable(j);
+    if (h.limited) {
+      h.lower = j.limits->lower;
+      h.upper = j.limits->upper;
+    }
+    return h;
+  }
+  // A joint's own held position: given, else 0 within its limits.
+  double own(const urdf::Joint& j) const {
+    if (const auto it = given.find(j.name); it != given.end()) return it->second;
+    if (j.type == urdf::Joint::CONTINUOUS || j.limits == nullptr || !movable(j)) return 0.0;
+    return std::clamp(0.0, std::min(j.limits->lower, j.limits->upper), std::max(j.limits->lower, j.limits->upper));
+  }
+  void record(const UrdfHeldJoint& h) {
+    for (const UrdfHeldJoint& e : out.held) {
+      if (e.name == h.name) return;
+    }
+    out.held.push_back(h);
+  }
+};
+
+// The side branch below `joint`, hanging from a link that rides on chain joint `index` with its frame `at` in that
+// joint's link frame: each link of it a UrdfLink of its own, its movable joints held (Holder). Walked with a stack of
+// its own, so that a branch of 10,000 fixed links is as safe as one of 3 (the graph is a tree: checked first).
+void add_branch(const Namer& names, const urdf::ModelInterface& model, const urdf::Joint& joint, int index,
+                const Eigen::Isometry3d& at, bool branch, Holder& holder, const std::string& messages,
+                UrdfChain& chain) {
+  struct Item {
+    const urdf::Joint* joint;
+    Eigen::Isometry3d from;
+    bool branch;
+  };
+  std::vector<Item> stack{{&joint, at, branch}};
   std::size_t visited = 0;
   while (!stack.empty()) {
     if (++visited > model.joints_.size()) {  // the tree checks hold this off; kept so the walk always ends
       throw UrdfError(names.joint(joint.name) + ": its side branch goes round a cycle of joints");
     }
-    const auto [j, from] = stack.back();
+    const Item item = stack.back();
     stack.pop_back();
-    const urdf::LinkConstSharedPtr link = model.getLink(j->child_link_name);
+    const urdf::Joint& j = *item.joint;
+    const urdf::LinkConstSharedPtr link = model.getLink(j.child_link_name);
     if (!link) continue;
-    check_pose(names.joint(j->name), "<origin>", j->parent_to_joint_origin_transform);
-    const Eigen::Isometry3d frame = from * pose_of(j->parent_to_joint_origin_transform);
-    add_shapes(names, *link, frame, messages, out);
+    check_name(names.joint(j.name), j.name);
+    check_name(names.link(link->name), link->name);
+    check_pose(names.joint(j.name), "<origin>", j.parent_to_joint_origin_transform);
+    const bool moves = movable(j) || j.mimic != nullptr;
+    Eigen::Isometry3d frame = item.from * pose_of(j.parent_to_joint_origin_transform);
+    if (moves) frame = frame * joint_motion(j, holder.value(j));
+    UrdfLink l;
+    l.name = link->name;
+    l.where = names.link(link->name);
+    l.branch = item.branch || moves;
+    l.joint = index;
+    l.pose = frame;
+    add_shapes(names, *link, Eigen::Isometry3d::Identity(), messages, l);
+    chain.links.push_back(std::move(l));
     for (auto it = link->child_joints.rbegin(); it != link->child_joints.rend(); ++it) {
-      if (*it) stack.emplace_back(it->get(), frame);
+      if (*it) stack.push_back({it->get(), frame, item.branch || moves});
     }
   }
 }
@@ -326,12 +448,6 @@ void check_tree(const Namer& names, const XmlOutline& outline) {
                       "'): a URDF's joints form a tree");
     }
     for (const std::string& l : way) state[l] = 2;
-  }
-}
-
-void check_name(const std::string& who, const std::string& name) {
-  if (!is_printable_name(name)) {
-    throw UrdfError(who + ": the name is not UTF-8 without control characters (it reads '" + printable(name) + "')");
   }
 }
 
@@ -430,8 +546,8 @@ std::pair<std::string, std::string> default_urdf_chain(const std::filesystem::pa
   });
 }
 
-UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link,
-                          const std::string& tip_link) {
+UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link, const std::string& tip_link,
+                          const std::map<std::string, double>& held) {
   return with_parsed_urdf(file, [&](const urdf::ModelInterface& model_ref, const Namer& names,
                                     const std::string& messages) {
     const std::string where = file.string();
@@ -439,10 +555,14 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
     UrdfChain chain;
     chain.robot_name = model->getName();
     check_name(where + ": <robot>", chain.robot_name);
+    for (const std::string& l : names.outline.link_order) chain.all_links.push_back(l);
     const urdf::LinkConstSharedPtr base = model->getLink(base_link);
-    if (!base) throw UrdfError(where + ": no link named '" + printable(base_link) + "' (base_link)");
+    if (!base) {
+      throw UrdfError(where + ": no link named '" + printable(base_link) + "' (base_link); " + names.link_list());
+    }
     urdf::LinkConstSharedPtr link = model->getLink(tip_link);
-    if (!link) throw UrdfError(where + ": no link named '" + printable(tip_link) + "' (tip_link)");
+    if (!link)
+      throw UrdfError(where + ": no link named '" + printable(tip_link) + "' (tip_link); " + names.link_list());
 
     // Walk up from the tip to the base (the tree is checked: this ends); the joints met, reversed, are the chain.
     std::vector<urdf::LinkConstSharedPtr> links{link};
@@ -462,79 +582,96 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
     }
     std::reverse(links.begin(), links.end());  // base first
 
+    // The chain's own moving joints (a mimic joint is not one: it follows its leader).
+    std::set<std::string> chain_joints;
+    for (std::size_t k = 1; k < links.size(); ++k) {
+      const urdf::JointConstSharedPtr joint = links[k]->parent_joint;
+      if (movable(*joint) && !joint->mimic) chain_joints.insert(joint->name);
+    }
+    Holder holder{names, *model, held, chain_joints, chain};
+
     Eigen::Isometry3d fixed = Eigen::Isometry3d::Identity();  // fixed joints since the last moving one
     for (std::size_t k = 1; k < links.size(); ++k) {
       const urdf::JointConstSharedPtr joint = links[k]->parent_joint;
       const std::string who = names.joint(joint->name);
       check_name(who, joint->name);
       check_name(names.link(links[k]->name), links[k]->name);
-      if (joint->mimic) throw UrdfError(who + " is a mimic joint; a chain of independent joints is expected");
       check_pose(who, "<origin>", joint->parent_to_joint_origin_transform);
       const Eigen::Isometry3d origin = pose_of(joint->parent_to_joint_origin_transform);
-      switch (joint->type) {
-        case urdf::Joint::FIXED: fixed = fixed * origin; break;
-        case urdf::Joint::REVOLUTE:
-        case urdf::Joint::CONTINUOUS:
-        case urdf::Joint::PRISMATIC: {
-          if (chain.joints.size() == kMaxJoints) {
-            throw UrdfError(who + ": the chain from '" + printable(base_link) + "' to '" + printable(tip_link) +
-                            "' has more than " + std::to_string(kMaxJoints) + " moving joints, the most a robot has");
-          }
-          UrdfJoint j;
-          j.name = joint->name;
-          j.prismatic = joint->type == urdf::Joint::PRISMATIC;
-          j.continuous = joint->type == urdf::Joint::CONTINUOUS;
-          j.origin = fixed * origin;
-          fixed = Eigen::Isometry3d::Identity();
-          j.axis = Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
-          if (!j.axis.allFinite() || !(j.axis.norm() > 1e-9)) {
-            throw UrdfError(who + ": <axis> expected a finite, non-zero vector, got [" + num(j.axis.x()) + ", " +
-                            num(j.axis.y()) + ", " + num(j.axis.z()) + "]");
-          }
-          j.axis.normalize();
-          if (joint->limits) {
-            j.lower = joint->limits->lower;
-            j.upper = joint->limits->upper;
-            j.velocity = joint->limits->velocity;
-            j.effort = joint->limits->effort;
-            if (!(std::isfinite(j.effort) && j.effort >= 0.0 && j.effort <= 1e7)) {
-              throw UrdfError(who + ": <limit> effort expected 0 <= effort <= 1e7 " + (j.prismatic ? "N" : "N m") +
-                              ", got " + num(j.effort));
+      if (joint->mimic) {
+        // A mimic joint whose leader is off the chain is held where its leader is (Holder refuses one whose leader
+        // is on the chain): a fixed transform here.
+        fixed = fixed * origin * joint_motion(*joint, holder.value(*joint));
+        if (chain.joints.empty()) continue;
+      } else {
+        switch (joint->type) {
+          case urdf::Joint::FIXED: fixed = fixed * origin; break;
+          case urdf::Joint::REVOLUTE:
+          case urdf::Joint::CONTINUOUS:
+          case urdf::Joint::PRISMATIC: {
+            if (chain.joints.size() == kMaxJoints) {
+              throw UrdfError(who + ": the chain from '" + printable(base_link) + "' to '" + printable(tip_link) +
+                              "' has more than " + std::to_string(kMaxJoints) + " moving joints, the most a robot has");
             }
-            const double bound = *physical_bound(j.prismatic ? "m" : "rad");
-            const char* unit = j.prismatic ? " m" : " rad";
-            if (!j.continuous && !(std::abs(j.lower) <= bound && std::abs(j.upper) <= bound)) {
-              throw UrdfError(who + ": <limit> lower and upper expected |x| <= " + num(bound) + unit +
-                              " (a physical range), got " + num(j.lower) + " and " + num(j.upper));
+            UrdfJoint j;
+            j.name = joint->name;
+            j.where = who;
+            j.prismatic = joint->type == urdf::Joint::PRISMATIC;
+            j.continuous = joint->type == urdf::Joint::CONTINUOUS;
+            j.origin = fixed * origin;
+            fixed = Eigen::Isometry3d::Identity();
+            j.axis = Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
+            if (!j.axis.allFinite() || !(j.axis.norm() > 1e-9)) {
+              throw UrdfError(who + ": <axis> expected a finite, non-zero vector, got [" + num(j.axis.x()) + ", " +
+                              num(j.axis.y()) + ", " + num(j.axis.z()) + "]");
             }
-            if (!(std::abs(j.velocity) <= *physical_bound("rad/s or m/s")) || j.velocity < 0.0) {
-              throw UrdfError(who + ": <limit> velocity expected 0 <= v <= " + num(*physical_bound("rad/s or m/s")) +
-                              (j.prismatic ? " m/s" : " rad/s") + ", got " + num(j.velocity));
+            j.axis.normalize();
+            if (joint->limits) {
+              j.lower = joint->limits->lower;
+              j.upper = joint->limits->upper;
+              j.velocity = joint->limits->velocity;
+              j.effort = joint->limits->effort;
+              if (!(std::isfinite(j.effort) && j.effort >= 0.0 && j.effort <= 1e7)) {
+                throw UrdfError(who + ": <limit> effort expected 0 <= effort <= 1e7 " + (j.prismatic ? "N" : "N m") +
+                                ", got " + num(j.effort));
+              }
+              const double bound = *physical_bound(j.prismatic ? "m" : "rad");
+              const char* unit = j.prismatic ? " m" : " rad";
+              if (!j.continuous && !(std::abs(j.lower) <= bound && std::abs(j.upper) <= bound)) {
+                throw UrdfError(who + ": <limit> lower and upper expected |x| <= " + num(bound) + unit +
+                                " (a physical range), got " + num(j.lower) + " and " + num(j.upper));
+              }
+              if (!(std::abs(j.velocity) <= *physical_bound("rad/s or m/s")) || j.velocity < 0.0) {
+                throw UrdfError(who + ": <limit> velocity expected 0 <= v <= " + num(*physical_bound("rad/s or m/s")) +
+                                (j.prismatic ? " m/s" : " rad/s") + ", got " + num(j.velocity));
+              }
             }
+            chain.joints.push_back(j);
+            break;
           }
-          chain.joints.push_back(j);
-          break;
+          default:
+            throw UrdfError(who + " is a " +
+                            (joint->type == urdf::Joint::FLOATING ? std::string("floating")
+                             : joint->type == urdf::Joint::PLANAR ? std::string("planar")
+                                                                  : std::string("unknown")) +
+                            " joint; a chain of revolute, continuous, prismatic and fixed joints is expected");
         }
-        default:
-          throw UrdfError(who + " is a " +
-                          (joint->type == urdf::Joint::FLOATING ? std::string("floating")
-                           : joint->type == urdf::Joint::PLANAR ? std::string("planar")
-                                                                : std::string("unknown")) +
-                          " joint; a chain of revolute, continuous, prismatic and fixed joints is expected");
       }
       if (chain.joints.empty()) continue;  // still on the base: these links do not move
       UrdfLink l;
       l.name = links[k]->name;
+      l.where = names.link(links[k]->name);
       l.joint = static_cast<int>(chain.joints.size()) - 1;
       l.pose = fixed;
       add_shapes(names, *links[k], Eigen::Isometry3d::Identity(), messages, l);
-      // Side branches hanging from this link by fixed joints (a hand, a camera) ride on it; joints that could move
-      // in them are taken at position 0 (they are not part of the chain).
+      chain.links.push_back(std::move(l));
+      // Side branches hanging from this link (a hand, a camera, a head): each of their links a body of its own, riding
+      // on this joint, their movable joints held (Holder).
       for (const urdf::JointSharedPtr& child : links[k]->child_joints) {
         if (k + 1 < links.size() && child->child_link_name == links[k + 1]->name) continue;  // the chain itself
-        add_branch(names, *model, *child, Eigen::Isometry3d::Identity(), messages, l);
+        add_branch(names, *model, *child, static_cast<int>(chain.joints.size()) - 1, fixed, false, holder, messages,
+                   chain);
       }
-      chain.links.push_back(std::move(l));
     }
     if (chain.joints.empty()) {
       throw UrdfError(where + ": no moving joint between '" + printable(base_link) + "' and '" + printable(tip_link) +

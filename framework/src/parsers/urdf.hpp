@@ -7,6 +7,7 @@
 /// urdfdom is included only by urdf.cpp.
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -34,6 +35,7 @@ class UrdfError : public std::runtime_error {
 /// One moving joint of the chain, as the URDF gives it.
 struct UrdfJoint {
   std::string name;                                          //!< the joint's name
+  std::string where;                                         //!< "file:line: joint 'name'", for messages
   bool prismatic = false;                                    //!< else revolute or continuous
   bool continuous = false;                                   //!< a continuous joint has no position limits
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  //!< from the previous moving joint's link frame
@@ -50,9 +52,15 @@ struct UrdfMesh {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< the mesh's frame in the link's frame
 };
 
-/// A link of the chain that moves with a joint: its shapes, placed in that joint's link frame.
+/// A link that moves with a joint of the chain: a link of the chain itself (after the joint, and those fixed to it), or
+/// a link of a side branch hanging from one (a hand, a head, a finger), its branch's joints held. Its shapes are
+/// placed in that joint's link frame.
 struct UrdfLink {
-  std::string name;                                        //!< the link's name
+  std::string name;   //!< the link's name
+  std::string where;  //!< "file:line: link 'name'", for messages
+  /// On a side branch, below a joint that could move (held at a value): a body of its own, which self-collision
+  /// checks against the chain's links next to its joint's. False for the chain's links and for links fixed to them.
+  bool branch = false;
   int joint = 0;                                           //!< index of the moving joint it rides on (0-based)
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< the link's frame in that joint's link frame
   std::vector<ShapeSpec> shapes;                           //!< its sphere, box and cylinder collision elements
@@ -67,12 +75,26 @@ struct UrdfLink {
 /// read_urdf_chain() does.
 [[nodiscard]] std::pair<std::string, std::string> default_urdf_chain(const std::filesystem::path& file);
 
+/// A joint of a side branch that could move (revolute, continuous, prismatic), held at a value: the value the robot
+/// file gives (`held_joints`), else 0 (or the limit nearest 0 when 0 is outside its limits); a mimic joint follows
+/// its leader (multiplier * leader + offset). A mimic joint of the chain whose leader is not on the chain is held too.
+struct UrdfHeldJoint {
+  std::string name;                 //!< the joint's name
+  std::string where;                //!< "file:line: joint 'name'"
+  double value = 0.0;               //!< the position it is held at (rad or m)
+  bool limited = false;             //!< it has position limits (not continuous)
+  double lower = 0.0, upper = 0.0;  //!< its limits, when limited
+  std::string mimics;               //!< the leader's name, for a mimic joint (empty: not a mimic)
+};
+
 /// The chain from `base_link` to `tip_link`.
 struct UrdfChain {
   std::string robot_name;                                 //!< the URDF's robot name
   std::vector<UrdfJoint> joints;                          //!< the moving joints, base to tip
   std::vector<UrdfLink> links;                            //!< the links after the first moving joint, base to tip
   Eigen::Isometry3d tip = Eigen::Isometry3d::Identity();  //!< tip_link's frame in the last joint's link frame
+  std::vector<UrdfHeldJoint> held;                        //!< the held joints met (side branches, off-chain mimics)
+  std::vector<std::string> all_links;                     //!< every link of the URDF, in file order (for messages)
 };
 
 /// Reads the chain. Throws UrdfError naming the file and the element for: a missing or unparsable file (with
@@ -80,9 +102,11 @@ struct UrdfChain {
 /// a tree (a cycle, a link that is its own parent, a link with two parents), more links or joints than
 /// kMaxUrdfLinks or more moving joints than kMaxJoints, a name that is not UTF-8 or holds control characters, a
 /// length, position limit or velocity outside the robot file's physical range, a missing link, a tip that is not
-/// below the base, a floating, planar or mimic joint in the chain, and a chain without moving joints. Messages
-/// give the element's line where the file has it.
+/// below the base, a floating or planar joint in the chain, a mimic joint whose leader is on the chain (coupled joints
+/// are not supported), and a chain without moving joints. Messages give the element's line where the file has it.
+/// `held` gives the positions of side-branch joints by name (others: 0, see UrdfHeldJoint); names it gives that the
+/// file has no held joint for are not an error here (the caller reports them, with UrdfChain::held).
 [[nodiscard]] UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link,
-                                        const std::string& tip_link);
+                                        const std::string& tip_link, const std::map<std::string, double>& held = {});
 
 }  // namespace redres

@@ -56,6 +56,9 @@ struct ShapeSpec {
   std::optional<double> resolution{};               //!< points: the cell edge the points are put into (m)
   /// octree, points: the occupied cells, once read (load_cloud()); shared by the spec's copies.
   std::shared_ptr<const OccupancyMap> cloud{};
+  /// A robot's shapes: the body (a URDF link riding on the joint) it belongs to; empty: the joint's own link. Not a
+  /// key of the files (a URDF link's shapes are given by the link's name).
+  std::string body{};
 
   static const Schema<ShapeSpec>& schema();
 

@@ -97,6 +97,11 @@ struct JointSpec {
   std::optional<Inertia> inertia;
   std::string inertia_source;   //!< "file:line:col" of the robot file's `inertia` (empty: from the URDF or none)
   std::string inertia_warning;  //!< what is wrong with a URDF's <inertial> kept as given (empty: nothing)
+  /// The name of the link joint j moves (a URDF's link after the joint); empty: the joint's name stands for it.
+  std::string link_name;
+  /// Links riding on this joint below a held joint of a side branch (a URDF's head or fingers): bodies of their own,
+  /// which self-collision checks against the neighbouring joints' links (RobotModel::Body::branch).
+  std::vector<std::string> branch_links;
   /// Collision shapes of the link that joint j moves, in the link frame (the joint's frame after its motion, before
   /// the fixed transform to the next joint). A capsule with neither `length` nor `from`/`to` runs along the link:
   /// from the joint's origin to the next joint's origin (the end effector's, for the last joint).
@@ -123,6 +128,11 @@ struct RobotSpec {
   std::string source;                                              //!< file the spec came from (may be empty)
   /// Link pairs (joint indices, 0-based) never checked against each other, besides adjacent links, which never are.
   std::vector<std::pair<int, int>> collision_exclude;
+  /// The joints of a URDF's side branches, and mimic joints off the chain, with the positions they are held at (for
+  /// reports; the shapes are placed with them already).
+  std::vector<std::pair<std::string, double>> held_joints;
+  /// Body pairs, by name (RobotModel::bodies(): a URDF's links), never checked against each other.
+  std::vector<std::pair<std::string, std::string>> collision_exclude_bodies;
 };
 
 /// An immutable robot model. Construction validates the spec and throws std::invalid_argument on misuse.
@@ -197,10 +207,25 @@ class RobotModel {
   /// The spec the model was built from.
   [[nodiscard]] const RobotSpec& spec() const noexcept { return spec_; }
 
-  /// One collision shape of a link: the link (joint index) and the shape, with its pose in the link frame resolved
-  /// (a capsule along the link gets its end points here).
+  /// A rigid body the shapes belong to: the link a joint moves, or a link riding on it (a URDF's links each, by name:
+  /// the links fixed after the joint, and the links of side branches hanging from them).
+  struct Body {
+    std::string name;     //!< the URDF link's name (the joint's link_name, or the joint's name, for other robots)
+    int link = 0;         //!< the joint it rides on (0-based)
+    bool branch = false;  //!< below a held joint of a side branch (JointSpec::branch_links)
+  };
+  /// Every body, in joint order; the first body of each joint is the link the joint moves (body_of_joint()).
+  [[nodiscard]] const std::vector<Body>& bodies() const noexcept { return bodies_; }
+  /// The body the joint's link is.
+  [[nodiscard]] int body_of_joint(int j) const { return joint_body_[static_cast<std::size_t>(j)]; }
+  /// The body named `name`, or -1.
+  [[nodiscard]] int find_body(const std::string& name) const;
+
+  /// One collision shape of a link: the link (joint index), its body and the shape, with its pose in the link frame
+  /// resolved (a capsule along the link gets its end points here).
   struct LinkShape {
     int link = 0;            //!< joint index j (0-based)
+    int body = 0;            //!< index into bodies()
     ShapeSpec spec;          //!< the shape as FCL will see it (from/to filled in for capsules along the link)
     Eigen::Isometry3d pose;  //!< pose of the shape in the link frame
   };
@@ -209,6 +234,9 @@ class RobotModel {
   /// Whether links i and j are checked against each other for self-collision (not equal, not adjacent, not
   /// excluded by the robot file).
   [[nodiscard]] bool self_collision_pair(int i, int j) const;
+  /// Whether bodies a and b are checked against each other: not on the same joint; not on neighbouring joints unless
+  /// one of them is a side-branch body (Body::branch); their joints not excluded; the bodies not excluded by name.
+  [[nodiscard]] bool self_collision_bodies(int a, int b) const;
 
   /// Velocity limits of every joint at theta; writes into lower/upper (size n). Allocation-free.
   void velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
@@ -239,6 +267,9 @@ class RobotModel {
   double base_angle_ = 0.0;
   double end_effector_angle_ = 0.0;
   std::vector<LinkShape> link_shapes_;
+  std::vector<Body> bodies_;
+  std::vector<int> joint_body_;
+  std::vector<std::pair<int, int>> excluded_bodies_;
 };
 
 /// The rows of a pose task, in order ("x", "y", "phi" planar; "x", "y", "z", "wx", "wy", "wz" spatial); a position

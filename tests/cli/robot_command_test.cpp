@@ -39,6 +39,24 @@ TEST(RobotCommand, TheJsonGivesPosesAndTheSelfDistancesNearestFirst) {
   for (std::size_t k = 1; k < pairs.size(); ++k) {
     EXPECT_LE(pairs[k - 1]["distance"].get<double>(), pairs[k]["distance"].get<double>());
   }
+  // Shapes and pairs name their URDF links; the fingers are a side branch, their joints held (the second follows the
+  // first).
+  bool finger = false;
+  for (const auto& shape : j["collision_shapes"]) {
+    if (shape["link"] == "panda_leftfinger") {
+      finger = true;
+      EXPECT_TRUE(shape["side_branch"].get<bool>());
+      EXPECT_EQ(shape["joint_name"], "panda_joint7");
+    }
+    if (shape["link"] == "panda_hand") EXPECT_FALSE(shape["side_branch"].get<bool>());
+  }
+  EXPECT_TRUE(finger);
+  ASSERT_EQ(j["held_joints"].size(), 2u);
+  bool finger_pair = false;
+  for (const auto& p : pairs) {
+    if (p["links"][1] == "panda_leftfinger" && p["links"][0] == "panda_link6") finger_pair = true;
+  }
+  EXPECT_TRUE(finger_pair) << "a side-branch finger is checked against the neighbouring link 6";
   // The end-effector pose is the kinematics' at home.
   const RobotModel robot = load_robot(source_path("robots/franka_panda_meshes.toml"));
   KinematicsData k(robot);

@@ -189,5 +189,35 @@ TEST(Inertia, TheTomlPandaCarriesFrankasFiguresInItsOwnFrames) {
     EXPECT_LE((a.tensor - b.tensor).cwiseAbs().maxCoeff(), 1e-9) << "trial " << trial;
   }
 }
+
+// A [[links]] entry's `inertia` replaces one URDF link's <inertial> (here the xArm6's impossible link 2 tensor, whose
+// warning goes with it); the other links keep the URDF's, and an impossible one given here is an error.
+TEST(Inertia, ALinksEntryReplacesAUrdfLinksInertial) {
+  const auto dir = scratch("inertia_links");
+  std::filesystem::create_directories(dir);
+  const RobotModel shipped = load_robot(source_path("robots/xarm6.toml"));
+  const std::string head = "urdf = \"" + source_path("robots/xarm6_description/xarm6_robot.urdf").string() +
+                           "\"\nbase_link = \"link_base\"\ntip_link = \"link6\"\ncollision_model = \"none\"\n";
+  std::ofstream(dir / "good.toml") << head
+                                   << "[[links]]\nname = \"link2\"\ninertia = { mass = 2.0, com = [0.1, 0.0, 0.0], "
+                                      "ixx = 0.01, iyy = 0.02, izz = 0.02 }\n";
+  const RobotModel robot = load_robot(dir / "good.toml");
+  ASSERT_TRUE(robot.joint(1).inertia);
+  EXPECT_EQ(robot.joint(1).inertia->mass, 2.0);
+  EXPECT_LE((robot.joint(1).inertia->com - Eigen::Vector3d(0.1, 0.0, 0.0)).norm(), 1e-15);
+  EXPECT_EQ(robot.joint(1).inertia_warning, "");
+  ASSERT_TRUE(robot.joint(0).inertia);
+  EXPECT_EQ(robot.joint(0).inertia->mass, shipped.joint(0).inertia->mass);
+  std::ofstream(dir / "bad.toml") << head
+                                  << "[[links]]\nname = \"link2\"\ninertia = { mass = 2.0, ixx = 0.01, iyy = 0.01, "
+                                     "izz = 0.03 }\n";
+  try {
+    (void)load_robot(dir / "bad.toml");
+    FAIL() << "expected an error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("triangle"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bad.toml:7:"), std::string::npos) << e.what();
+  }
+}
 }  // namespace
 }  // namespace redres

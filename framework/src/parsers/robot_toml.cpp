@@ -143,10 +143,11 @@ void read_effort(const TableReader& r, JointSpec& jt) {
   jt.effort_limit = e;
 }
 
-// A joint's `inertia` table: the mass properties of the link it moves, in that link's frame.
-void read_inertia(const TableReader& r, JointSpec& jt) {
+// An `inertia` table (of a joint: the link it moves; of a [[links]] entry: that URDF link), in the link's frame.
+// `who` names it in messages ("joint 'j1'", "link 'head'").
+Inertia read_inertia_table(const TableReader& r, const std::string& who) {
   const TableReader t = r.table("inertia");
-  const TableReader in(t.file_ptr(), t.raw(), "joint '" + jt.name + "' inertia");
+  const TableReader in(t.file_ptr(), t.raw(), who + " inertia");
   Inertia body;
   body.mass = in.number("mass");
   const std::vector<double> com = in.has("com") ? in.numbers("com", 3) : std::vector<double>{0.0, 0.0, 0.0};
@@ -157,7 +158,12 @@ void read_inertia(const TableReader& r, JointSpec& jt) {
   body.tensor << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
   in.finish();
   if (const std::string bad = body.invalid(); !bad.empty()) r.fail("inertia", bad);
-  jt.inertia = body;
+  return body;
+}
+
+// A joint's `inertia` table: the mass properties of the link it moves, in that link's frame.
+void read_inertia(const TableReader& r, JointSpec& jt) {
+  jt.inertia = read_inertia_table(r, "joint '" + jt.name + "'");
   jt.inertia_source = r.location("inertia").str();
 }
 
@@ -433,6 +439,7 @@ struct LinkEntry {
   bool replace = true;
   std::vector<ShapeSpec> collision;
   std::string collision_model;  // empty: the robot's
+  std::optional<Inertia> inertia;
   static const Schema<LinkEntry>& schema() {
     using C = LinkEntry;
     static const Schema<C> s{{
@@ -445,6 +452,12 @@ struct LinkEntry {
               rule<std::string>("\"capsule\" or \"none\"",
                                 [](const std::string& v) { return v == "capsule" || v == "none"; }))
             .listed_default("the robot's `collision_model`"),
+        entry<C>("inertia", "table {mass, com, ixx, iyy, izz, ixy, ixz, iyz}", "kg, m, kg m^2", "the URDF's <inertial>",
+                 "the link's mass properties, in the link's frame, replacing the URDF's (as a [[joints]] entry's "
+                 "`inertia`)",
+                 [](const TableReader& r, C& c) {
+                   if (r.has("inertia")) c.inertia = read_inertia_table(r, "link '" + c.name + "'");
+                 }),
     }};
     return s;
   }
@@ -477,6 +490,7 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
     const auto e = link_entries.find(link.name);
     bool replace = false;
     std::string model = c.collision_model;
+    std::optional<Inertia> given_inertia;
     if (e != link_entries.end())
       gather(c, [&] {
         const TableReader entry(e->second.file_ptr(), e->second.raw(), "link '" + link.name + "'");
@@ -484,6 +498,7 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
         read_config(entry, LinkEntry::schema(), links);
         replace = links.replace;
         if (!links.collision_model.empty()) model = links.collision_model;
+        given_inertia = links.inertia;
         for (std::size_t k = 0; k < links.collision.size(); ++k) {
           const ShapeSpec& shape = links.collision[k];
           if (shape.shape == ShapeSpec::Kind::kCapsule && !shape.length && !shape.from) {
@@ -498,10 +513,15 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
         }
         entry.finish();
       });
-    if (link.inertia && jt.inertia_source.empty()) {  // the link's mass properties, in the joint's link frame
-      const Inertia placed = link.inertia->moved(link.pose);
+    // The link's mass properties (the [[links]] entry's, else the URDF's), in the joint's link frame; a [[joints]]
+    // entry's `inertia` replaces them all.
+    const std::optional<Inertia>& body = given_inertia ? given_inertia : link.inertia;
+    if (body && jt.inertia_source.empty()) {
+      const Inertia placed = body->moved(link.pose);
       jt.inertia = jt.inertia ? jt.inertia->combined(placed) : placed;
-      for (const std::string& w : link.warnings) jt.inertia_warning += (jt.inertia_warning.empty() ? "" : "; ") + w;
+      if (!given_inertia) {
+        for (const std::string& w : link.warnings) jt.inertia_warning += (jt.inertia_warning.empty() ? "" : "; ") + w;
+      }
     }
     // Every shape of this link belongs to it (a body of its own: RobotModel::bodies()).
     const auto own = [&] {

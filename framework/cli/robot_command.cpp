@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "redres/common/formula.hpp"
 #include "redres/model/collision.hpp"
+#include "redres/model/convex.hpp"
 #include "redres/model/kinematics.hpp"
 #include "redres/parsers/robot_toml.hpp"
 
@@ -138,6 +139,11 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
                       {"joint_name", model.joint(shape.link).name},
                       {"shape", shape.spec.describe()},
                       {"position", to_vector(shape.pose.translation())}});
+    if (shape.spec.hull) {
+      shapes.back()["file"] = shape.spec.hull->source.string();
+      shapes.back()["vertices"] = shape.spec.hull->vertices.size();
+      shapes.back()["faces"] = shape.spec.hull->faces.size();
+    }
   }
   nlohmann::json J = nlohmann::json::array();
   for (Eigen::Index r = 0; r < k.J.rows(); ++r) J.push_back(to_vector(k.J.row(r).transpose()));
@@ -231,7 +237,13 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
   if (model.link_shapes().empty()) o << "  none\n";
   for (const auto& shape : model.link_shapes()) {
     o << std::setw(5) << shape.link + 1 << "  " << std::left << std::setw(width) << model.joint(shape.link).name
-      << std::right << "  " << shape.spec.describe() << "\n";
+      << std::right << "  " << shape.spec.describe();
+    if (shape.spec.shape == ShapeSpec::Kind::kConvex) {  // a hull's pose: it has no size to place it by
+      const Eigen::Vector3d p = shape.pose.translation();
+      const auto rpy = rpy_of(shape.pose.linear());
+      o << " at xyz " << p.x() << " " << p.y() << " " << p.z() << " rpy " << rpy[0] << " " << rpy[1] << " " << rpy[2];
+    }
+    o << "\n";
   }
   const std::vector<PairDistance> pairs = self_distances(model, k);
   if (!pairs.empty()) {

@@ -24,6 +24,7 @@
 #include "redres/model/convex.hpp"
 #include "redres/model/mesh.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/run/scenario.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -578,6 +579,60 @@ TEST(ConvexHull, AScenarioCannotWriteAConvexShape) {
     EXPECT_NE(std::string(e.what()).find("collision_model = \"hull\""), std::string::npos) << e.what();
   }
   EXPECT_THROW(DistanceQuery({s}), std::invalid_argument);
+  // In a scenario file: refused at the obstacle, with the same message.
+  const fs::path dir = scratch("hull_scenario");
+  fs::create_directories(dir);
+  std::string text = read_text(source_path("configs/panda_hulls_table_pole.toml"));
+  const std::string pole = "{ shape = \"capsule\", radius = 0.03, from = [0.25, -0.2, 0.4], to = [0.25, -0.2, 1.0] }";
+  ASSERT_NE(text.find(pole), std::string::npos);
+  text.replace(text.find(pole), pole.size(), "{ shape = \"convex\", file = \"pole.obj\" }");
+  const std::string robot = "\"../robots/franka_panda_hulls.toml\"";
+  text.replace(text.find(robot), robot.size(), "\"" + source_path("robots/franka_panda_hulls.toml").string() + "\"");
+  std::ofstream(dir / "s.toml") << text;
+  try {
+    (void)load_scenario(dir / "s.toml");
+    FAIL() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("collision_model = \"hull\""), std::string::npos) << e.what();
+  }
+}
+
+// A hull against a point cloud: measured to each cell's bounding ball, so never farther than the nearest point and
+// at most a cell's half diagonal nearer.
+TEST(ConvexDistance, AHullAgainstAPointCloud) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  std::vector<Vector3d> pts;
+  for (int k = 0; k < 2000; ++k) pts.emplace_back(u(rng), u(rng), 0.3 * u(rng));
+  const fs::path dir = scratch("hull_cloud");
+  fs::create_directories(dir);
+  {
+    std::ofstream o(dir / "c.xyz");
+    o.precision(17);
+    for (const auto& p : pts) o << p.x() << " " << p.y() << " " << p.z() << "\n";
+  }
+  ShapeSpec cloud;
+  cloud.shape = ShapeSpec::Kind::kPoints;
+  cloud.file = dir / "c.xyz";
+  const double edge = 0.02;
+  cloud.resolution = edge;
+  int reached = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const ShapeSpec a = random_hull(rng);
+    const DistanceQuery q({a, cloud});
+    Isometry3d Ta = random_pose(rng, 0.05);
+    Ta.translation().z() += 0.3 + 0.1 * (trial % 3);
+    const ShapeDistance d = q.distance(0, Ta, 1, Isometry3d::Identity());
+    ASSERT_TRUE(d.ok);
+    const Features f = features(a, Ta);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& p : pts) nearest = std::min(nearest, inside_polytope(f, p) ? 0.0 : feature_distance(f, p));
+    EXPECT_LE(d.distance, nearest + 1e-9) << "trial " << trial;
+    EXPECT_GE(d.distance, nearest - std::sqrt(3.0) * edge - 1e-9) << "trial " << trial;
+    if (d.distance > 0.0) EXPECT_LE(surface_gap(f, d.point_a), 1e-9) << "trial " << trial;
+    reached += d.distance > 0.0 ? 0 : 1;
+  }
+  EXPECT_GT(reached, 0);  // some poses reach into the cloud
 }
 
 // A cube of side 2 centred on `c`, as an OBJ object named `name` (its vertices numbered from first + 1).

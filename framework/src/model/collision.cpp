@@ -418,6 +418,10 @@ struct DistanceQuery::Impl {
     c.centre = core_centre[k];
     c.planes = core_planes[k].empty() ? nullptr : core_planes[k].data();
     c.plane_count = static_cast<int>(core_planes[k].size());
+    if (hull[k]) {
+      c.first_neighbour = hull[k]->first_neighbour.data();
+      c.neighbours = hull[k]->neighbours.data();
+    }
     c.radius = round[k].round ? round[k].radius : 0.0;
     c.R = T.linear();
     c.t = T.translation();

@@ -132,6 +132,22 @@ std::shared_ptr<const ConvexHull> convex_hull(const std::vector<Eigen::Vector3d>
     hull->bound = std::max(hull->bound, p.norm());
   }
   hull->half_extent = 0.5 * (hi - lo);
+  // Each vertex's neighbours along the triangles' edges.
+  std::vector<std::vector<int>> adjacent(hull->vertices.size());
+  for (const auto& f : hull->faces) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const int a = f[k], b = f[(k + 1) % 3];
+      adjacent[static_cast<std::size_t>(a)].push_back(b);
+      adjacent[static_cast<std::size_t>(b)].push_back(a);
+    }
+  }
+  hull->first_neighbour.push_back(0);
+  for (auto& list : adjacent) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    hull->neighbours.insert(hull->neighbours.end(), list.begin(), list.end());
+    hull->first_neighbour.push_back(static_cast<int>(hull->neighbours.size()));
+  }
   return hull;
 }
 

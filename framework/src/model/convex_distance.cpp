@@ -23,6 +23,25 @@ int Core::support(const Eigen::Vector3d& d, Eigen::Vector3d& out) const {
     out = R * p + t;
     return -1;
   }
+  if (first_neighbour != nullptr) {
+    int at = last;
+    double most = local.dot(vertices[at]);
+    for (;;) {
+      int next = -1;
+      for (int j = first_neighbour[at]; j < first_neighbour[at + 1]; ++j) {
+        const double h = local.dot(vertices[neighbours[j]]);
+        if (h > most) {
+          most = h;
+          next = neighbours[j];
+        }
+      }
+      if (next < 0) break;
+      at = next;
+    }
+    last = at;
+    out = R * vertices[at] + t;
+    return at;
+  }
   int best = 0;
   double most = local.dot(vertices[0]);
   for (int k = 1; k < count; ++k) {
@@ -284,9 +303,9 @@ Result distance(const Core& a, const Core& b) {
   ccd.support2 = ccd_support;
   ccd.center1 = ccd_centre;
   ccd.center2 = ccd_centre;
-  ccd.max_iterations = 200;
+  ccd.max_iterations = 64;
   ccd.epa_tolerance = 1e-4;  // unused: EPA is never run
-  ccd.mpr_tolerance = 1e-12;
+  ccd.mpr_tolerance = 1e-9;
   ccd.dist_tolerance = 1e-12;
   ccd_real_t depth = 0.0;
   ccd_vec3_t dir{}, pos{};
@@ -302,11 +321,16 @@ Result distance(const Core& a, const Core& b) {
   a.support(n, sa);
   b.support(-n, sb);
   // The face normals: a's (n = its outward normal: b lies beyond that face) and b's (n = minus its outward normal).
+  // A face whose depth cannot beat the best is skipped without its support loop: the other core's extent along the
+  // face normal reaches at least its centre, so the depth is at least h - m.centre.
   double best = n.dot(sa - sb);
+  const Eigen::Vector3d centre_a = world_centre(a), centre_b = world_centre(b);
   for (int k = 0; k < a.plane_count; ++k) {
     const Eigen::Vector3d m = a.R * a.planes[k].head<3>();
+    const double h = a.planes[k](3) + m.dot(a.t);
+    if (!(h - m.dot(centre_b) < best)) continue;
     b.support(-m, sb);
-    const double depth = a.planes[k](3) + m.dot(a.t) - m.dot(sb);
+    const double depth = h - m.dot(sb);
     if (depth < best) {
       best = depth;
       n = m;
@@ -314,8 +338,10 @@ Result distance(const Core& a, const Core& b) {
   }
   for (int k = 0; k < b.plane_count; ++k) {
     const Eigen::Vector3d m = b.R * b.planes[k].head<3>();
+    const double h = b.planes[k](3) + m.dot(b.t);
+    if (!(h - m.dot(centre_a) < best)) continue;
     a.support(-m, sa);
-    const double depth = b.planes[k](3) + m.dot(b.t) - m.dot(sa);
+    const double depth = h - m.dot(sa);
     if (depth < best) {
       best = depth;
       n = -m;

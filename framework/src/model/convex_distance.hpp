@@ -20,10 +20,16 @@ namespace redres::convex {
 struct Core {
   const Eigen::Vector3d* vertices = nullptr;  //!< the polytope's vertices in the shape's frame (null: a cylinder)
   int count = 0;                              //!< how many
-  double cylinder_radius = 0.0;               //!< a cylinder's radius (when vertices is null)
-  double cylinder_half = 0.0;                 //!< a cylinder's half length (along local z)
-  const Eigen::Vector4d* planes = nullptr;    //!< a polytope's face planes in its frame (unit outward n, h: n.x <= h)
-  int plane_count = 0;                        //!< how many (none for a point or a segment)
+  /// A hull's vertex neighbours (ConvexHull::first_neighbour, neighbours): the support point is then found by climbing
+  /// from the last one found (exact on a convex polytope: a vertex no neighbour improves on is a maximum). Null: a
+  /// loop.
+  const int* first_neighbour = nullptr;
+  const int* neighbours = nullptr;
+  mutable int last = 0;                     //!< where the climb starts (the previous support vertex of this query)
+  double cylinder_radius = 0.0;             //!< a cylinder's radius (when vertices is null)
+  double cylinder_half = 0.0;               //!< a cylinder's half length (along local z)
+  const Eigen::Vector4d* planes = nullptr;  //!< a polytope's face planes in its frame (unit outward n, h: n.x <= h)
+  int plane_count = 0;                      //!< how many (none for a point or a segment)
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  //!< a point inside the core, in the shape's frame
   double radius = 0.0;                               //!< the radius the core is swept by
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();   //!< the shape's world pose

@@ -21,6 +21,9 @@ namespace redres {
 struct ConvexHull {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<std::array<int, 3>> faces;
+  /// The vertices' neighbours along the faces' edges: those of vertex k are neighbours[first_neighbour[k] ..
+  /// first_neighbour[k + 1]) (the support point is found by climbing them).
+  std::vector<int> first_neighbour, neighbours;
   std::filesystem::path source;          //!< the mesh file it was made from (empty for one made from points)
   int piece = 0;                         //!< which piece of the mesh file (0-based)
   int pieces = 1;                        //!< how many pieces the file has

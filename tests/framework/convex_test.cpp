@@ -238,6 +238,10 @@ ShapeSpec random_primitive(std::mt19937& rng, ShapeSpec::Kind kind) {
 // Is x within tol of the shape's surface (the radius away from its core's features)?
 double surface_gap(const Features& A, const Vector3d& x) { return std::abs(feature_distance(A, x) - A.r); }
 
+// The shapes a hull is measured against.
+constexpr std::array<ShapeSpec::Kind, 4> kOthers = {ShapeSpec::Kind::kSphere, ShapeSpec::Kind::kCapsule,
+                                                    ShapeSpec::Kind::kBox, ShapeSpec::Kind::kConvex};
+
 struct PairStats {
   int apart = 0, overlapping = 0;
   double worst_error = 0.0, worst_witness = 0.0, worst_symmetry = 0.0;
@@ -341,10 +345,7 @@ TEST(ConvexDistance, AnOverlapIsUndoneByMovingItsDepthAlongItsNormal) {
   int checked = 0;
   for (int trial = 0; trial < 600; ++trial) {
     const ShapeSpec a = random_hull(rng);
-    const ShapeSpec b = random_primitive(rng, static_cast<ShapeSpec::Kind>(trial % 4 == 3   ? 6
-                                                                           : trial % 4 == 2 ? 3
-                                                                           : trial % 4 == 1 ? 1
-                                                                                            : 0));
+    const ShapeSpec b = random_primitive(rng, kOthers[static_cast<std::size_t>(trial % 4)]);
     const DistanceQuery q({a, b});
     const Isometry3d Ta = random_pose(rng, 0.02), Tb = random_pose(rng, 0.05);
     const ShapeDistance d = q.distance(0, Ta, 1, Tb);
@@ -389,7 +390,7 @@ TEST(ConvexDistance, TheGradientIsTheUnitNormal) {
   int checked = 0;
   for (int trial = 0; trial < 300; ++trial) {
     const ShapeSpec a = random_hull(rng);
-    const ShapeSpec b = random_primitive(rng, static_cast<ShapeSpec::Kind>(trial % 3 == 2 ? 6 : trial % 3));
+    const ShapeSpec b = random_primitive(rng, kOthers[static_cast<std::size_t>(trial % 4)]);
     const DistanceQuery q({a, b});
     const Isometry3d Ta = random_pose(rng, 0.05), Tb = random_pose(rng, 0.3);
     const ShapeDistance d = q.distance(0, Ta, 1, Tb);
@@ -428,8 +429,8 @@ TEST(ConvexDistance, HullVsCylinderIsCloseToASampledCylinder) {
     EXPECT_LE(std::abs(local.z()), half + 1e-9);
     EXPECT_TRUE(std::abs(rho - *c.radius) < 1e-9 || std::abs(std::abs(local.z()) - half) < 1e-9);
     EXPECT_LE(surface_gap(features(a, Ta), d.point_a), 1e-9);
-    // No point of a fine sampling of the cylinder is nearer the hull than d (each sample's distance is exact:
-    // a hull against a sphere of radius 0 ... measured as a tiny sphere).
+    // No point of a fine sampling of the cylinder is nearer the hull than d (each sample is a sphere of radius
+    // 1e-12, whose distance to the hull is exact).
     ShapeSpec dot;
     dot.shape = ShapeSpec::Kind::kSphere;
     dot.radius = 1e-12;

@@ -200,9 +200,10 @@ def plane_section(shape, p, R, directions=120):
 
 
 def surface(shape, p, R):
-    """A 3-D mesh of the shape at world pose (p, R): (X, Y, Z) grids, or for a box a list of its 6 faces."""
+    """A 3-D mesh of the shape at world pose (p, R): (X, Y, Z) grids, or for a box a list of its 6 faces (a convex
+    hull is drawn as the box of its vertices, which summary.json gives as its `size`)."""
     kind = shape["shape"]
-    if kind == "box":
+    if kind in ("box", "convex"):
         h = 0.5 * np.array(shape["size"])
         corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h @ R.T + p
         faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
@@ -411,7 +412,7 @@ def snapshot_spatial(ax, data, summary, frames, duration):
     if closest is not None:
         k, t, d = closest
         for shape, p, R in link_shape_poses(summary, rots[k], pts[k]):
-            if shape["shape"] == "box":
+            if shape["shape"] in ("box", "convex"):
                 draw_solid(ax, shape, p, R, CLOSEST_COLOUR, 0.2)
             else:
                 ax.plot_wireframe(*surface(shape, p, R), color=CLOSEST_COLOUR, lw=0.3, alpha=0.5)

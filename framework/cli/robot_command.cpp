@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "redres/common/formula.hpp"
 #include "redres/model/collision.hpp"
+#include "redres/model/convex.hpp"
 #include "redres/model/kinematics.hpp"
 #include "redres/parsers/robot_toml.hpp"
 
@@ -142,6 +143,11 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
                       {"side_branch", model.bodies()[static_cast<std::size_t>(shape.body)].branch},
                       {"shape", shape.spec.describe()},
                       {"position", to_vector(shape.pose.translation())}});
+    if (shape.spec.hull) {
+      shapes.back()["file"] = shape.spec.hull->source.string();
+      shapes.back()["vertices"] = shape.spec.hull->vertices.size();
+      shapes.back()["faces"] = shape.spec.hull->faces.size();
+    }
   }
   nlohmann::json held = nlohmann::json::array();
   for (const auto& [name, value] : model.spec().held_joints) held.push_back({{"name", name}, {"value", value}});
@@ -244,8 +250,13 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
   for (const auto& shape : model.link_shapes()) {
     const auto& body = model.bodies()[static_cast<std::size_t>(shape.body)];
     o << std::setw(5) << shape.link + 1 << "  " << std::left << std::setw(width) << model.joint(shape.link).name << "  "
-      << std::setw(width) << body.name << std::right << "  " << shape.spec.describe()
-      << (body.branch ? "  (side branch)" : "") << "\n";
+      << std::setw(width) << body.name << std::right << "  " << shape.spec.describe();
+    if (shape.spec.shape == ShapeSpec::Kind::kConvex) {  // a hull's pose: it has no size to place it by
+      const Eigen::Vector3d p = shape.pose.translation();
+      const auto rpy = rpy_of(shape.pose.linear());
+      o << " at xyz " << p.x() << " " << p.y() << " " << p.z() << " rpy " << rpy[0] << " " << rpy[1] << " " << rpy[2];
+    }
+    o << (body.branch ? "  (side branch)" : "") << "\n";
   }
   if (!model.spec().held_joints.empty()) {
     o << "\nheld joints (side branches; `held_joints` in the robot file)\n";

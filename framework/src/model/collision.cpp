@@ -3,7 +3,9 @@
 #include "redres/model/collision.hpp"
 
 #include "redres/common/error.hpp"
+#include "redres/model/convex.hpp"
 
+#include "model/convex_distance.hpp"
 #include "model/occupancy.hpp"
 
 #include <algorithm>
@@ -38,7 +40,8 @@ const Schema<ShapeSpec>& ShapeSpec::schema() {
   using S = ShapeSpec;
   static const Schema<S> s{
       {field("shape", &S::shape, "",
-             "the primitive, or occupied space read from a file (octree, points: obstacles only)"),
+             "the primitive, or occupied space read from a file (octree, points: obstacles only); convex: made from a "
+             "robot's meshes only (collision_model = \"hull\")"),
        field("radius", &S::radius, "m",
              "sphere, capsule, cylinder: radius; octree, points: how far the occupied cells are grown (default 0)"),
        field("length", &S::length, "m", "capsule, cylinder: axis length (along the local z axis)"),
@@ -53,6 +56,25 @@ const Schema<ShapeSpec>& ShapeSpec::schema() {
        field("resolution", &S::resolution, "m", "points: the edge of the cubic cells the points are put into")},
       [](const S& spec) {
         const std::string name(config_io::enum_name(spec.shape));
+        if (spec.shape == Kind::kConvex) {
+          if (!spec.hull) {
+            throw FieldError("shape",
+                             "\"convex\" is the convex hull of a robot's collision mesh, made by the robot file's "
+                             "`collision_model = \"hull\"` (docs/robot_format.md, \"Meshes\"); it cannot be written "
+                             "by hand");
+          }
+          if (spec.radius || spec.size || spec.length || spec.from || spec.to || spec.resolution) {
+            throw FieldError(spec.radius   ? "radius"
+                             : spec.size   ? "size"
+                             : spec.length ? "length"
+                             : spec.from   ? "from"
+                             : spec.to     ? "to"
+                                           : "resolution",
+                             "is not used by a convex hull (its shape comes from its mesh)");
+          }
+          return;
+        }
+        if (spec.hull) throw FieldError("shape", "only a convex shape holds a hull");
         if (spec.is_cloud()) {
           if (!spec.file || spec.file->empty())
             throw FieldError("file", "is required for " + name + " (the file to read)");
@@ -149,6 +171,15 @@ void ShapeSpec::describe(TextSink& s) const {
         s << (shape == Kind::kPoints ? " in " : ": ") << info.cells << " cells of " << info.resolution << " m";
       }
       if (radius.value_or(0.0) > 0.0) s << ", r = " << *radius << " m";
+      break;
+    case Kind::kConvex:
+      if (hull) {
+        s << hull->vertices.size() << " vertices, " << hull->faces.size() << " faces, from ";
+        const std::string_view whole(hull->source.native());
+        const std::size_t slash = whole.find_last_of('/');
+        s << (slash == std::string_view::npos ? whole : whole.substr(slash + 1));
+        if (hull->pieces > 1) s << " piece " << hull->piece + 1 << " of " << hull->pieces;
+      }
       break;
   }
   s << ")";
@@ -370,6 +401,47 @@ struct DistanceQuery::Impl {
   std::vector<std::shared_ptr<const OccupancyMap>> cloud;
   std::vector<Eigen::Vector3d> cloud_lo, cloud_hi;
   std::vector<Eigen::Isometry3d> object_offset;  // the FCL object's pose in the shape's frame (a cloud's box)
+  // Convex hulls, and every primitive as a core for the convex distance (model/convex_distance.hpp): the core's
+  // vertices (none for a cylinder, whose support is smooth) and a point inside it, in the shape's frame.
+  std::vector<std::shared_ptr<const ConvexHull>> hull;
+  std::vector<std::vector<Eigen::Vector3d>> core_vertices;
+  std::vector<Eigen::Vector3d> core_centre;
+  std::vector<std::vector<Eigen::Vector4d>> core_planes;  // a box's or hull's face planes (unit outward normal, offset)
+
+  // Shape k at pose T as a core swept by its radius.
+  [[nodiscard]] convex::Core core(std::size_t k, const Eigen::Isometry3d& T) const {
+    convex::Core c;
+    c.vertices = core_vertices[k].empty() ? nullptr : core_vertices[k].data();
+    c.count = static_cast<int>(core_vertices[k].size());
+    c.cylinder_radius = cylinder_radius[k];
+    c.cylinder_half = cylinder_half[k];
+    c.centre = core_centre[k];
+    c.planes = core_planes[k].empty() ? nullptr : core_planes[k].data();
+    c.plane_count = static_cast<int>(core_planes[k].size());
+    if (hull[k]) {
+      c.first_neighbour = hull[k]->first_neighbour.data();
+      c.neighbours = hull[k]->neighbours.data();
+    }
+    c.radius = round[k].round ? round[k].radius : 0.0;
+    c.R = T.linear();
+    c.t = T.translation();
+    return c;
+  }
+  // A pair with a convex hull (neither a cloud).
+  [[nodiscard]] ShapeDistance convex_pair(std::size_t a, const Eigen::Isometry3d& Ta, std::size_t b,
+                                          const Eigen::Isometry3d& Tb) const {
+    ShapeDistance out;
+    const convex::Result r = convex::distance(core(a, Ta), core(b, Tb));
+    if (!(std::isfinite(r.distance) && r.point_a.allFinite() && r.point_b.allFinite())) {
+      out.error = "the convex distance is not finite";
+      return out;
+    }
+    out.ok = true;
+    out.distance = r.distance;
+    out.point_a = r.point_a;
+    out.point_b = r.point_b;
+    return out;
+  }
 
   // A box or cylinder (shape k at T, in the cloud's frame) against a cloud's cells: each cell as its bounding ball
   // (grown by g), measured to the shape's nearest point in closed form (project).
@@ -381,6 +453,8 @@ struct DistanceQuery::Impl {
     Eigen::Isometry3d T;
     double g;
     [[nodiscard]] double bound(const Eigen::Vector3d& c, double h, double /*best*/) const override {
+      // A hull by its bounding ball (its exact projection is a GJK run; cell() makes it).
+      if (impl.hull[k]) return (c - T.translation()).norm() - impl.bound[k] - std::sqrt(3.0) * h - g;
       return (c - impl.project(k, T, c)).norm() - std::sqrt(3.0) * h - g;
     }
     double cell(const Eigen::Vector3d& c, double h, Eigen::Vector3d& on_query,
@@ -433,6 +507,15 @@ struct DistanceQuery::Impl {
     Eigen::Vector3d q = p;
     if (cloud[k]) {
       q = p.cwiseMax(cloud_lo[k]).cwiseMin(cloud_hi[k]);  // the bounding box: for lower bounds only
+    } else if (hull[k]) {
+      // GJK from the point (a core of one vertex) to the hull: exact; the point itself when inside.
+      const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+      convex::Core point;
+      point.vertices = &origin;
+      point.count = 1;
+      point.t = p;
+      Eigen::Vector3d on_point, on_hull;
+      if (convex::core_distance(point, core(k, Eigen::Isometry3d::Identity()), on_point, on_hull) > 0.0) q = on_hull;
     } else if (box_half[k]) {
       q = p.cwiseMax(-*box_half[k]).cwiseMin(*box_half[k]);
     } else if (cylinder_radius[k] > 0.0) {
@@ -535,6 +618,10 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
       impl_->box_half.push_back(std::nullopt);
       impl_->cylinder_radius.push_back(0.0);
       impl_->cylinder_half.push_back(0.0);
+      impl_->hull.push_back(nullptr);
+      impl_->core_vertices.emplace_back();
+      impl_->core_centre.emplace_back(Eigen::Vector3d::Zero());
+      impl_->core_planes.emplace_back();
       // The farthest corner of the grown cells' box from the cloud's origin.
       impl_->bound.push_back(impl_->cloud_lo.back().cwiseAbs().cwiseMax(impl_->cloud_hi.back().cwiseAbs()).norm() *
                              (1.0 + 1e-12));
@@ -548,6 +635,60 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
     impl_->cloud.push_back(nullptr);
     impl_->cloud_lo.emplace_back(Eigen::Vector3d::Zero());
     impl_->cloud_hi.emplace_back(Eigen::Vector3d::Zero());
+    impl_->hull.push_back(s.shape == ShapeSpec::Kind::kConvex ? s.hull : nullptr);
+    // The core's vertices: a sphere's centre, a capsule's two ends, a box's corners, a hull's vertices.
+    std::vector<Eigen::Vector3d> corners;
+    Eigen::Vector3d inner = Eigen::Vector3d::Zero();
+    switch (s.shape) {
+      case ShapeSpec::Kind::kSphere: corners.emplace_back(Eigen::Vector3d::Zero()); break;
+      case ShapeSpec::Kind::kCapsule:
+        corners.emplace_back(0.0, 0.0, -0.5 * s.axis_length());
+        if (s.axis_length() > 0.0) corners.emplace_back(0.0, 0.0, 0.5 * s.axis_length());
+        break;
+      case ShapeSpec::Kind::kBox:
+        for (int c = 0; c < 8; ++c) {
+          corners.emplace_back(((c & 1) ? 0.5 : -0.5) * (*s.size)[0], ((c & 2) ? 0.5 : -0.5) * (*s.size)[1],
+                               ((c & 4) ? 0.5 : -0.5) * (*s.size)[2]);
+        }
+        break;
+      case ShapeSpec::Kind::kConvex:
+        corners = s.hull->vertices;
+        for (const auto& v : corners) inner += v;
+        inner /= static_cast<double>(corners.size());
+        break;
+      case ShapeSpec::Kind::kCylinder:
+      case ShapeSpec::Kind::kOctree:
+      case ShapeSpec::Kind::kPoints: break;  // a smooth support; clouds above
+    }
+    // Face planes: a box's six; a hull's distinct ones (qhull's triangles split a facet into several).
+    std::vector<Eigen::Vector4d> planes;
+    if (s.shape == ShapeSpec::Kind::kBox) {
+      for (int k = 0; k < 3; ++k) {
+        for (const double side : {-1.0, 1.0}) {
+          Eigen::Vector4d p = Eigen::Vector4d::Zero();
+          p(k) = side;
+          p(3) = 0.5 * (*s.size)[static_cast<std::size_t>(k)];
+          planes.push_back(p);
+        }
+      }
+    } else if (s.hull) {
+      for (const auto& f : s.hull->faces) {
+        const Eigen::Vector3d& v0 = s.hull->vertices[static_cast<std::size_t>(f[0])];
+        Eigen::Vector3d n = (s.hull->vertices[static_cast<std::size_t>(f[1])] - v0)
+                                .cross(s.hull->vertices[static_cast<std::size_t>(f[2])] - v0);
+        if (!(n.norm() > 1e-12 * s.hull->bound * s.hull->bound)) continue;  // a sliver
+        n.normalize();
+        if (n.dot(v0 - inner) < 0.0) n = -n;  // outward
+        const double h = n.dot(v0);
+        const bool seen = std::any_of(planes.begin(), planes.end(), [&](const Eigen::Vector4d& p) {
+          return p.head<3>().dot(n) > 1.0 - 1e-12 && std::abs(p(3) - h) <= 1e-12 * s.hull->bound;
+        });
+        if (!seen) planes.emplace_back(n.x(), n.y(), n.z(), h);
+      }
+    }
+    impl_->core_planes.push_back(std::move(planes));
+    impl_->core_vertices.push_back(std::move(corners));
+    impl_->core_centre.push_back(inner);
     impl_->round.push_back(
         {round, round ? radius : 0.0, s.shape == ShapeSpec::Kind::kCapsule ? 0.5 * s.axis_length() : 0.0});
     impl_->box_half.push_back(s.shape == ShapeSpec::Kind::kBox ? std::optional<Eigen::Vector3d>(0.5 * vec(*s.size))
@@ -558,6 +699,7 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
     double bound = radius + impl_->round.back().half_length;  // a sphere or capsule
     if (impl_->box_half.back()) bound = impl_->box_half.back()->norm();
     if (cyl) bound = std::hypot(radius, 0.5 * *s.length);
+    if (s.hull) bound = s.hull->bound;
     impl_->bound.push_back(bound * (1.0 + 1e-12));  // rounding never culls a pair within reach
     std::shared_ptr<fcl::CollisionGeometryd> geometry;
     switch (s.shape) {
@@ -574,6 +716,12 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
       case ShapeSpec::Kind::kBox:
         geometry = std::make_shared<fcl::Boxd>((*s.size)[0], (*s.size)[1], (*s.size)[2]);
         break;
+      case ShapeSpec::Kind::kConvex: {
+        // In the broadphase a hull is the box of its vertices, centred on its frame's origin (convex_hull()).
+        const Eigen::Vector3d side = 2.0 * s.hull->half_extent;
+        geometry = std::make_shared<fcl::Boxd>(side.x(), side.y(), side.z());
+        break;
+      }
       case ShapeSpec::Kind::kOctree:
       case ShapeSpec::Kind::kPoints: break;  // above
     }
@@ -627,6 +775,10 @@ ShapeDistance DistanceQuery::distance(int a, const Eigen::Isometry3d& Ta, int b,
   }
   if (impl_->cloud[static_cast<std::size_t>(a)] || impl_->cloud[static_cast<std::size_t>(b)]) {
     return impl_->cloud_distance(a, Ta, b, Tb, within);
+  }
+  if (impl_->hull[static_cast<std::size_t>(a)] || impl_->hull[static_cast<std::size_t>(b)]) {
+    // A convex hull against any shape: GJK/MPR on support functions (model/convex_distance.hpp), without FCL.
+    return impl_->convex_pair(static_cast<std::size_t>(a), Ta, static_cast<std::size_t>(b), Tb);
   }
   {
     const Impl::Round& ra = impl_->round[static_cast<std::size_t>(a)];

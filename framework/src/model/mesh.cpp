@@ -79,18 +79,19 @@ void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent
              MeshData& out, int depth) {
   if (depth > 64) throw std::runtime_error("mesh '" + out.file.string() + "': its scene is nested too deeply");
   const aiMatrix4x4 at = parent * node.mTransformation;
+  // One piece per node (an OBJ's object or group): its meshes, which Assimp splits by material, together.
+  std::vector<Eigen::Vector3d> piece;
   for (unsigned k = 0; k < node.mNumMeshes; ++k) {
     const aiMesh& mesh = *scene.mMeshes[node.mMeshes[k]];
-    std::vector<Eigen::Vector3d> piece;
-    piece.reserve(mesh.mNumVertices);
+    piece.reserve(piece.size() + mesh.mNumVertices);
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
       const aiVector3D p = at * mesh.mVertices[v];
       const Eigen::Vector3d q(scale.x() * p.x, scale.y() * p.y, scale.z() * p.z);
       if (!q.allFinite()) throw std::runtime_error("mesh '" + out.file.string() + "': a vertex is not finite");
       piece.push_back(q);
     }
-    if (!piece.empty()) out.pieces.push_back(std::move(piece));
   }
+  if (!piece.empty()) out.pieces.push_back(std::move(piece));
   for (unsigned c = 0; c < node.mNumChildren; ++c) collect(scene, *node.mChildren[c], at, scale, out, depth + 1);
 }
 

@@ -165,8 +165,9 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
       const std::string who =
           "joint " + std::to_string(j + 1) + " ('" + joint(j).name + "') collision shape " + std::to_string(k + 1);
       REDRES_REQUIRE(!shape.velocity, "RobotModel", who + " has no velocity (only obstacles move)");
-      REDRES_REQUIRE(!shape.is_cloud(), "RobotModel",
-                     who + " is a sphere, capsule, cylinder or box (octrees and point clouds are obstacles)");
+      REDRES_REQUIRE(
+          !shape.is_cloud(), "RobotModel",
+          who + " is a sphere, capsule, cylinder, box or convex hull (octrees and point clouds are obstacles)");
       if (shape.shape == ShapeSpec::Kind::kCapsule && !shape.from && !shape.length) {
         const Vector3d end = next.translation();
         shape.from = std::array<double, 3>{0.0, 0.0, 0.0};

@@ -13,6 +13,7 @@
 #include "model/transforms.hpp"
 #include "parsers/urdf.hpp"
 #include "redres/config/plugin_loader.hpp"
+#include "redres/model/convex.hpp"
 #include "redres/model/mesh.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
 
@@ -448,9 +449,10 @@ struct LinkEntry {
         field("collision", &C::collision, "", "the link's shapes, in the link's frame (capsules need `length`)")
             .listed_default("[] (none)"),
         field("collision_model", &C::collision_model, "",
-              "what this link's mesh collision elements become: \"capsule\" or \"none\" (default: the robot's)",
-              rule<std::string>("\"capsule\" or \"none\"",
-                                [](const std::string& v) { return v == "capsule" || v == "none"; }))
+              "what this link's mesh collision elements become: \"capsule\", \"hull\" or \"none\" (default: the "
+              "robot's)",
+              rule<std::string>("\"capsule\", \"hull\" or \"none\"",
+                                [](const std::string& v) { return v == "capsule" || v == "hull" || v == "none"; }))
             .listed_default("the robot's `collision_model`"),
         entry<C>("inertia", "table {mass, com, ixx, iyy, izz, ixy, ixz, iyz}", "kg, m, kg m^2", "the URDF's <inertial>",
                  "the link's mass properties, in the link's frame, replacing the URDF's (as a [[joints]] entry's "
@@ -537,10 +539,18 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
       continue;
     }
     // Mesh collision elements: a capsule fitted to each mesh, every piece of it (a file's meshes, e.g. an OBJ's
-    // material groups, or a convex decomposition's pieces) together.
+    // material groups, or a convex decomposition's pieces) together; or ("hull") the convex hull of each piece.
     for (const UrdfMesh& mesh : link.meshes) {
       try {
         const MeshData data = read_mesh(resolve_mesh(mesh.filename, base_dir, c.packages), mesh.scale);
+        if (model == "hull") {
+          const int pieces = static_cast<int>(data.pieces.size());
+          for (int k = 0; k < pieces; ++k) {
+            jt.collision.push_back(convex_shape(data.pieces[static_cast<std::size_t>(k)], data.file, k, pieces)
+                                       .placed(link.pose * mesh.pose));
+          }
+          continue;
+        }
         std::vector<Eigen::Vector3d> all;
         all.reserve(data.vertex_count());
         for (const auto& piece : data.pieces) all.insert(all.end(), piece.begin(), piece.end());
@@ -697,13 +707,14 @@ const Schema<RobotReading>& RobotReading::schema() {
                    }
                  }
                }),
-      entry<C>("collision_model", "\"capsule\" or \"none\"", "", "\"capsule\"",
+      entry<C>("collision_model", "\"capsule\", \"hull\" or \"none\"", "", "\"capsule\"",
                "what a URDF's mesh collision elements become: a capsule fitted to each mesh (all its pieces "
-               "together) or nothing; a [[links]] entry may set its own (docs/robot_format.md, \"Meshes\")",
+               "together), the convex hull of each piece, or nothing; a [[links]] entry may set its own "
+               "(docs/robot_format.md, \"Meshes\")",
                [](const TableReader& r, C& c) {
                  if (!r.has("collision_model")) return;
                  only_with_urdf(r, c, "collision_model", "");
-                 c.collision_model = r.choice("collision_model", {"capsule", "none"});
+                 c.collision_model = r.choice("collision_model", {"capsule", "hull", "none"});
                }),
       entry<C>("packages", "table { NAME = \"dir\" }", "", "none",
                "where a URDF's package://NAME/ paths are, relative to this file (before REDRES_PACKAGE_PATH, "

@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "redres/model/convex.hpp"
+
 namespace redres {
 
 const Metric* RunSummary::metric(const std::string& plugin, const std::string& metric_name) const {
@@ -175,6 +177,15 @@ nlohmann::json shape_json(const ShapeSpec& shape) {
       j["length"] = shape.axis_length();
       break;
     case ShapeSpec::Kind::kBox: j["size"] = shape.size.value_or(std::array<double, 3>{0.0, 0.0, 0.0}); break;
+    case ShapeSpec::Kind::kConvex:
+      // The mesh it was made from, its counts, and its vertices' bounding box (centred on its pose) as `size`.
+      j["file"] = shape.file.value_or("").string();
+      if (shape.hull) {
+        j["vertices"] = shape.hull->vertices.size();
+        j["faces"] = shape.hull->faces.size();
+        j["size"] = vector_json(2.0 * shape.hull->half_extent);
+      }
+      break;
     case ShapeSpec::Kind::kOctree:
     case ShapeSpec::Kind::kPoints: {
       // The file, and its occupied cells (centre, edge; cloud frame): every k-th of them past 3,000, for plots.

@@ -32,6 +32,7 @@
 namespace redres {
 
 class OccupancyMap;
+struct ConvexHull;
 
 /// A primitive shape with a pose in its owner's frame (a link's frame, or the world for an obstacle). Capsules and
 /// cylinders have their axis along the local z axis, centred on the pose's origin; a capsule may instead be given
@@ -41,8 +42,12 @@ class OccupancyMap;
 /// octree (`octree`, `.bt` or `.ot`) or a point cloud (`points`, `.ply`, `.pcd` or `.xyz`) put into cubic cells of
 /// edge `resolution`. The obstacle is the union of the occupied cells grown by `radius` (0 for an octree unless
 /// given), placed by xyz/rpy. The file is read once (cloud(), load_cloud()) and shared by every copy of the spec.
+///
+/// A robot link may also be the convex hull of a collision mesh piece (`convex`, made by a robot file's
+/// `collision_model = "hull"`, docs/robot_format.md "Meshes"): its vertices and faces in `hull`, shared by every copy
+/// of the spec, placed by xyz/rpy, its mesh in `file`. Files cannot write one by hand (it has no size to give).
 struct ShapeSpec {
-  enum class Kind { kSphere, kCapsule, kCylinder, kBox, kOctree, kPoints };
+  enum class Kind { kSphere, kCapsule, kCylinder, kBox, kOctree, kPoints, kConvex };
   Kind shape = Kind::kCapsule;                      //!< which primitive
   std::optional<double> radius{};                   //!< sphere, capsule, cylinder (m)
   std::optional<double> length{};                   //!< capsule, cylinder: axis length (m)
@@ -59,6 +64,8 @@ struct ShapeSpec {
   /// A robot's shapes: the body (a URDF link riding on the joint) it belongs to; empty: the joint's own link. Not a
   /// key of the files (a URDF link's shapes are given by the link's name).
   std::string body{};
+  /// convex: the hull's vertices and faces (in the shape's frame); shared by the spec's copies.
+  std::shared_ptr<const ConvexHull> hull{};
 
   static const Schema<ShapeSpec>& schema();
 
@@ -69,8 +76,8 @@ struct ShapeSpec {
   [[nodiscard]] ShapeSpec placed(const Eigen::Isometry3d& at) const;
   /// The capsule's axis length (from `length`, or |to - from|).
   [[nodiscard]] double axis_length() const;
-  /// One line, e.g. "capsule(r = 0.05 m, l = 0.3 m)" or "points(cloud.ply: 100000 points in 5310 cells of 0.01 m,
-  /// r = 0.005 m)".
+  /// One line, e.g. "capsule(r = 0.05 m, l = 0.3 m)", "points(cloud.ply: 100000 points in 5310 cells of 0.01 m,
+  /// r = 0.005 m)" or "convex(412 vertices, 820 faces, from link3.stl)".
   [[nodiscard]] std::string describe() const;
   /// The same, written into `out` (allocation-free, for a failed step's diagnosis).
   void describe(TextSink& out) const;
@@ -109,7 +116,8 @@ inline auto enum_names(ShapeSpec::Kind) {
   return std::array{
       std::pair{K::kSphere, std::string_view("sphere")},     std::pair{K::kCapsule, std::string_view("capsule")},
       std::pair{K::kCylinder, std::string_view("cylinder")}, std::pair{K::kBox, std::string_view("box")},
-      std::pair{K::kOctree, std::string_view("octree")},     std::pair{K::kPoints, std::string_view("points")}};
+      std::pair{K::kOctree, std::string_view("octree")},     std::pair{K::kPoints, std::string_view("points")},
+      std::pair{K::kConvex, std::string_view("convex")}};
 }
 
 /// The outcome of one distance query.

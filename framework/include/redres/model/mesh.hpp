@@ -16,9 +16,9 @@
 namespace redres {
 
 /// A mesh as read: its vertices (in the mesh file's frame, scaled), and its pieces: a convex decomposition (a
-/// `*_vhacd.obj`) has several, each the vertices of one of the file's meshes.
+/// `*_vhacd.obj`) has several, each the vertices of one of the file's objects (an object's material groups together).
 struct MeshData {
-  std::filesystem::path file;                   //!< where it was read from
+  std::filesystem::path file;                        //!< where it was read from
   std::vector<std::vector<Eigen::Vector3d>> pieces;  //!< the vertices of each piece (at least one, each non-empty)
   [[nodiscard]] std::size_t vertex_count() const;
 };
@@ -38,8 +38,8 @@ struct PackagePaths {
 [[nodiscard]] std::filesystem::path resolve_mesh(const std::string& uri, const std::filesystem::path& base_dir,
                                                  const PackagePaths& packages);
 
-/// Reads a mesh file through Assimp, every mesh of its scene (with the scene's node transforms) as one piece (an OBJ's
-/// material groups are pieces too; a convex decomposition's pieces are its objects), each
+/// Reads a mesh file through Assimp, every node of its scene (with the scene's node transforms) as one piece, its
+/// meshes together (an OBJ's material groups are one piece; a convex decomposition's pieces are its objects), each
 /// vertex scaled by `scale`. Throws std::runtime_error naming the file when it cannot be read or holds no vertex.
 [[nodiscard]] MeshData read_mesh(const std::filesystem::path& file, const Eigen::Vector3d& scale);
 

@@ -1,8 +1,8 @@
 // `redres robot FILE`: the model's summary and its kinematics at theta (by default the home configuration).
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -50,7 +50,7 @@ Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model, co
                                 std::to_string(values.size()));
   }
   Eigen::VectorXd theta = Eigen::Map<Eigen::VectorXd>(values.data(), model.dof());
-  REDRES_REQUIRE(theta.allFinite(), option, "every value is finite");
+  REDRES_REQUIRE(theta.allFinite(), option.c_str(), "every value is finite");
   for (int j = 0; j < model.dof(); ++j) {
     const JointSpec& jt = model.joint(j);
     if (theta(j) < jt.lower || theta(j) > jt.upper) {
@@ -263,17 +263,16 @@ int print_ik(const RobotModel& model, const RobotOptions& opts) {
   const bool planar = model.kind() == ChainKind::kPlanar;
   const std::size_t p = planar ? 2 : 3, pose = planar ? 3 : 6;
   if (v.size() != p && v.size() != pose) {
-    throw std::invalid_argument("--ik: expected " + std::string(planar ? "x,y or x,y,phi" : "x,y,z or x,y,z,roll,pitch,yaw") +
-                                " (" + model.name() + " is " + (planar ? "planar" : "spatial") + "), got " +
-                                std::to_string(v.size()) + " value(s)");
+    throw std::invalid_argument(
+        "--ik: expected " + std::string(planar ? "x,y or x,y,phi" : "x,y,z or x,y,z,roll,pitch,yaw") + " (" +
+        model.name() + " is " + (planar ? "planar" : "spatial") + "), got " + std::to_string(v.size()) + " value(s)");
   }
   for (double x : v) REDRES_REQUIRE(std::isfinite(x), "--ik", "every value is finite");
-  const IkTarget target = planar ? IkTarget::planar(v[0], v[1], v.size() == pose ? std::optional<double>(v[2])
-                                                                                 : std::nullopt)
-                                 : IkTarget::spatial({v[0], v[1], v[2]}, v.size() == pose
-                                                                             ? std::optional<Eigen::Vector3d>(
-                                                                                   Eigen::Vector3d(v[3], v[4], v[5]))
-                                                                             : std::nullopt);
+  const IkTarget target =
+      planar ? IkTarget::planar(v[0], v[1], v.size() == pose ? std::optional<double>(v[2]) : std::nullopt)
+             : IkTarget::spatial(
+                   {v[0], v[1], v[2]},
+                   v.size() == pose ? std::optional<Eigen::Vector3d>(Eigen::Vector3d(v[3], v[4], v[5])) : std::nullopt);
   Eigen::VectorXd seed = model.home();
   const std::string seed_name = opts.seed.empty() ? "home" : opts.seed;
   if (seed_name == "zeros") {
@@ -316,8 +315,8 @@ int print_ik(const RobotModel& model, const RobotOptions& opts) {
                 << row(Eigen::Map<const Eigen::VectorXd>(v.data() + p, static_cast<long>(pose - p)));
     }
     std::cout << " from the seed '" << seed_name << "' " << row(seed) << "\n";
-    std::cout << "        " << (r.converged ? r.summary() : "did not converge (" + std::string(to_string(r.failure)) + ")")
-              << "\n";
+    std::cout << "        "
+              << (r.converged ? r.summary() : "did not converge (" + std::string(to_string(r.failure)) + ")") << "\n";
     std::cout << "theta   " << row(r.theta) << "\n";
     std::cout << "end effector  xyz " << row(r.pose.translation()) << "  rpy " << row(rpy(r.pose)) << "\n";
     std::cout << std::setprecision(3) << "position error " << r.position_error << " m, orientation error "

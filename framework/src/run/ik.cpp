@@ -104,9 +104,9 @@ RobotModel ik_model(const RobotModel& robot, const IkTarget& target, double step
 
 // One collision constraint of the IK and what it needs to be read back.
 struct Clone {
-  std::size_t index = 0;       // in the scheme's constraints
-  double safety = 0.0;         // its d_s (m)
-  std::string name;            // as the scenario named it
+  std::size_t index = 0;  // in the scheme's constraints
+  double safety = 0.0;    // its d_s (m)
+  std::string name;       // as the scenario named it
 };
 
 class IkSolver {
@@ -292,8 +292,8 @@ class IkSolver {
         return best;
       }
       if (!usable()) {
-        best.solver_failure = out_.info.diagnosis.empty() ? std::string(to_string(out_.info.status))
-                                                          : out_.info.diagnosis;
+        best.solver_failure =
+            out_.info.diagnosis.empty() ? std::string(to_string(out_.info.status)) : out_.info.diagnosis;
         break;
       }
       if (since_best >= options_.stall_iterations) break;
@@ -375,8 +375,8 @@ class IkSolver {
     }
     std::ostringstream s;
     s.precision(4);
-    s << "the closest configuration found, theta = " << vec(a.theta) << ", leaves the end effector "
-      << r.position_error << " m";
+    s << "the closest configuration found, theta = " << vec(a.theta) << ", leaves the end effector " << r.position_error
+      << " m";
     if (target_.rotation) s << " and " << r.orientation_error << " rad";
     s << " from the target (reached xyz " << vec(r.pose.translation());
     if (target_.rotation && model_.kind() == ChainKind::kSpatial) {
@@ -492,16 +492,11 @@ IkTarget IkTarget::planar(double x, double y, std::optional<double> phi) {
 
 const char* to_string(IkFailure failure) noexcept {
   switch (failure) {
-    case IkFailure::kNone:
-      return "none";
-    case IkFailure::kUnreachable:
-      return "unreachable";
-    case IkFailure::kJointLimit:
-      return "joint_limit";
-    case IkFailure::kCollision:
-      return "collision";
-    case IkFailure::kSolver:
-      return "solver";
+    case IkFailure::kNone: return "none";
+    case IkFailure::kUnreachable: return "unreachable";
+    case IkFailure::kJointLimit: return "joint_limit";
+    case IkFailure::kCollision: return "collision";
+    case IkFailure::kSolver: return "solver";
   }
   return "unknown";
 }

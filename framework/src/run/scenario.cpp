@@ -138,33 +138,34 @@ struct IkTable {
              },
              "|x| <= 1000 m")
              .required(),
-         entry<C>("rpy", "array of 3 numbers", "rad", "none (position only, or the seed's orientation for a pose task)",
-                  "spatial robots: the end effector's roll, pitch, yaw, R = Rz(yaw) Ry(pitch) Rx(roll)",
-                  [](const TableReader& r, C& c) {
-                    if (!r.has("rpy")) return;
-                    if (c.planar) {
-                      r.fail("rpy", "a planar robot's end-effector orientation is `phi` (one angle about z)");
-                    }
-                    const std::vector<double> a = r.numbers("rpy", 3);
-                    c.rpy = Eigen::Vector3d(a[0], a[1], a[2]);
-                    if (!(c.rpy->cwiseAbs().maxCoeff() <= *physical_bound("rad"))) {
-                      r.fail("rpy", "expected |x| <= 1e6 rad (a physical range)");
-                    }
-                  },
-                  "|x| <= 1e+06 rad"),
-         entry<C>("phi", "number", "rad", "none (as rpy)", "planar robots: the end effector's angle about z",
-                  [](const TableReader& r, C& c) {
-                    if (!r.has("phi")) return;
-                    if (!c.planar) {
-                      r.fail("phi",
-                             "is for a planar robot; a spatial robot's orientation is `rpy = [roll, pitch, yaw]`");
-                    }
-                    c.phi = r.number("phi");
-                    if (!(std::abs(*c.phi) <= *physical_bound("rad"))) {
-                      r.fail("phi", "expected |x| <= 1e6 rad (a physical range)");
-                    }
-                  },
-                  "|x| <= 1e+06 rad")}};
+         entry<C>(
+             "rpy", "array of 3 numbers", "rad", "none (position only, or the seed's orientation for a pose task)",
+             "spatial robots: the end effector's roll, pitch, yaw, R = Rz(yaw) Ry(pitch) Rx(roll)",
+             [](const TableReader& r, C& c) {
+               if (!r.has("rpy")) return;
+               if (c.planar) {
+                 r.fail("rpy", "a planar robot's end-effector orientation is `phi` (one angle about z)");
+               }
+               const std::vector<double> a = r.numbers("rpy", 3);
+               c.rpy = Eigen::Vector3d(a[0], a[1], a[2]);
+               if (!(c.rpy->cwiseAbs().maxCoeff() <= *physical_bound("rad"))) {
+                 r.fail("rpy", "expected |x| <= 1e6 rad (a physical range)");
+               }
+             },
+             "|x| <= 1e+06 rad"),
+         entry<C>(
+             "phi", "number", "rad", "none (as rpy)", "planar robots: the end effector's angle about z",
+             [](const TableReader& r, C& c) {
+               if (!r.has("phi")) return;
+               if (!c.planar) {
+                 r.fail("phi", "is for a planar robot; a spatial robot's orientation is `rpy = [roll, pitch, yaw]`");
+               }
+               c.phi = r.number("phi");
+               if (!(std::abs(*c.phi) <= *physical_bound("rad"))) {
+                 r.fail("phi", "expected |x| <= 1e6 rad (a physical range)");
+               }
+             },
+             "|x| <= 1e+06 rad")}};
     return s;
   }
 };
@@ -188,50 +189,49 @@ struct Theta0Ik {
                     const toml::node& n = *r.raw().get("ik");
                     if (const auto* text = n.as_string()) {
                       if (text->get() != "path") {
-                        r.fail("ik", "expected \"path\" (the path's start) or a table { position = [...], rpy = "
-                                     "[...] }, got \"" +
-                                         text->get() + "\"");
+                        r.fail("ik",
+                               "expected \"path\" (the path's start) or a table { position = [...], rpy = "
+                               "[...] }, got \"" +
+                                   text->get() + "\"");
                       }
                       c.ik.from_path = true;
                       return;
                     }
                     if (!n.is_table()) {
-                      r.fail("ik", "expected \"path\" or a table { position = [...], rpy = [...] }, got " +
-                                       describe_type(n));
+                      r.fail("ik",
+                             "expected \"path\" or a table { position = [...], rpy = [...] }, got " + describe_type(n));
                     }
                     c.ik.planar = c.robot->kind() == ChainKind::kPlanar;
                     config_io::read(r, "ik", c.ik);
                   })
              .required(),
-         entry<C>("seed", "\"home\", \"zeros\" or an array of numbers, one per joint", "rad or m", "\"home\"",
-                  "where the iteration starts: the robot's home, zeros (clamped into the limits), or these joint "
-                  "positions (within the limits)",
-                  [](const TableReader& r, C& c) {
-                    const RobotModel& robot = *c.robot;
-                    c.seed = robot.home();
-                    if (!r.has("seed")) return;
-                    const toml::node& n = *r.raw().get("seed");
-                    const std::string expected = "expected \"home\", \"zeros\" or an array of " +
-                                                 std::to_string(robot.dof()) + " joint positions";
-                    if (const auto* text = n.as_string()) {
-                      c.seed_name = text->get();
-                      if (c.seed_name == "zeros") {
-                        c.seed = Eigen::VectorXd::Zero(robot.dof())
-                                     .cwiseMax(robot.lower_limits())
-                                     .cwiseMin(robot.upper_limits());
-                      } else if (c.seed_name != "home") {
-                        r.fail("seed", expected + ", got \"" + c.seed_name + "\"");
-                      }
-                      return;
-                    }
-                    c.seed_name = "given";
-                    c.seed = read_joint_array(r, "seed", robot, expected + ", got " + describe_type(n) +
-                                                                    (n.is_array() ? " of " +
-                                                                                        std::to_string(
-                                                                                            n.as_array()->size()) +
-                                                                                        " element(s)"
-                                                                                  : ""));
-                  })}};
+         entry<C>(
+             "seed", "\"home\", \"zeros\" or an array of numbers, one per joint", "rad or m", "\"home\"",
+             "where the iteration starts: the robot's home, zeros (clamped into the limits), or these joint "
+             "positions (within the limits)",
+             [](const TableReader& r, C& c) {
+               const RobotModel& robot = *c.robot;
+               c.seed = robot.home();
+               if (!r.has("seed")) return;
+               const toml::node& n = *r.raw().get("seed");
+               const std::string expected =
+                   "expected \"home\", \"zeros\" or an array of " + std::to_string(robot.dof()) + " joint positions";
+               if (const auto* text = n.as_string()) {
+                 c.seed_name = text->get();
+                 if (c.seed_name == "zeros") {
+                   c.seed =
+                       Eigen::VectorXd::Zero(robot.dof()).cwiseMax(robot.lower_limits()).cwiseMin(robot.upper_limits());
+                 } else if (c.seed_name != "home") {
+                   r.fail("seed", expected + ", got \"" + c.seed_name + "\"");
+                 }
+                 return;
+               }
+               c.seed_name = "given";
+               c.seed = read_joint_array(
+                   r, "seed", robot,
+                   expected + ", got " + describe_type(n) +
+                       (n.is_array() ? " of " + std::to_string(n.as_array()->size()) + " element(s)" : ""));
+             })}};
     return s;
   }
 };
@@ -581,8 +581,8 @@ void solve_start(Scenario& s, const Theta0Ik& req, const SourceLocation& where) 
       if (robot.tracks(r)) target.rows.push_back(robot.reference_names()[static_cast<std::size_t>(r)]);
     }
     if (target.rotation) {
-      const std::vector<std::string> names = planar ? std::vector<std::string>{"phi"}
-                                                    : std::vector<std::string>{"wx", "wy", "wz"};
+      const std::vector<std::string> names =
+          planar ? std::vector<std::string>{"phi"} : std::vector<std::string>{"wx", "wy", "wz"};
       for (std::size_t i = 0; i < names.size(); ++i) {
         if (!held || robot.tracks(p + static_cast<int>(i))) target.rows.push_back(names[i]);
       }
@@ -629,6 +629,10 @@ const std::vector<KeyTable>& scenario_key_tables() {
        describe_keys(OutputTable::schema())},
       {"scenario", "[orientation]", "the orientation reference of a pose task",
        describe_keys(OrientationTable::schema())},
+      {"scenario", "theta0 = { ik, seed }", "theta(0) found by inverse kinematics (docs/ik.md)",
+       describe_keys(Theta0Ik::schema())},
+      {"scenario", "theta0.ik = { position, rpy, phi }", "the inverse kinematics' target, in the world frame",
+       describe_keys(IkTable::schema())},
       {"scenario", "[solver]", "the run's policy for a step that is not solved (the engine's keys: redres plugins)",
        solver_policy_keys()},
   };

@@ -54,15 +54,15 @@ struct IkOptions {
   /// Kept from every joint limit (rad or m): one number, or one per joint (size n). Each must be below half the
   /// joint's range.
   Eigen::VectorXd margin = Eigen::VectorXd::Zero(1);
-  double max_step = 0.25;                     //!< the largest change of a joint per iteration (rad or m), > 0
-  double position_tolerance = 1e-10;          //!< converged when the position error is at most this (m)
-  double orientation_tolerance = 1e-10;       //!< and the orientation error at most this (rad)
-  int max_iterations = 300;                   //!< QP iterations per seed, at most
-  int stall_iterations = 25;                  //!< a seed gives up after this many iterations without progress
-  int restarts = 8;                           //!< further seeds tried when the first does not converge
-  double relax_weight = 1e4;                  //!< rho of the elastic QP: damping 1 / rho
-  bool self_collision = true;                 //!< add `self_collision` (its defaults) for a robot with collision
-                                              //!< shapes when `collision` has none of that type
+  double max_step = 0.25;                //!< the largest change of a joint per iteration (rad or m), > 0
+  double position_tolerance = 1e-12;     //!< converged when the position error is at most this (m)
+  double orientation_tolerance = 1e-12;  //!< and the orientation error at most this (rad)
+  int max_iterations = 300;              //!< QP iterations per seed, at most
+  int stall_iterations = 25;             //!< a seed gives up after this many iterations without progress
+  int restarts = 8;                      //!< further seeds tried when the first does not converge
+  double relax_weight = 1e4;             //!< rho of the elastic QP: damping 1 / rho
+  bool self_collision = true;            //!< add `self_collision` (its defaults) for a robot with collision
+                                         //!< shapes when `collision` has none of that type
 };
 
 /// Why an IK did not converge.
@@ -77,21 +77,21 @@ enum class IkFailure {
 /// The outcome of solve_ik(). On failure `theta` is the closest configuration found (within the limits and clear of
 /// collisions), never an unchecked one.
 struct IkResult {
-  bool converged = false;                                    //!< both errors within their tolerances
-  Eigen::VectorXd theta;                                     //!< the configuration found (n)
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();    //!< the end effector's pose there
-  double position_error = 0.0;                               //!< over the target's position rows (m)
-  double orientation_error = 0.0;                            //!< over its orientation rows (rad; 0 without)
-  int iterations = 0;                                        //!< QP iterations, every seed counted
-  int seeds = 0;                                             //!< seeds tried (1 + restarts used)
-  double seconds = 0.0;                                      //!< wall time
+  bool converged = false;                                         //!< both errors within their tolerances
+  Eigen::VectorXd theta;                                          //!< the configuration found (n)
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();         //!< the end effector's pose there
+  double position_error = 0.0;                                    //!< over the target's position rows (m)
+  double orientation_error = 0.0;                                 //!< over its orientation rows (rad; 0 without)
+  int iterations = 0;                                             //!< QP iterations, every seed counted
+  int seeds = 0;                                                  //!< seeds tried (1 + restarts used)
+  double seconds = 0.0;                                           //!< wall time
   double min_distance = std::numeric_limits<double>::infinity();  //!< nearest pair of the collision constraints (m);
                                                                   //!< +inf without any (or none within reach)
-  std::string nearest_pair;                                  //!< that pair, e.g. "link 'j3' ... vs obstacle 1 ..."
-  IkFailure failure = IkFailure::kNone;                      //!< why not converged
-  std::vector<int> limit_joints;                             //!< kJointLimit: the joints (0-based)
-  std::string blocking_pair;                                 //!< kCollision: the pair, as its constraint names it
-  std::string diagnosis;                                     //!< one sentence with the figures (empty: converged)
+  std::string nearest_pair;                                       //!< that pair, e.g. "link 'j3' ... vs obstacle 1 ..."
+  IkFailure failure = IkFailure::kNone;                           //!< why not converged
+  std::vector<int> limit_joints;                                  //!< kJointLimit: the joints (0-based)
+  std::string blocking_pair;                                      //!< kCollision: the pair, as its constraint names it
+  std::string diagnosis;                                          //!< one sentence with the figures (empty: converged)
 
   /// One line: "converged in 9 iterations (1 seed, 2.1 ms): position error 1.1e-16 m, orientation error 2e-16 rad,
   /// nearest collision pair 0.0312 m", or "did not converge: <diagnosis>".

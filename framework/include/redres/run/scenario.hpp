@@ -50,13 +50,13 @@ enum class OnInfeasible { kHold, kStop, kRelax, kBrake };
 
 /// A loaded scenario. Owns everything a run needs.
 struct Scenario {
-  std::string name;                            //!< scenario name
-  std::string source;                          //!< file it came from
-  std::unique_ptr<RobotModel> robot;           //!< the robot
-  Eigen::VectorXd theta0;                      //!< theta(0)
+  std::string name;                   //!< scenario name
+  std::string source;                 //!< file it came from
+  std::unique_ptr<RobotModel> robot;  //!< the robot
+  Eigen::VectorXd theta0;             //!< theta(0)
   /// theta0 = { ik = ... }: what the inverse kinematics found (theta0 is its answer; docs/ik.md); empty otherwise.
   std::optional<IkResult> ik;
-  std::string ik_target;  //!< the IK's target and seed, in words (empty without an IK)
+  std::string ik_target;                       //!< the IK's target and seed, in words (empty without an IK)
   double duration = 0.0;                       //!< T (s)
   double tau = 0.0;                            //!< step (s)
   Integrator integrator = Integrator::kEuler;  //!< integrator

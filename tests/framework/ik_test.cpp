@@ -19,6 +19,7 @@
 
 #include <Eigen/Geometry>
 
+#include "random_chain.hpp"
 #include "redres/common/error.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/control/plugin.hpp"
@@ -133,8 +134,8 @@ INSTANTIATE_TEST_SUITE_P(Robots, IkRoundTrip,
                                            RoundTrip{"robots/franka_panda_meshes.toml", 10},
                                            RoundTrip{"robots/xarm6.toml", 20},
                                            RoundTrip{"robots/kuka_iiwa14.toml", 10}),
-                         [](const auto& info) {
-                           std::string name = std::filesystem::path(info.param.robot).stem().string();
+                         [](const ::testing::TestParamInfo<RoundTrip>& robot) {
+                           std::string name = std::filesystem::path(robot.param.robot).stem().string();
                            for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
                            return name;
                          });
@@ -176,30 +177,64 @@ TEST(Ik, AnUnreachableTargetIsReportedWithTheDistanceLeft) {
   expect_within_limits(robot, r.theta);
 }
 
-// The paper's arm bends counter-clockwise only (joints 2 to 6 have positive limits), so a target far clockwise needs
-// joint 1 below its lower limit: the diagnosis names it.
+// A two-link planar arm (1 m links) whose first joint turns only within +-0.5 rad: a point 1.5 m away at 2 rad needs
+// joint 1 at 2 -+ 0.72 rad, beyond its limit (joint 2 at -+1.45 rad is well within its own): the diagnosis names
+// joint 1 alone, and the same arm with joint 1 free reaches the point.
+RobotSpec two_link(double lower1, double upper1) {
+  RobotSpec spec;
+  spec.name = "two_link";
+  spec.kind = ChainKind::kPlanar;
+  spec.task = TaskRows::kPosition;
+  for (int j = 0; j < 2; ++j) {
+    JointSpec joint;
+    joint.name = "j" + std::to_string(j + 1);
+    joint.length = 1.0;
+    joint.lower = j == 0 ? lower1 : -2.5;
+    joint.upper = j == 0 ? upper1 : 2.5;
+    joint.velocity_limit = testing::constant_law(1.0);
+    spec.joints.push_back(joint);
+  }
+  spec.home = Eigen::Vector2d(0.1, 0.5);
+  return spec;
+}
+
 TEST(Ik, ATargetBeyondAJointLimitNamesTheJoint) {
-  const RobotModel robot = load_robot(source_path("robots/paper_pushrod_6dof.toml"));
-  const double reach = 0.5 * (pose_at(robot, robot.home()).translation() - robot.base().translation()).norm();
-  const double angle = robot.lower_limits()(0) - 0.6;
-  const Eigen::Vector3d goal =
-      robot.base().translation() + reach * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0);
+  const RobotModel robot(two_link(-0.5, 0.5));
+  const Eigen::Vector2d goal = 1.5 * Eigen::Vector2d(std::cos(2.0), std::sin(2.0));
   const IkResult r = solve_ik(robot, IkTarget::planar(goal.x(), goal.y()), robot.home());
   EXPECT_FALSE(r.converged);
   ASSERT_EQ(r.failure, IkFailure::kJointLimit) << r.diagnosis;
-  ASSERT_FALSE(r.limit_joints.empty());
-  EXPECT_EQ(r.limit_joints.front(), 0) << r.diagnosis;
-  EXPECT_NEAR(r.theta(0), robot.lower_limits()(0), 1e-6);
-  EXPECT_NE(r.diagnosis.find("joint 1 ('" + robot.joint(0).name + "') at its lower limit"), std::string::npos)
-      << r.diagnosis;
-  EXPECT_GT(r.position_error, 0.01);
+  EXPECT_EQ(r.limit_joints, std::vector<int>{0}) << r.diagnosis;
+  EXPECT_NEAR(r.theta(0), 0.5, 1e-6);
+  EXPECT_NE(r.diagnosis.find("joint 1 ('j1') at its upper limit 0.5"), std::string::npos) << r.diagnosis;
+  EXPECT_EQ(r.diagnosis.find("joint 2"), std::string::npos) << r.diagnosis;
+  const Eigen::Vector3d reached = pose_at(robot, r.theta).translation();
+  EXPECT_NEAR(r.position_error, (reached.head<2>() - goal).norm(), 1e-12);
+  EXPECT_GT(r.position_error, 0.1);
   expect_within_limits(robot, r.theta);
-  // The same target with joint 1's limit out of the way is reached: the limit was what held it.
-  RobotSpec spec = robot.spec();
-  spec.joints[0].lower = angle - 1.0;
-  const RobotModel wide(spec);
-  const IkResult w = solve_ik(wide, IkTarget::planar(goal.x(), goal.y()), robot.home());
-  EXPECT_TRUE(w.converged) << w.summary();
+  // With joint 1 free the point is reached: the limit was what held it.
+  const RobotModel wide(two_link(-3.0, 3.0));
+  const IkResult w = solve_ik(wide, IkTarget::planar(goal.x(), goal.y()), wide.home());
+  ASSERT_TRUE(w.converged) << w.summary();
+  EXPECT_LE((pose_at(wide, w.theta).translation().head<2>() - goal).norm(), 1e-9);
+  // The shipped paper arm bends counter-clockwise only (joints 2 to 6 have positive limits): a pose whose angle phi
+  // needs joint 1 below its lower limit names joint 1 too.
+  const RobotModel paper = load_robot(source_path("robots/paper_pushrod_6dof.toml"));
+  Eigen::VectorXd q = paper.lower_limits();
+  RobotSpec spec = paper.spec();
+  spec.joints[0].lower = -3.0;
+  const RobotModel unlimited(spec);
+  q(0) = paper.lower_limits()(0) - 0.3;
+  const Eigen::Isometry3d p = pose_at(unlimited, q);
+  const double phi = std::atan2(p.linear()(1, 0), p.linear()(0, 0));
+  const IkResult s = solve_ik(paper, IkTarget::planar(p.translation().x(), p.translation().y(), phi), paper.home());
+  EXPECT_FALSE(s.converged);
+  ASSERT_EQ(s.failure, IkFailure::kJointLimit) << s.diagnosis;
+  EXPECT_EQ(s.limit_joints.front(), 0) << s.diagnosis;
+  EXPECT_NE(s.diagnosis.find("joint 1 ('" + paper.joint(0).name + "') at its lower limit"), std::string::npos)
+      << s.diagnosis;
+  EXPECT_TRUE(
+      solve_ik(unlimited, IkTarget::planar(p.translation().x(), p.translation().y(), phi), paper.home()).converged);
 }
 
 ShapeSpec sphere(double radius, const Eigen::Vector3d& at) {

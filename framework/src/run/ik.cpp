@@ -51,13 +51,6 @@ class StepBound final : public VelocityLimitLaw {
   double step_;
 };
 
-std::string num(double v, int digits = 4) {
-  std::ostringstream s;
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
-
 std::string vec(const Eigen::Ref<const Eigen::VectorXd>& v, int digits = 6) {
   std::ostringstream s;
   s.precision(digits);
@@ -396,9 +389,30 @@ class IkSolver {
       if (margin_(j) > 0.0) l << " less the margin " << margin_(j);
       limits += l.str();
     }
+    // A chain of revolute joints reaches no farther from its first joint than the sum of the distances between
+    // consecutive joint axes' points and the end effector (each is fixed by the joints before it).
+    std::string beyond;
+    bool all_position = true;
+    for (int row = 0; row < model_.position_rows(); ++row) all_position = all_position && model_.tracks(row);
+    if (model_.all_revolute() && all_position) {
+      double reach = 0.0;
+      for (int j = 0; j + 1 < model_.dof(); ++j) reach += (kin_->origins.col(j + 1) - kin_->origins.col(j)).norm();
+      reach += (kin_->ee_pose.translation() - kin_->origins.col(model_.dof() - 1)).norm();
+      const double far = (target_.position - kin_->origins.col(0)).head(model_.position_rows()).norm();
+      if (far > reach) {
+        std::ostringstream m;
+        m.precision(4);
+        m << "; the target is " << far << " m from the first joint, beyond the arm's reach of at most " << reach
+          << " m";
+        beyond = m.str();
+      }
+    }
     if (!a.solver_failure.empty()) {
       r.failure = IkFailure::kSolver;
-      r.diagnosis = "a QP of the iteration was not solved (" + a.solver_failure + "); " + s.str();
+      r.diagnosis = "a QP of the iteration was not solved (" + a.solver_failure + "); " + s.str() + beyond;
+    } else if (!beyond.empty()) {
+      r.failure = IkFailure::kUnreachable;
+      r.diagnosis = "unreachable: " + s.str() + beyond;
     } else if (!blocking.empty()) {
       r.failure = IkFailure::kCollision;
       r.blocking_pair = blocking;
@@ -410,21 +424,6 @@ class IkSolver {
     } else {
       r.failure = IkFailure::kUnreachable;
       r.diagnosis = "unreachable: " + s.str();
-      // A chain of revolute joints reaches no farther from its first joint than the sum of the distances between
-      // consecutive joint axes' points and the end effector (each is fixed by the joints before it).
-      if (model_.all_revolute()) {
-        double reach = 0.0;
-        for (int j = 0; j + 1 < model_.dof(); ++j) reach += (kin_->origins.col(j + 1) - kin_->origins.col(j)).norm();
-        reach += (kin_->ee_pose.translation() - kin_->origins.col(model_.dof() - 1)).norm();
-        const double far = (target_.position - kin_->origins.col(0)).head(model_.position_rows()).norm();
-        if (far > reach && !model_.task_names().empty() && target_.rows.empty()) {
-          std::ostringstream m;
-          m.precision(4);
-          m << "; the target is " << far << " m from the first joint, beyond the arm's reach of at most " << reach
-            << " m";
-          r.diagnosis += m.str();
-        }
-      }
     }
     if (!a.clear) r.diagnosis += "; no configuration found is clear of collisions";
     return r;

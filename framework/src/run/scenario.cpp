@@ -57,12 +57,13 @@ struct SolverPolicy {
 };
 
 // An array of joint positions at `key` (numbers or formulas, one per joint, within the limits).
+// `label` starts the entries' messages ("" at the top level, "theta0: " in theta0's table).
 Eigen::VectorXd read_joint_array(const TableReader& r, std::string_view key, const RobotModel& robot,
-                                 const std::string& expected) {
+                                 const std::string& expected, const std::string& label = "") {
   const toml::node& node = *r.raw().get(key);
   const toml::array* arr = node.as_array();
   if (arr == nullptr || static_cast<int>(arr->size()) != robot.dof()) r.fail(key, expected);
-  const std::string what = (r.context().empty() ? "" : r.context() + ": ") + "key '" + std::string(key) + "'";
+  const std::string what = label + "key '" + std::string(key) + "'";
   Eigen::VectorXd theta(robot.dof());
   for (int j = 0; j < robot.dof(); ++j) {
     const toml::node& el = (*arr)[static_cast<std::size_t>(j)];
@@ -230,7 +231,8 @@ struct Theta0Ik {
                c.seed = read_joint_array(
                    r, "seed", robot,
                    expected + ", got " + describe_type(n) +
-                       (n.is_array() ? " of " + std::to_string(n.as_array()->size()) + " element(s)" : ""));
+                       (n.is_array() ? " of " + std::to_string(n.as_array()->size()) + " element(s)" : ""),
+                   "theta0: ");
              })}};
     return s;
   }

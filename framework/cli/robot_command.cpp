@@ -306,6 +306,9 @@ int print_ik(const RobotModel& model, const RobotOptions& opts) {
           planar ? nlohmann::json(v[2]) : nlohmann::json(std::vector<double>(v.begin() + 3, v.end()));
     }
     j["min_self_collision_distance"] = pairs.empty() ? nlohmann::json(nullptr) : nlohmann::json(pairs[0].distance);
+    if (!pairs.empty()) {
+      j["nearest_self_collision_pair"] = {model.joint(pairs[0].i).name, model.joint(pairs[0].j).name};
+    }
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "robot   " << model.name() << "\n";

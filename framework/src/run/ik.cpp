@@ -133,7 +133,8 @@ class IkSolver {
       tables.push_back(c->config());
     }
     if (options.self_collision && !self && !robot.link_shapes().empty()) {
-      tables.push_back(toml::table{{"type", "self_collision"}});
+      // With every key of its defaults written out (config()), so that its damper is set like the others'.
+      tables.push_back(constraint_registry().create_default("self_collision", robot)->config());
     }
     for (toml::table& t : tables) {
       Clone clone;

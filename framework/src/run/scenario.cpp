@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <string_view>
 #include <utility>
 
@@ -598,7 +599,12 @@ void solve_start(Scenario& s, const Theta0Ik& req, const SourceLocation& where) 
   }
   IkOptions options;
   options.margin = scheme_margin(*s.scheme, robot.dof());
-  const IkResult result = solve_ik(robot, target, req.seed, collision, options);
+  IkResult result;
+  try {
+    result = solve_ik(robot, target, req.seed, collision, options);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(where, std::string("key 'theta0': the inverse kinematics cannot start: ") + e.what());
+  }
   if (!result.converged) {
     throw ConfigError(where, "key 'theta0': the inverse kinematics to " + text.str() + " from the seed '" +
                                  req.seed_name + "' " + result.summary() +

@@ -140,6 +140,55 @@ INSTANTIATE_TEST_SUITE_P(Robots, IkRoundTrip,
                            return name;
                          });
 
+// The smallest distance between two links of `robot` at theta that may collide (RobotModel::self_collision_pair).
+double self_distance(const RobotModel& robot, const Eigen::VectorXd& theta) {
+  KinematicsData k(robot);
+  compute_kinematics(robot, theta, k, KinematicsLevel::kPosition);
+  std::vector<ShapeSpec> shapes;
+  for (const auto& s : robot.link_shapes()) shapes.push_back(s.spec);
+  const DistanceQuery query(shapes);
+  double nearest = std::numeric_limits<double>::infinity();
+  const auto& ls = robot.link_shapes();
+  for (std::size_t a = 0; a < ls.size(); ++a) {
+    for (std::size_t b = a + 1; b < ls.size(); ++b) {
+      if (!robot.self_collision_pair(std::min(ls[a].link, ls[b].link), std::max(ls[a].link, ls[b].link))) continue;
+      const ShapeDistance d =
+          query.distance(static_cast<int>(a), k.link_frames[static_cast<std::size_t>(ls[a].link)] * ls[a].pose,
+                         static_cast<int>(b), k.link_frames[static_cast<std::size_t>(ls[b].link)] * ls[b].pose);
+      EXPECT_TRUE(d.ok) << d.error;
+      nearest = std::min(nearest, d.distance);
+    }
+  }
+  return nearest;
+}
+
+// With the robot's self-collision rows on (the default), the full pose of configurations whose links are 2 cm apart
+// or more is reached, and the answer's links are apart too.
+TEST(Ik, SpatialRoundTripsKeepTheLinksApart) {
+  for (const char* file : {"robots/franka_panda.toml", "robots/xarm6.toml"}) {
+    SCOPED_TRACE(file);
+    const RobotModel robot = load_robot(source_path(file));
+    std::mt19937 rng(26);
+    int reached = 0;
+    for (int trial = 0; trial < 40 && reached < 8; ++trial) {
+      const Eigen::VectorXd q = random_inside(robot, rng, 0.05);
+      if (self_distance(robot, q) < 0.02) continue;
+      const Eigen::Isometry3d goal = pose_at(robot, q);
+      const std::array<double, 3> rpy = rpy_of(goal.linear());
+      const IkResult r =
+          solve_ik(robot, IkTarget::spatial(goal.translation(), Eigen::Vector3d(rpy[0], rpy[1], rpy[2])), robot.home());
+      ASSERT_TRUE(r.converged) << r.summary();
+      const Eigen::Isometry3d got = pose_at(robot, r.theta);
+      EXPECT_LE((got.translation() - goal.translation()).norm(), 1e-9);
+      EXPECT_LE(angle_between(got.linear(), goal.linear()), 1e-9);
+      EXPECT_GT(self_distance(robot, r.theta), 0.0);
+      expect_within_limits(robot, r.theta);
+      ++reached;
+    }
+    EXPECT_EQ(reached, 8);
+  }
+}
+
 // A position target leaves the orientation free: the planar arm reaches (x, y) of a random configuration from zeros
 // clamped into its limits, with its self-collision rows (the default) on.
 TEST(Ik, PlanarPositionOnlyFromAnotherSeed) {

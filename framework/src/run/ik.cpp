@@ -311,6 +311,24 @@ class IkSolver {
     return best;
   }
 
+  // "; the target is ... beyond the arm's reach ..." when it is provably out of reach, else "" (uses kin_, at any
+  // configuration). A chain of revolute joints reaches no farther from its first joint than the sum of the distances
+  // between consecutive joint axes' points and the end effector (each is fixed by the joints before it).
+  [[nodiscard]] std::string beyond_reach() const {
+    bool all_position = true;
+    for (int row = 0; row < model_.position_rows(); ++row) all_position = all_position && model_.tracks(row);
+    if (!model_.all_revolute() || !all_position) return {};
+    double reach = 0.0;
+    for (int j = 0; j + 1 < model_.dof(); ++j) reach += (kin_->origins.col(j + 1) - kin_->origins.col(j)).norm();
+    reach += (kin_->ee_pose.translation() - kin_->origins.col(model_.dof() - 1)).norm();
+    const double far = (target_.position - kin_->origins.col(0)).head(model_.position_rows()).norm();
+    if (!(far > reach)) return {};
+    std::ostringstream m;
+    m.precision(4);
+    m << "; the target is " << far << " m from the first joint, beyond the arm's reach of at most " << reach << " m";
+    return m.str();
+  }
+
   // The result at theta, with the distances, and on failure the diagnosis.
   IkResult finish(const Attempt& a, bool converged) {
     IkResult r;
@@ -390,24 +408,7 @@ class IkSolver {
       if (margin_(j) > 0.0) l << " less the margin " << margin_(j);
       limits += l.str();
     }
-    // A chain of revolute joints reaches no farther from its first joint than the sum of the distances between
-    // consecutive joint axes' points and the end effector (each is fixed by the joints before it).
-    std::string beyond;
-    bool all_position = true;
-    for (int row = 0; row < model_.position_rows(); ++row) all_position = all_position && model_.tracks(row);
-    if (model_.all_revolute() && all_position) {
-      double reach = 0.0;
-      for (int j = 0; j + 1 < model_.dof(); ++j) reach += (kin_->origins.col(j + 1) - kin_->origins.col(j)).norm();
-      reach += (kin_->ee_pose.translation() - kin_->origins.col(model_.dof() - 1)).norm();
-      const double far = (target_.position - kin_->origins.col(0)).head(model_.position_rows()).norm();
-      if (far > reach) {
-        std::ostringstream m;
-        m.precision(4);
-        m << "; the target is " << far << " m from the first joint, beyond the arm's reach of at most " << reach
-          << " m";
-        beyond = m.str();
-      }
-    }
+    const std::string beyond = beyond_reach();
     if (!a.solver_failure.empty()) {
       r.failure = IkFailure::kSolver;
       r.diagnosis = "a QP of the iteration was not solved (" + a.solver_failure + "); " + s.str() + beyond;
@@ -448,6 +449,7 @@ class IkSolver {
                           (a.clear == best.clear && a.merit < best.merit);
       if (better) best = std::move(a);
       if (best.converged) break;
+      if (k == 0 && !beyond_reach().empty()) break;  // no other seed can reach it (kin_ holds the last step's)
     }
     IkResult r = finish(best, best.converged);
     r.iterations = iterations_;

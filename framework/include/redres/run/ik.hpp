@@ -17,7 +17,8 @@
 /// inside every bound and collision row. A step that makes the error grow, or that makes two bodies overlap, is
 /// halved. The iteration ends when both errors are below their tolerances (converged), or when the error has not
 /// improved for `stall_iterations` iterations; then it starts again from up to `restarts` other seeds (pseudo-random
-/// within the limits, fixed sequence), and a failure reports the closest configuration of all with a diagnosis.
+/// within the limits, fixed sequence; none for a target beyond the arm's reach), and a failure reports the closest
+/// configuration of all with a diagnosis.
 
 #include <limits>
 #include <optional>
@@ -59,7 +60,7 @@ struct IkOptions {
   double orientation_tolerance = 1e-12;  //!< and the orientation error at most this (rad)
   int max_iterations = 300;              //!< QP iterations per seed, at most
   int stall_iterations = 25;             //!< a seed gives up after this many iterations without progress
-  int restarts = 8;                      //!< further seeds tried when the first does not converge
+  int restarts = 24;                     //!< further seeds tried when the first does not converge
   double relax_weight = 1e4;             //!< rho of the elastic QP: damping 1 / rho
   bool self_collision = true;            //!< add `self_collision` (its defaults) for a robot with collision
                                          //!< shapes when `collision` has none of that type

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -17,6 +19,7 @@
 #include "redres/model/convex.hpp"
 #include "redres/model/kinematics.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/run/ik.hpp"
 
 namespace redres::cli {
 
@@ -26,10 +29,11 @@ struct RobotOptions {
   std::string file;
   std::string base_link, tip_link;
   std::string theta;
+  std::string ik, seed;
   bool json = false;
 };
 
-Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model) {
+Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model, const std::string& option = "--theta") {
   std::vector<double> values;
   std::stringstream in(text);
   std::string item;
@@ -37,22 +41,22 @@ Eigen::VectorXd parse_theta(const std::string& text, const RobotModel& model) {
     try {
       values.push_back(evaluate_constant(item));
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("--theta: ") + e.what());
+      throw std::invalid_argument(option + ": " + e.what());
     }
   }
   if (static_cast<int>(values.size()) != model.dof()) {
-    throw std::invalid_argument("--theta: expected " + std::to_string(model.dof()) +
+    throw std::invalid_argument(option + ": expected " + std::to_string(model.dof()) +
                                 " comma-separated values (one "
                                 "per joint), got " +
                                 std::to_string(values.size()));
   }
   Eigen::VectorXd theta = Eigen::Map<Eigen::VectorXd>(values.data(), model.dof());
-  REDRES_REQUIRE(theta.allFinite(), "--theta", "every value is finite");
+  REDRES_REQUIRE(theta.allFinite(), option.c_str(), "every value is finite");
   for (int j = 0; j < model.dof(); ++j) {
     const JointSpec& jt = model.joint(j);
     if (theta(j) < jt.lower || theta(j) > jt.upper) {
       std::ostringstream m;
-      m << "--theta: joint " << j + 1 << " ('" << jt.name << "') = " << theta(j) << " is outside its limits ["
+      m << option << ": joint " << j + 1 << " ('" << jt.name << "') = " << theta(j) << " is outside its limits ["
         << jt.lower << ", " << jt.upper << "]";
       throw std::invalid_argument(m.str());
     }
@@ -275,6 +279,96 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
   }
 }
 
+// `--ik x,y,z[,r,p,y]` (planar: x,y[,phi]) from `--seed home|zeros|v1,v2,...`: the inverse kinematics (run/ik.hpp),
+// clear of the robot's self-collision; prints the answer (or JSON) and returns 2 when it does not converge.
+int print_ik(const RobotModel& model, const RobotOptions& opts) {
+  std::vector<double> v;
+  std::stringstream in(opts.ik);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      v.push_back(evaluate_constant(item));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--ik: ") + e.what());
+    }
+  }
+  const bool planar = model.kind() == ChainKind::kPlanar;
+  const std::size_t p = planar ? 2 : 3, pose = planar ? 3 : 6;
+  if (v.size() != p && v.size() != pose) {
+    throw std::invalid_argument(
+        "--ik: expected " + std::string(planar ? "x,y or x,y,phi" : "x,y,z or x,y,z,roll,pitch,yaw") + " (" +
+        model.name() + " is " + (planar ? "planar" : "spatial") + "), got " + std::to_string(v.size()) + " value(s)");
+  }
+  for (double x : v) REDRES_REQUIRE(std::isfinite(x), "--ik", "every value is finite");
+  const IkTarget target =
+      planar ? IkTarget::planar(v[0], v[1], v.size() == pose ? std::optional<double>(v[2]) : std::nullopt)
+             : IkTarget::spatial(
+                   {v[0], v[1], v[2]},
+                   v.size() == pose ? std::optional<Eigen::Vector3d>(Eigen::Vector3d(v[3], v[4], v[5])) : std::nullopt);
+  Eigen::VectorXd seed = model.home();
+  const std::string seed_name = opts.seed.empty() ? "home" : opts.seed;
+  if (seed_name == "zeros") {
+    seed = Eigen::VectorXd::Zero(model.dof()).cwiseMax(model.lower_limits()).cwiseMin(model.upper_limits());
+  } else if (seed_name != "home") {
+    seed = parse_theta(seed_name, model, "--seed");
+  }
+  const IkResult r = solve_ik(model, target, seed);
+  KinematicsData k(model);
+  compute_kinematics(model, r.theta, k, KinematicsLevel::kPosition);
+  const std::vector<PairDistance> pairs = self_distances(model, k);
+  if (opts.json) {
+    nlohmann::json limit_joints = nlohmann::json::array();
+    for (int j : r.limit_joints) limit_joints.push_back(j + 1);
+    nlohmann::json j{{"target", {{"xyz", std::vector<double>(v.begin(), v.begin() + static_cast<long>(p))}}},
+                     {"seed", to_vector(seed)},
+                     {"converged", r.converged},
+                     {"theta", to_vector(r.theta)},
+                     {"end_effector_pose", {{"xyz", to_vector(r.pose.translation())}, {"rpy", to_vector(rpy(r.pose))}}},
+                     {"position_error", r.position_error},
+                     {"orientation_error", r.orientation_error},
+                     {"iterations", r.iterations},
+                     {"seeds", r.seeds},
+                     {"seconds", r.seconds},
+                     {"failure", to_string(r.failure)},
+                     {"limit_joints", limit_joints},
+                     {"blocking_pair", r.blocking_pair},
+                     {"diagnosis", r.diagnosis}};
+    if (v.size() == pose) {
+      j["target"][planar ? "phi" : "rpy"] =
+          planar ? nlohmann::json(v[2]) : nlohmann::json(std::vector<double>(v.begin() + 3, v.end()));
+    }
+    j["min_self_collision_distance"] = pairs.empty() ? nlohmann::json(nullptr) : nlohmann::json(pairs[0].distance);
+    if (!pairs.empty()) {
+      j["nearest_self_collision_pair"] = {model.joint(pairs[0].i).name, model.joint(pairs[0].j).name};
+    }
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "robot   " << model.name() << "\n";
+    std::cout << "ik      to xyz " << row(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<long>(p)));
+    if (v.size() == pose) {
+      std::cout << (planar ? "  phi " : "  rpy ")
+                << row(Eigen::Map<const Eigen::VectorXd>(v.data() + p, static_cast<long>(pose - p)));
+    }
+    std::cout << " from the seed '" << seed_name << "' " << row(seed) << "\n";
+    std::cout << "        "
+              << (r.converged ? r.summary() : "did not converge (" + std::string(to_string(r.failure)) + ")") << "\n";
+    std::cout << "theta   " << row(r.theta) << "\n";
+    std::cout << "end effector  xyz " << row(r.pose.translation()) << "  rpy " << row(rpy(r.pose)) << "\n";
+    std::cout << std::setprecision(3) << "position error " << r.position_error << " m, orientation error "
+              << r.orientation_error << " rad, " << r.iterations << " iterations, " << r.seeds << " seed"
+              << (r.seeds == 1 ? "" : "s") << ", " << r.seconds * 1e3 << " ms\n";
+    if (!pairs.empty()) {
+      std::cout << std::setprecision(6) << "nearest self-collision pair " << model.joint(pairs[0].i).name << " / "
+                << model.joint(pairs[0].j).name << " at " << pairs[0].distance << " m\n";
+    }
+  }
+  if (!r.converged) {
+    std::cerr << "error: --ik: the inverse kinematics " << r.summary() << "\n";
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
 }  // namespace
 
 void add_robot_command(CLI::App& app, Action& action) {
@@ -288,6 +382,10 @@ void add_robot_command(CLI::App& app, Action& action) {
   cmd->add_option("--theta", opts->theta,
                   "joint positions, comma-separated (formulas allowed, e.g. pi/4,pi/12); default: the home "
                   "configuration");
+  cmd->add_option("--ik", opts->ik,
+                  "inverse kinematics: x,y,z[,roll,pitch,yaw] (planar: x,y[,phi]) in the world frame (m, rad); prints "
+                  "the joint positions that reach it (exit code 2 when none is found)");
+  cmd->add_option("--seed", opts->seed, "with --ik: where the iteration starts: home (default), zeros, or v1,v2,...");
   cmd->add_flag("--json", opts->json, "print JSON instead of text");
   cmd->callback([opts, &action] {
     action = [opts] {
@@ -299,6 +397,11 @@ void add_robot_command(CLI::App& app, Action& action) {
       }
       const RobotModel model =
           urdf ? load_urdf_robot(opts->file, opts->base_link, opts->tip_link) : load_robot(opts->file);
+      if (!opts->seed.empty() && opts->ik.empty()) throw std::invalid_argument("--seed is for --ik");
+      if (!opts->ik.empty()) {
+        if (!opts->theta.empty()) throw std::invalid_argument("--ik finds theta: give --ik or --theta, not both");
+        return print_ik(model, *opts);
+      }
       const bool at_home = opts->theta.empty();
       const Eigen::VectorXd theta = at_home ? model.home() : parse_theta(opts->theta, model);
       KinematicsData k(model);

@@ -110,11 +110,22 @@ StartReport checked_start(Scenario& s, const std::string& file) {
   return report;
 }
 
+// theta0 = { ik = ... }: one line with what the inverse kinematics found (run/ik.hpp).
+void print_ik(const Scenario& s) {
+  if (!s.ik) return;
+  std::ostringstream line;
+  line.precision(9);
+  line << "theta0 by inverse kinematics to " << s.ik_target << ": " << s.ik->summary() << "; theta0 = [";
+  for (Eigen::Index j = 0; j < s.theta0.size(); ++j) line << (j ? ", " : "") << s.theta0(j);
+  std::cout << line.str() << "]\n";
+}
+
 // `redres run`: one scenario, its files, and the figures or the animation asked for.
 int run_scenario(const RunOptions& options) {
   const RunOptions* const opts = &options;
   Scenario scenario = load_scenario(opts->scenarios.front(), opts->overrides);
   (void)checked_start(scenario, opts->scenarios.front());
+  if (!opts->quiet) print_ik(scenario);
   RecordOptions record = scenario.record;
   if (!opts->record.empty()) {
     try {
@@ -168,6 +179,7 @@ int validate_scenario(const RunOptions& options) {
             << s.robot->dof() << " joints), " << s.steps() << " steps of " << s.tau << " s, path "
             << s.path->description() << ", " << s.scheme->objectives().size() << " objective(s), "
             << s.scheme->constraints().size() << " constraint(s), engine " << s.engine->name() << "\n";
+  print_ik(s);
   std::cout << "start: within limits, no collision, task rows' smallest singular value " << start.sigma_min
             << " (w = " << start.w << "), path " << start.path_offset << " m from the end effector (checked in "
             << start.seconds << " s)\n";

@@ -9,6 +9,7 @@
 ///   name = "paper_r_tvcmm"                      # default: the file's stem
 ///   robot = "../robots/paper_pushrod_6dof.toml"
 ///   theta0 = ["pi/4", "pi/12", ...]            # numbers or formulas; default: the robot's home
+///   theta0 = { ik = { position = [...], rpy = [...] }, seed = "home" }   # or by inverse kinematics (ik.hpp)
 ///   duration = 40.0                             # T (s)
 ///   step = 0.01                                 # tau (s)
 ///   integrator = "euler"                        # or "heun" (second order)
@@ -21,11 +22,13 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "redres/config/config.hpp"
 #include "redres/control/controller.hpp"
+#include "redres/run/ik.hpp"
 #include "redres/run/record.hpp"
 
 namespace redres {
@@ -47,10 +50,13 @@ enum class OnInfeasible { kHold, kStop, kRelax, kBrake };
 
 /// A loaded scenario. Owns everything a run needs.
 struct Scenario {
-  std::string name;                            //!< scenario name
-  std::string source;                          //!< file it came from
-  std::unique_ptr<RobotModel> robot;           //!< the robot
-  Eigen::VectorXd theta0;                      //!< theta(0)
+  std::string name;                   //!< scenario name
+  std::string source;                 //!< file it came from
+  std::unique_ptr<RobotModel> robot;  //!< the robot
+  Eigen::VectorXd theta0;             //!< theta(0)
+  /// theta0 = { ik = ... }: what the inverse kinematics found (theta0 is its answer; docs/ik.md); empty otherwise.
+  std::optional<IkResult> ik;
+  std::string ik_target;                       //!< the IK's target and seed, in words (empty without an IK)
   double duration = 0.0;                       //!< T (s)
   double tau = 0.0;                            //!< step (s)
   Integrator integrator = Integrator::kEuler;  //!< integrator

@@ -339,7 +339,8 @@ int print_ik(const RobotModel& model, const RobotOptions& opts) {
     }
     j["min_self_collision_distance"] = pairs.empty() ? nlohmann::json(nullptr) : nlohmann::json(pairs[0].distance);
     if (!pairs.empty()) {
-      j["nearest_self_collision_pair"] = {model.joint(pairs[0].i).name, model.joint(pairs[0].j).name};
+      j["nearest_self_collision_pair"] = {model.bodies()[static_cast<std::size_t>(pairs[0].i)].name,
+                                          model.bodies()[static_cast<std::size_t>(pairs[0].j)].name};
     }
     std::cout << j.dump(2) << "\n";
   } else {
@@ -358,8 +359,9 @@ int print_ik(const RobotModel& model, const RobotOptions& opts) {
               << r.orientation_error << " rad, " << r.iterations << " iterations, " << r.seeds << " seed"
               << (r.seeds == 1 ? "" : "s") << ", " << r.seconds * 1e3 << " ms\n";
     if (!pairs.empty()) {
-      std::cout << std::setprecision(6) << "nearest self-collision pair " << model.joint(pairs[0].i).name << " / "
-                << model.joint(pairs[0].j).name << " at " << pairs[0].distance << " m\n";
+      std::cout << std::setprecision(6) << "nearest self-collision pair "
+                << model.bodies()[static_cast<std::size_t>(pairs[0].i)].name << " / "
+                << model.bodies()[static_cast<std::size_t>(pairs[0].j)].name << " at " << pairs[0].distance << " m\n";
     }
   }
   if (!r.converged) {

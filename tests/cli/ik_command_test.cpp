@@ -47,6 +47,16 @@ TEST(IkCommand, TheJsonAnswerReachesTheSpatialPose) {
   // The robot has collision shapes: the answer's nearest self-collision pair is apart.
   ASSERT_TRUE(j["min_self_collision_distance"].is_number()) << r.out;
   EXPECT_GT(j["min_self_collision_distance"].get<double>(), 0.0);
+  // The pair is named by its links: on a URDF robot, the URDF's link names (a side-branch finger among them).
+  const Cli urdf = redres("robot robots/franka_panda_meshes.toml --ik 0.45,-0.1,0.35,pi,0.3,0.2 --json");
+  ASSERT_EQ(urdf.code, 0) << urdf.out;
+  const nlohmann::json u = nlohmann::json::parse(urdf.out);
+  ASSERT_EQ(u["nearest_self_collision_pair"].size(), 2u) << urdf.out;
+  for (const auto& name : u["nearest_self_collision_pair"]) {
+    const RobotModel meshes = load_robot(source_path("robots/franka_panda_meshes.toml"));
+    EXPECT_GE(meshes.find_body(name.get<std::string>()), 0) << name;
+    EXPECT_EQ(name.get<std::string>().rfind("panda_joint", 0), std::string::npos) << name;
+  }
   // The same answer as text.
   const Cli text = redres("robot robots/franka_panda.toml --ik 0.45,-0.1,0.35,pi,0.3,0.2");
   ASSERT_EQ(text.code, 0) << text.out;

@@ -146,7 +146,10 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
                       {"link", model.bodies()[static_cast<std::size_t>(shape.body)].name},
                       {"side_branch", model.bodies()[static_cast<std::size_t>(shape.body)].branch},
                       {"shape", shape.spec.describe()},
-                      {"position", to_vector(shape.pose.translation())}});
+                      {"position", to_vector(shape.pose.translation())},
+                      {"rpy", rpy_of(shape.pose.linear())},
+                      {"kind", std::string(config_io::enum_name(shape.spec.shape))}});
+    if (!shape.spec.source.empty()) shapes.back()["source_mesh"] = shape.spec.source.string();
     if (shape.spec.hull) {
       shapes.back()["file"] = shape.spec.hull->source.string();
       shapes.back()["vertices"] = shape.spec.hull->vertices.size();
@@ -255,10 +258,13 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
     const auto& body = model.bodies()[static_cast<std::size_t>(shape.body)];
     o << std::setw(5) << shape.link + 1 << "  " << std::left << std::setw(width) << model.joint(shape.link).name << "  "
       << std::setw(width) << body.name << std::right << "  " << shape.spec.describe();
-    if (shape.spec.shape == ShapeSpec::Kind::kConvex) {  // a hull's pose: it has no size to place it by
+    {  // its pose in the link frame, and the mesh it was made from
       const Eigen::Vector3d p = shape.pose.translation();
       const auto rpy = rpy_of(shape.pose.linear());
       o << " at xyz " << p.x() << " " << p.y() << " " << p.z() << " rpy " << rpy[0] << " " << rpy[1] << " " << rpy[2];
+      if (!shape.spec.source.empty() && shape.spec.shape != ShapeSpec::Kind::kConvex) {
+        o << " from " << shape.spec.source.filename().string();
+      }
     }
     o << (body.branch ? "  (side branch)" : "") << "\n";
   }

@@ -49,6 +49,10 @@ TEST(RobotCommand, TheJsonGivesPosesAndTheSelfDistancesNearestFirst) {
       EXPECT_EQ(shape["joint_name"], "panda_joint7");
     }
     if (shape["link"] == "panda_hand") EXPECT_FALSE(shape["side_branch"].get<bool>());
+    // Every shape: its kind, pose (xyz, rpy in the link frame) and the mesh it was fitted to.
+    EXPECT_EQ(shape["kind"], "capsule");
+    EXPECT_EQ(shape["rpy"].size(), 3u);
+    EXPECT_NE(shape["source_mesh"].get<std::string>().find(".obj"), std::string::npos) << shape;
   }
   EXPECT_TRUE(finger);
   ASSERT_EQ(j["held_joints"].size(), 2u);

@@ -548,6 +548,7 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
           for (int k = 0; k < pieces; ++k) {
             jt.collision.push_back(convex_shape(data.pieces[static_cast<std::size_t>(k)], data.file, k, pieces)
                                        .placed(link.pose * mesh.pose));
+            jt.collision.back().source = data.file;
           }
           continue;
         }
@@ -555,6 +556,7 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
         all.reserve(data.vertex_count());
         for (const auto& piece : data.pieces) all.insert(all.end(), piece.begin(), piece.end());
         jt.collision.push_back(fit_capsule(all).placed(link.pose * mesh.pose));
+        jt.collision.back().source = data.file;
       } catch (const std::exception& ex) {
         problems.push_back(link.where + ": " + ex.what());
       }

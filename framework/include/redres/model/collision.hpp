@@ -64,6 +64,8 @@ struct ShapeSpec {
   /// A robot's shapes: the body (a URDF link riding on the joint) it belongs to; empty: the joint's own link. Not a
   /// key of the files (a URDF link's shapes are given by the link's name).
   std::string body{};
+  /// A robot's shapes made from a mesh: the mesh file (empty: written by hand, or a URDF primitive). Not a key.
+  std::filesystem::path source{};
   /// convex: the hull's vertices and faces (in the shape's frame); shared by the spec's copies.
   std::shared_ptr<const ConvexHull> hull{};
 

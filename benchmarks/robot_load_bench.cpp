@@ -1,8 +1,8 @@
 // Loading a robot file, from the text to a RobotModel: the hand-written Panda (robots/franka_panda.toml, modified DH
 // with capsules written out: the baseline of the ratios), the same arm from its URDF with hand-written capsules
 // (robots/franka_panda_urdf.toml), and the two arms as their makers publish them, meshes read through Assimp and
-// turned into fitted capsules (robots/franka_panda_meshes.toml, robots/xarm6.toml). Also each mesh robot's
-// meshes read alone (no fitting), to split the time.
+// turned into fitted capsules (robots/franka_panda_meshes.toml, robots/xarm6.toml) or convex hulls by qhull
+// (robots/franka_panda_hulls.toml). Also each mesh robot's meshes read alone (no fitting), to split the time.
 // BM_LoadRobot/<file>: time per load.
 
 #include <string>
@@ -48,6 +48,8 @@ BENCHMARK_CAPTURE(BM_LoadRobot, franka_panda, std::string("robots/franka_panda.t
 BENCHMARK_CAPTURE(BM_LoadRobot, franka_panda_urdf, std::string("robots/franka_panda_urdf.toml"))
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LoadRobot, franka_panda_meshes, std::string("robots/franka_panda_meshes.toml"))
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LoadRobot, franka_panda_hulls, std::string("robots/franka_panda_hulls.toml"))
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LoadRobot, xarm6, std::string("robots/xarm6.toml"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ReadMeshes, franka_panda, std::string("robots/franka_panda_description/meshes/collision"))

@@ -110,12 +110,13 @@ StartReport checked_start(Scenario& s, const std::string& file) {
   return report;
 }
 
-// theta0 = { ik = ... }: one line with what the inverse kinematics found (run/ik.hpp).
-void print_ik(const Scenario& s) {
+// theta0 = { ik = ... }: one line with what the inverse kinematics found (run/ik.hpp), after `prefix` (compare: the
+// scenario's file).
+void print_ik(const Scenario& s, const std::string& prefix = "") {
   if (!s.ik) return;
   std::ostringstream line;
   line.precision(9);
-  line << "theta0 by inverse kinematics to " << s.ik_target << ": " << s.ik->summary() << "; theta0 = [";
+  line << prefix << "theta0 by inverse kinematics to " << s.ik_target << ": " << s.ik->summary() << "; theta0 = [";
   for (Eigen::Index j = 0; j < s.theta0.size(); ++j) line << (j ? ", " : "") << s.theta0(j);
   std::cout << line.str() << "]\n";
 }
@@ -199,6 +200,7 @@ int compare_scenarios(const RunOptions& options) {
   for (const auto& file : opts->scenarios) {
     scenarios.push_back(load_scenario(file, opts->overrides));
     (void)checked_start(scenarios.back(), file);
+    if (!opts->quiet) print_ik(scenarios.back(), file + ": ");
     const std::string stem = std::filesystem::path(file).stem().string();
     std::string name = stem;
     for (int k = 2; std::find(dirs.begin(), dirs.end(), name) != dirs.end(); ++k) {

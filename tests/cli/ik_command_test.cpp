@@ -3,6 +3,7 @@
 // reached is exit code 2 with the diagnosis, and `validate` prints what the IK found.
 
 #include <array>
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -122,6 +123,15 @@ TEST(IkCommand, ValidatePrintsWhatTheIkFound) {
   EXPECT_EQ(far.code, 2) << far.out;
   EXPECT_NE(far.out.find("key 'theta0'"), std::string::npos) << far.out;
   EXPECT_NE(far.out.find("did not converge (unreachable)"), std::string::npos) << far.out;
+  // compare prints it too, after the scenario's file.
+  const std::string out = ::testing::TempDir() + "redres_ik_compare";
+  std::filesystem::remove_all(out);
+  const Cli cmp = redres("compare configs/panda_ik_start.toml --no-plots --out " + out);
+  EXPECT_EQ(cmp.code, 0) << cmp.out;
+  EXPECT_NE(cmp.out.find("configs/panda_ik_start.toml: theta0 by inverse kinematics to the path's start"),
+            std::string::npos)
+      << cmp.out;
+  std::filesystem::remove_all(out);
 }
 
 }  // namespace

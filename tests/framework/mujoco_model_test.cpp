@@ -48,7 +48,53 @@ struct Agreement {
   double position = 0.0;     // the largest |p_mujoco - p_redres| (m) of the end effector
   double orientation = 0.0;  // the largest rotation-matrix entry difference of the end effector
   double links = 0.0;        // the largest difference of any body pose entry against redres's link frames
+  double shapes = 0.0;       // the largest difference of a primitive geom's pose against redres's shape pose
+  double hulls = 0.0;        // the largest distance of a hull's vertex from MuJoCo's nearest mesh vertex (m)
 };
+
+// The geom names mjcf_from_robot gives the shapes: the body's name, "_shape", the shape's index on its link.
+std::vector<std::string> geom_names(const RobotModel& robot) {
+  std::vector<std::string> names;
+  std::vector<int> count(static_cast<std::size_t>(robot.dof()), 0);
+  for (const RobotModel::LinkShape& s : robot.link_shapes())
+    names.push_back(mjcf_body_name(robot, s.link) + "_shape" +
+                    std::to_string(count[static_cast<std::size_t>(s.link)]++));
+  return names;
+}
+
+// Where MuJoCo has each shape against where redres has it, at the configuration both last computed.
+void compare_shapes(const RobotModel& robot, const MujocoModel& mj, const KinematicsData& k, Agreement& worst) {
+  const std::vector<std::string> names = geom_names(robot);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const RobotModel::LinkShape& s = robot.link_shapes()[i];
+    const int g = mj.geom(names[i]);
+    ASSERT_GE(g, 0) << names[i];
+    const Eigen::Isometry3d want = k.link_frames[static_cast<std::size_t>(s.link)] * s.pose;
+    const Eigen::Isometry3d got = mj.geom_pose(g);
+    const double position = (got.translation() - want.translation()).norm();
+    switch (s.spec.shape) {
+      case ShapeSpec::Kind::kSphere: worst.shapes = std::max(worst.shapes, position); break;
+      case ShapeSpec::Kind::kCapsule: {  // symmetric: the centre and the axis, either way along it
+        const Eigen::Vector3d a = got.linear().col(2), b = want.linear().col(2);
+        worst.shapes =
+            std::max({worst.shapes, position, std::min((a - b).cwiseAbs().maxCoeff(), (a + b).cwiseAbs().maxCoeff())});
+        break;
+      }
+      case ShapeSpec::Kind::kBox:
+      case ShapeSpec::Kind::kCylinder:
+        worst.shapes = std::max({worst.shapes, position, rotation_error(got, want)});
+        break;
+      case ShapeSpec::Kind::kConvex: {
+        const Eigen::Matrix3Xd mesh = mj.mesh_vertices(g);
+        ASSERT_EQ(mesh.cols(), static_cast<Eigen::Index>(s.spec.hull->vertices.size())) << names[i];
+        for (const Eigen::Vector3d& v : s.spec.hull->vertices)
+          worst.hulls = std::max(worst.hulls, (mesh.colwise() - want * v).colwise().norm().minCoeff());
+        break;
+      }
+      default: ADD_FAILURE() << "unexpected shape " << names[i];
+    }
+  }
+}
 
 // MuJoCo's and redres's forward kinematics at kConfigurations random configurations within the limits.
 Agreement compare_kinematics(const RobotModel& robot, MujocoModel& mj, unsigned seed) {
@@ -71,6 +117,7 @@ Agreement compare_kinematics(const RobotModel& robot, MujocoModel& mj, unsigned 
     const Eigen::Isometry3d ee = mj.site_pose(site);
     worst.position = std::max(worst.position, (ee.translation() - k.ee_pose.translation()).norm());
     worst.orientation = std::max(worst.orientation, rotation_error(ee, k.ee_pose));
+    compare_shapes(robot, mj, k, worst);
     for (int j = 0; j < robot.dof(); ++j) {
       const Eigen::Isometry3d body = mj.body_pose(bodies[static_cast<std::size_t>(j)]);
       const Eigen::Isometry3d& link = k.link_frames[static_cast<std::size_t>(j)];
@@ -140,10 +187,13 @@ void check_model(const RobotModel& robot, MujocoModel& mj, unsigned seed) {
   EXPECT_LE(agreement.position, kPoseTolerance);
   EXPECT_LE(agreement.orientation, kPoseTolerance);
   EXPECT_LE(agreement.links, kPoseTolerance);
+  EXPECT_LE(agreement.shapes, kPoseTolerance);
+  EXPECT_LE(agreement.hulls, 1e-6);  // MuJoCo keeps mesh vertices as floats
   std::cout << "[ mujoco   ] " << robot.name() << ": " << robot.dof() << " joints, " << robot.link_shapes().size()
             << " shapes; largest end-effector difference over " << kConfigurations << " configurations: position "
             << agreement.position << " m, rotation entries " << agreement.orientation << "; inertia tensors (relative) "
-            << worst_inertia << "; link frames " << agreement.links << "\n";
+            << worst_inertia << "; shapes " << agreement.shapes << ", hull vertices " << agreement.hulls
+            << " m; link frames " << agreement.links << "\n";
 }
 
 TEST(MujocoModel, EveryShippedRobotHasRedresKinematicsInMujoco) {

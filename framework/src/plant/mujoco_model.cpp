@@ -59,6 +59,7 @@ int MujocoModel::nexclude() const { return impl_->m->nexclude; }
 int MujocoModel::body(const std::string& name) const { return mj_name2id(impl_->m, mjOBJ_BODY, name.c_str()); }
 int MujocoModel::joint(const std::string& name) const { return mj_name2id(impl_->m, mjOBJ_JOINT, name.c_str()); }
 int MujocoModel::site(const std::string& name) const { return mj_name2id(impl_->m, mjOBJ_SITE, name.c_str()); }
+int MujocoModel::geom(const std::string& name) const { return mj_name2id(impl_->m, mjOBJ_GEOM, name.c_str()); }
 double MujocoModel::body_mass(int b) const { return impl_->m->body_mass[b]; }
 Eigen::Vector3d MujocoModel::body_com(int b) const { return Eigen::Vector3d(impl_->m->body_ipos + 3 * b); }
 
@@ -104,6 +105,22 @@ Eigen::Isometry3d MujocoModel::site_pose(int s) const {
 Eigen::Isometry3d MujocoModel::body_pose(int b) const {
   return pose_from(impl_->d->xpos + 3 * b, impl_->d->xmat + 9 * b);
 }
+Eigen::Isometry3d MujocoModel::geom_pose(int g) const {
+  return pose_from(impl_->d->geom_xpos + 3 * g, impl_->d->geom_xmat + 9 * g);
+}
+
+Eigen::Matrix3Xd MujocoModel::mesh_vertices(int g) const {
+  const mjModel* m = impl_->m;
+  const int mesh = m->geom_dataid[g];
+  if (m->geom_type[g] != mjGEOM_MESH || mesh < 0) return Eigen::Matrix3Xd(3, 0);
+  const Eigen::Isometry3d T = geom_pose(g);
+  Eigen::Matrix3Xd out(3, m->mesh_vertnum[mesh]);
+  const float* v = m->mesh_vert + 3 * m->mesh_vertadr[mesh];
+  for (int i = 0; i < m->mesh_vertnum[mesh]; ++i)
+    out.col(i) = T * Eigen::Vector3d(static_cast<double>(v[3 * i]), static_cast<double>(v[3 * i + 1]),
+                                     static_cast<double>(v[3 * i + 2]));
+  return out;
+}
 
 #else  // without MuJoCo
 
@@ -136,6 +153,9 @@ bool MujocoModel::excluded(int, int) const { unavailable(); }
 void MujocoModel::kinematics(const Eigen::Ref<const Eigen::VectorXd>&) { unavailable(); }
 Eigen::Isometry3d MujocoModel::site_pose(int) const { unavailable(); }
 Eigen::Isometry3d MujocoModel::body_pose(int) const { unavailable(); }
+int MujocoModel::geom(const std::string&) const { unavailable(); }
+Eigen::Isometry3d MujocoModel::geom_pose(int) const { unavailable(); }
+Eigen::Matrix3Xd MujocoModel::mesh_vertices(int) const { unavailable(); }
 
 #endif
 

@@ -76,6 +76,7 @@ class MujocoModel {
   [[nodiscard]] int body(const std::string& name) const;
   [[nodiscard]] int joint(const std::string& name) const;
   [[nodiscard]] int site(const std::string& name) const;
+  [[nodiscard]] int geom(const std::string& name) const;
   [[nodiscard]] double body_mass(int body) const;
   /// The centre of mass in the body frame (MuJoCo's body_ipos).
   [[nodiscard]] Eigen::Vector3d body_com(int body) const;
@@ -93,6 +94,10 @@ class MujocoModel {
   /// After kinematics(): the world pose of a site or a body.
   [[nodiscard]] Eigen::Isometry3d site_pose(int site) const;
   [[nodiscard]] Eigen::Isometry3d body_pose(int body) const;
+  [[nodiscard]] Eigen::Isometry3d geom_pose(int geom) const;
+  /// After kinematics(): the world positions of a mesh geom's vertices (3 x their number; MuJoCo keeps them as
+  /// floats), none for another geom.
+  [[nodiscard]] Eigen::Matrix3Xd mesh_vertices(int geom) const;
 
  private:
   struct Impl;

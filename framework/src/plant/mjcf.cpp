@@ -1,6 +1,9 @@
 // mjcf_from_robot(): a RobotModel as MuJoCo's XML (docs/plant.md). Plain text; MuJoCo itself is not needed here.
 
+#include <array>
+#include <cstddef>
 #include <cstdio>
+#include <initializer_list>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -97,10 +100,10 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
     std::string what = "robot '" + robot.name() + "': MuJoCo needs physical mass properties for every moving link";
     if (!missing.empty())
       what += "; the links of these joints have none usable: " + missing +
-              " (give each joint an `inertia`, or allow placeholder masses)";
+              " (give each joint an `inertia`, or allow placeholder masses: MjcfOptions::placeholder_inertia)";
     if (!impossible.empty())
       what += "; the links of these joints have mass properties no rigid body has: " + impossible +
-              " (correct them, or let MuJoCo balance the principal moments)";
+              " (correct them, or let MuJoCo balance the principal moments: MjcfOptions::balance_inertia)";
     throw std::invalid_argument(what);
   }
   if (!(options.placeholder_mass > kMinValue) || !(options.placeholder_moment > kMinValue))

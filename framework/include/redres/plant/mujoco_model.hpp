@@ -11,7 +11,6 @@
 /// end effector E is a site "end_effector" in the last body.
 
 #include <memory>
-#include <optional>
 #include <string>
 
 #include <Eigen/Core>

@@ -29,6 +29,7 @@ ALLOWED = {
     "control": {"common", "config", "model", "qp"},
     "run": {"common", "config", "model", "parsers", "qp", "control"},
     "extend": {"common", "config", "model", "parsers", "qp", "control", "run"},
+    "plant": {"common", "config", "model"},
 }
 PLUGIN_DIRS = {"objectives", "constraints", "engines", "paths", "velocity_limits"}
 

@@ -1,0 +1,232 @@
+// mjcf_from_robot(): a RobotModel as MuJoCo's XML (docs/plant.md). Plain text; MuJoCo itself is not needed here.
+
+#include <array>
+#include <cstddef>
+#include <cstdio>
+#include <initializer_list>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+
+#include "redres/model/convex.hpp"
+#include "redres/plant/mujoco_model.hpp"
+
+namespace redres {
+namespace {
+
+// MuJoCo refuses a moving body whose mass or a principal moment is not above this (its mjMINVAL).
+constexpr double kMinValue = 1e-15;
+
+// A double with 17 significant digits: it reads back as the same double.
+std::string num(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+std::string nums(std::initializer_list<double> xs) {
+  std::string s;
+  for (const double x : xs) {
+    if (!s.empty()) s += ' ';
+    s += num(x);
+  }
+  return s;
+}
+
+std::string vec3(const Eigen::Vector3d& v) { return nums({v.x(), v.y(), v.z()}); }
+
+// MuJoCo's quaternions are w x y z.
+std::string quat(const Eigen::Matrix3d& R) {
+  Eigen::Quaterniond q(R);
+  q.normalize();
+  return nums({q.w(), q.x(), q.y(), q.z()});
+}
+
+std::string pose_attributes(const Eigen::Isometry3d& T) {
+  return "pos=\"" + vec3(T.translation()) + "\" quat=\"" + quat(T.linear()) + "\"";
+}
+
+// A name as an XML attribute value.
+std::string escaped(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// Why the link has no mass properties MuJoCo could take ("" when it has): none given, or a mass or principal moment
+// not above MuJoCo's minimum.
+std::string missing_inertia(const JointSpec& joint) {
+  if (!joint.inertia) return "no inertia";
+  const Inertia& in = *joint.inertia;
+  if (!(in.mass > kMinValue)) return "mass " + num(in.mass) + " kg";
+  const Eigen::Matrix3d sym = 0.5 * (in.tensor + in.tensor.transpose());
+  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(sym, Eigen::EigenvaluesOnly).eigenvalues()(0);
+  if (!(smallest > kMinValue)) return "smallest principal moment " + num(smallest) + " kg m^2";
+  return "";
+}
+
+}  // namespace
+
+std::string mjcf_body_name(const RobotModel& robot, int j) {
+  return robot.bodies().at(static_cast<std::size_t>(robot.body_of_joint(j))).name;
+}
+
+std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options) {
+  const int n = robot.dof();
+  std::string missing, impossible;
+  for (int j = 0; j < n; ++j) {
+    const JointSpec& joint = robot.joint(j);
+    const std::string why = missing_inertia(joint);
+    if (!why.empty()) {
+      if (!options.placeholder_inertia)
+        missing += (missing.empty() ? "" : ", ") + ("'" + joint.name + "' (" + why + ")");
+    } else if (const std::string invalid = joint.inertia->invalid(); !invalid.empty() && !options.balance_inertia) {
+      impossible += (impossible.empty() ? "" : ", ") + ("'" + joint.name + "' (" + invalid + ")");
+    }
+  }
+  if (!missing.empty() || !impossible.empty()) {
+    std::string what = "robot '" + robot.name() + "': MuJoCo needs physical mass properties for every moving link";
+    if (!missing.empty())
+      what += "; the links of these joints have none usable: " + missing +
+              " (give each joint an `inertia`, or allow placeholder masses: MjcfOptions::placeholder_inertia)";
+    if (!impossible.empty())
+      what += "; the links of these joints have mass properties no rigid body has: " + impossible +
+              " (correct them, or let MuJoCo balance the principal moments: MjcfOptions::balance_inertia)";
+    throw std::invalid_argument(what);
+  }
+  if (!(options.placeholder_mass > kMinValue) || !(options.placeholder_moment > kMinValue))
+    throw std::invalid_argument("MjcfOptions: the placeholder mass and moment must be > 1e-15");
+
+  // The shapes of each joint's link, and the hulls' mesh assets.
+  std::vector<std::string> geoms(static_cast<std::size_t>(n));
+  std::string assets;
+  std::vector<int> count(static_cast<std::size_t>(n), 0);
+  for (const RobotModel::LinkShape& s : robot.link_shapes()) {
+    const auto j = static_cast<std::size_t>(s.link);
+    const std::string name = escaped(mjcf_body_name(robot, s.link)) + "_shape" + std::to_string(count[j]++);
+    std::string& g = geoms[j];
+    g += "      <geom name=\"" + name + "\" ";
+    const ShapeSpec& spec = s.spec;
+    switch (spec.shape) {
+      case ShapeSpec::Kind::kSphere:
+        g += "type=\"sphere\" size=\"" + num(spec.radius.value_or(0.0)) + "\" " + pose_attributes(s.pose);
+        break;
+      case ShapeSpec::Kind::kCapsule: {
+        // The capsule's axis is its pose's z axis, centred on its origin (ShapeSpec::pose()).
+        const double half = 0.5 * spec.axis_length();
+        if (half > 0.0) {
+          const Eigen::Vector3d a = s.pose * Eigen::Vector3d(0, 0, -half), b = s.pose * Eigen::Vector3d(0, 0, half);
+          g += "type=\"capsule\" size=\"" + num(spec.radius.value_or(0.0)) + "\" fromto=\"" + vec3(a) + " " + vec3(b) +
+               "\"";
+        } else {  // a capsule of no length is a sphere
+          g += "type=\"sphere\" size=\"" + num(spec.radius.value_or(0.0)) + "\" " + pose_attributes(s.pose);
+        }
+        break;
+      }
+      case ShapeSpec::Kind::kCylinder:
+        g += "type=\"cylinder\" size=\"" + nums({spec.radius.value_or(0.0), 0.5 * spec.length.value_or(0.0)}) + "\" " +
+             pose_attributes(s.pose);
+        break;
+      case ShapeSpec::Kind::kBox: {
+        const std::array<double, 3> size = spec.size.value_or(std::array<double, 3>{0, 0, 0});
+        g += "type=\"box\" size=\"" + nums({0.5 * size[0], 0.5 * size[1], 0.5 * size[2]}) + "\" " +
+             pose_attributes(s.pose);
+        break;
+      }
+      case ShapeSpec::Kind::kConvex: {
+        if (!spec.hull) throw std::invalid_argument("robot '" + robot.name() + "': a convex shape without its hull");
+        // MuJoCo makes the hull of the vertices itself; it moves the mesh to its centre of mass and principal axes
+        // and moves the geom's pose the other way, so the shape stays where it is given.
+        std::string vertices;
+        for (const Eigen::Vector3d& v : spec.hull->vertices) vertices += (vertices.empty() ? "" : " ") + vec3(v);
+        assets += "    <mesh name=\"" + name + "\" vertex=\"" + vertices + "\"/>\n";
+        g += "type=\"mesh\" mesh=\"" + name + "\" " + pose_attributes(s.pose);
+        break;
+      }
+      case ShapeSpec::Kind::kOctree:
+      case ShapeSpec::Kind::kPoints:
+        throw std::invalid_argument("robot '" + robot.name() + "': joint '" + robot.joint(s.link).name +
+                                    "' has a point cloud or octree shape, which a MuJoCo model cannot hold");
+    }
+    g += "/>\n";
+  }
+
+  std::ostringstream out;
+  const std::string model = options.model_name.empty() ? robot.name() : options.model_name;
+  out << "<mujoco model=\"" << escaped(model) << "\">\n"
+      << "  <!-- Written by redres (mjcf_from_robot). -->\n"
+      << "  <compiler angle=\"radian\" inertiafromgeom=\"false\""
+      << (options.balance_inertia ? " balanceinertia=\"true\"" : "") << "/>\n";
+  // MuJoCo leaves out contacts between a body and its parent; redres checks a side branch's links (a URDF's hand)
+  // against the neighbouring joint's link, so the excluded pairs below decide alone.
+  out << "  <option>\n    <flag filterparent=\"disable\"/>\n  </option>\n";
+  if (!assets.empty()) out << "  <asset>\n" << assets << "  </asset>\n";
+  out << "  <worldbody>\n";
+  std::string indent = "    ";
+  for (int j = 0; j < n; ++j) {
+    const JointSpec& joint = robot.joint(j);
+    // Body j's frame is the link frame of joint j; at theta_j = 0 it sits at B_{j-1} A_j in its parent (P A_1 for the
+    // first), and the joint moves it about/along u_j through its origin.
+    const Eigen::Isometry3d place = (j == 0 ? robot.base() : robot.after(j - 1)) * robot.before(j);
+    out << indent << "<body name=\"" << escaped(mjcf_body_name(robot, j)) << "\" " << pose_attributes(place) << ">\n";
+    const std::string in = indent + "  ";
+    out << in << "<joint name=\"" << escaped(joint.name) << "\" type=\""
+        << (joint.type == JointType::kRevolute ? "hinge" : "slide") << "\" pos=\"0 0 0\" axis=\"" << vec3(robot.axis(j))
+        << "\" limited=\"true\" range=\"" << nums({joint.lower, joint.upper}) << "\"/>\n";
+    if (missing_inertia(joint).empty()) {
+      const Inertia& m = *joint.inertia;
+      const Eigen::Matrix3d& I = m.tensor;
+      out << in << "<inertial pos=\"" << vec3(m.com) << "\" mass=\"" << num(m.mass) << "\" fullinertia=\""
+          << nums({I(0, 0), I(1, 1), I(2, 2), 0.5 * (I(0, 1) + I(1, 0)), 0.5 * (I(0, 2) + I(2, 0)),
+                   0.5 * (I(1, 2) + I(2, 1))})
+          << "\"/>\n";
+    } else {  // placeholder (checked above that it is allowed)
+      const double I = options.placeholder_moment;
+      out << in << "<!-- placeholder: the robot gives no usable mass properties for this link -->\n"
+          << in << "<inertial pos=\"0 0 0\" mass=\"" << num(options.placeholder_mass) << "\" diaginertia=\""
+          << nums({I, I, I}) << "\"/>\n";
+    }
+    // The shapes were written with six spaces of indent; re-indent them for this depth.
+    std::istringstream lines(geoms[static_cast<std::size_t>(j)]);
+    for (std::string line; std::getline(lines, line);) out << in << line.substr(6) << "\n";
+    if (j == n - 1)
+      out << in << "<site name=\"" << escaped(options.end_effector_site) << "\" "
+          << pose_attributes(robot.after(j) * robot.end_effector()) << "/>\n";
+    indent = in;
+  }
+  for (int j = n - 1; j >= 0; --j) out << std::string(4 + 2 * static_cast<std::size_t>(j), ' ') << "</body>\n";
+  out << "  </worldbody>\n";
+
+  // Body pairs redres never checks: every redres body on joint i against every one on joint k unchecked.
+  std::vector<std::vector<int>> bodies_of(static_cast<std::size_t>(n));
+  for (int b = 0; b < static_cast<int>(robot.bodies().size()); ++b)
+    bodies_of[static_cast<std::size_t>(robot.bodies()[static_cast<std::size_t>(b)].link)].push_back(b);
+  std::string excludes;
+  for (int i = 0; i < n; ++i)
+    for (int k = i + 1; k < n; ++k) {
+      bool checked = false;
+      for (const int a : bodies_of[static_cast<std::size_t>(i)])
+        for (const int b : bodies_of[static_cast<std::size_t>(k)])
+          checked = checked || robot.self_collision_bodies(a, b);
+      if (!checked)
+        excludes += "    <exclude body1=\"" + escaped(mjcf_body_name(robot, i)) + "\" body2=\"" +
+                    escaped(mjcf_body_name(robot, k)) + "\"/>\n";
+    }
+  if (!excludes.empty()) out << "  <contact>\n" << excludes << "  </contact>\n";
+  out << "</mujoco>\n";
+  return out.str();
+}
+
+}  // namespace redres

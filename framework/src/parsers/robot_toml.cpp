@@ -689,8 +689,7 @@ const Schema<RobotReading>& RobotReading::schema() {
                  const TableReader t = r.table("held_joints");
                  std::string names;
                  for (const UrdfHeldJoint& h : c.chain.held) names += (names.empty() ? "'" : ", '") + h.name + "'";
-                 for (const auto& [key, value] : t.raw()) {
-                   const std::string name(key.str());
+                 for (const auto& [name, v] : c.held) {  // read with `urdf`, which places the branches with them
                    const auto it = std::find_if(c.chain.held.begin(), c.chain.held.end(),
                                                 [&](const UrdfHeldJoint& h) { return h.name == name; });
                    if (it == c.chain.held.end()) {
@@ -702,7 +701,6 @@ const Schema<RobotReading>& RobotReading::schema() {
                      t.fail(name, "joint '" + name + "' is a mimic of joint '" + it->mimics +
                                       "' and follows it: hold '" + it->mimics + "' instead");
                    }
-                   const double v = t.number(name);
                    if (it->limited && (v < std::min(it->lower, it->upper) || v > std::max(it->lower, it->upper))) {
                      t.fail(name, "expected joint '" + name + "' within its limits [" + num(it->lower) + ", " +
                                       num(it->upper) + "], got " + num(v));

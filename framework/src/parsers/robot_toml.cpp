@@ -689,7 +689,10 @@ const Schema<RobotReading>& RobotReading::schema() {
                  const TableReader t = r.table("held_joints");
                  std::string names;
                  for (const UrdfHeldJoint& h : c.chain.held) names += (names.empty() ? "'" : ", '") + h.name + "'";
-                 for (const auto& [name, v] : c.held) {  // read with `urdf`, which places the branches with them
+                 for (const auto& entry : c.held) {  // read with `urdf`, which places the branches with them
+                   // Named copies, not a structured binding: clang before 16 cannot capture a binding in a lambda.
+                   const std::string& name = entry.first;
+                   const double v = entry.second;
                    const auto it = std::find_if(c.chain.held.begin(), c.chain.held.end(),
                                                 [&](const UrdfHeldJoint& h) { return h.name == name; });
                    if (it == c.chain.held.end()) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -38,6 +39,8 @@ struct RunOptions {
   bool plots = false;
   bool animate = false;
   bool no_plots = false;
+  bool write_mjcf = false;
+  bool film = false;
   std::string record;  // --record; empty: the scenario's [output] record
   std::string format;  // --format; empty: the scenario's [output] format
 };
@@ -76,6 +79,20 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet,
     std::cout << s.steps << " steps of " << s.tau << " s, engine " << s.solver.engine << ", max position error "
               << s.max_position_error << " m, w " << s.manipulability.initial << " -> " << s.manipulability.final
               << ", " << s.solver.failures << " failed steps, " << s.wall_time_s << " s -> " << out.string() << "\n";
+    if (s.plant_kind == "mujoco") {
+      const PlantFacts& p = s.plant;
+      double ratio = 0.0;
+      for (std::size_t j = 0; j < p.max_torque.size(); ++j) {
+        if (std::isfinite(p.effort_limit[j])) ratio = std::max(ratio, p.max_torque[j] / p.effort_limit[j]);
+      }
+      std::cout << "  MuJoCo plant (" << p.actuator << ", " << p.substeps << " steps of " << p.timestep
+                << " s per control step): max position error " << s.max_position_error << " m (kinematic plant "
+                << p.kinematic_max_position_error << " m), max torque " << 100.0 * ratio << " % of its limit, "
+                << p.max_contacts << " contacts at most";
+      if (!p.contact_pairs.empty()) std::cout << ", first at t = " << p.contact_pairs.front().first_time << " s";
+      std::cout << "; " << 1e6 * p.controller_seconds / std::max(1L, p.control_steps) << " us per control step, "
+                << 1e6 * p.mujoco_seconds / std::max(1L, p.mujoco_steps) << " us per MuJoCo step\n";
+    }
     if (s.solver.relaxed_steps > 0) {
       std::cout << "  " << s.solver.relaxed_steps << " steps relaxed (rows missed by "
                 << s.solver.max_relaxed_task_error << " at most); first: " << s.solver.first_relaxed << "\n";
@@ -156,6 +173,15 @@ int run_scenario(const RunOptions& options) {
     animator = find_plotter(opts->animate ? "--animate" : opts->scenarios.front() + ": [output] animate = true");
   }
   prepare_output_dir(opts->out);  // before the run, so that a bad --out does not cost the run
+  if (opts->write_mjcf) {
+    if (scenario.plant.kind != PlantKind::kMujoco) {
+      throw std::runtime_error("--write-mjcf: scenario '" + scenario.name +
+                               "' runs on the kinematic plant; add --set plant.kind=mujoco");
+    }
+    const std::filesystem::path model = std::filesystem::path(opts->out) / "mujoco_model.xml";
+    write_text_file(model, scenario_mjcf(scenario));  // before the run: MuJoCo's own viewer can open it at once
+    if (!opts->quiet) std::cout << "MuJoCo model: " << model.string() << "\n";
+  }
   const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet, record);
   if (o.run.interrupted || g_stop_requested.load()) return kExitInterrupted;  // no figures: asked to stop
   const std::string written =
@@ -256,6 +282,9 @@ void add_run_commands(CLI::App& app, Action& action) {
   run->add_flag("--animate", opts->animate,
                 "render an animation of the arm and the obstacles into the output directory: animation.mp4 when "
                 "ffmpeg is on PATH, else animation.gif (plot_run.py, as --plots)");
+  run->add_flag("--write-mjcf", opts->write_mjcf,
+                "write the MuJoCo model the run steps ([plant] kind = \"mujoco\") to mujoco_model.xml in the output "
+                "directory, for MuJoCo's own viewer");
   run->add_option("--record", opts->record,
                   "rows of trajectory.csv: all, every=N (every N-th step and the last), or none (summary.json only); "
                   "the summary always uses every step (default: the scenario's [output] record, else all)");

@@ -27,8 +27,8 @@ ALLOWED = {
     "parsers": {"common", "config", "model"},
     "qp": {"common", "config"},
     "control": {"common", "config", "model", "qp"},
-    "run": {"common", "config", "model", "parsers", "qp", "control"},
-    "extend": {"common", "config", "model", "parsers", "qp", "control", "run"},
+    "run": {"common", "config", "model", "parsers", "qp", "control", "plant"},
+    "extend": {"common", "config", "model", "parsers", "qp", "control", "run", "plant"},
     "plant": {"common", "config", "model"},
 }
 PLUGIN_DIRS = {"objectives", "constraints", "engines", "paths", "velocity_limits"}

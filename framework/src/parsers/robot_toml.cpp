@@ -144,6 +144,15 @@ void read_effort(const TableReader& r, JointSpec& jt) {
   jt.effort_limit = e;
 }
 
+// `damping` or `armature` (docs/plant.md): a number >= 0.
+void read_drive(const TableReader& r, const char* key, const char* unit, std::optional<double>& into) {
+  const double v = r.number(key);
+  if (!(std::isfinite(v) && v >= 0.0 && v <= 1e6)) {
+    r.fail(key, std::string("expected 0 <= ") + key + " <= 1e6 (" + unit + "), got " + num(v));
+  }
+  into = v;
+}
+
 // An `inertia` table (of a joint: the link it moves; of a [[links]] entry: that URDF link), in the link's frame.
 // `who` names it in messages ("joint 'j1'", "link 'head'").
 Inertia read_inertia_table(const TableReader& r, const std::string& who) {
@@ -178,6 +187,8 @@ void read_motion_limits(const TableReader& r, JointSpec& jt) {
   if (r.has("jerk_limit"))
     read_law(r, "jerk_limit", "jerk-limit", "rad/s^3 or m/s^3", jt, jt.jerk_limit, jt.jerk_limit_source);
   if (r.has("effort_limit")) read_effort(r, jt);
+  if (r.has("damping")) read_drive(r, "damping", "N m s/rad or N s/m", jt.damping);
+  if (r.has("armature")) read_drive(r, "armature", "kg m^2 or kg", jt.armature);
   if (r.has("inertia")) read_inertia(r, jt);
 }
 
@@ -318,6 +329,16 @@ const Schema<JointReading>& JointReading::schema() {
                [](const TableReader& r, C& c) {
                  if (r.has("effort_limit")) read_effort(r, c.jt);
                }),
+      entry<C>("damping", "number", "N m s/rad or N s/m", "0 (a URDF's <dynamics damping>)",
+               "viscous damping of the joint in a physics plant ([plant] kind = \"mujoco\", docs/plant.md)",
+               [](const TableReader& r, C& c) {
+                 if (r.has("damping")) read_drive(r, "damping", "N m s/rad or N s/m", c.jt.damping);
+               }),
+      entry<C>("armature", "number", "kg m^2 or kg", "0",
+               "the drive's reflected rotor inertia, added to the joint's in a physics plant (docs/plant.md)",
+               [](const TableReader& r, C& c) {
+                 if (r.has("armature")) read_drive(r, "armature", "kg m^2 or kg", c.jt.armature);
+               }),
       entry<C>("inertia", "table {mass, com, ixx, iyy, izz, ixy, ixz, iyz}", "kg, m, kg m^2", "none",
                "the mass properties of the link the joint moves, in the link's frame: mass > 0, centre of mass "
                "`com` (default [0, 0, 0]), the inertia tensor about it (ixy, ixz, iyz default 0)",
@@ -427,6 +448,7 @@ void read_urdf_joints(const TableReader& r, RobotReading& c) {
                            "in a [[joints]] entry");
       }
       if (uj.effort > 0.0) jt.effort_limit = uj.effort;
+      if (uj.damping >= 0.0) jt.damping = uj.damping;
       if (entry) read_motion_limits(*entry, jt);
       if (entry) entry->finish();
     });

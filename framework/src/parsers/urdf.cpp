@@ -626,6 +626,12 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
                               num(j.axis.y()) + ", " + num(j.axis.z()) + "]");
             }
             j.axis.normalize();
+            if (joint->dynamics) {
+              j.damping = joint->dynamics->damping;
+              if (!(std::isfinite(j.damping) && j.damping >= 0.0 && j.damping <= 1e6)) {
+                throw UrdfError(who + ": <dynamics> damping expected 0 <= damping <= 1e6, got " + num(j.damping));
+              }
+            }
             if (joint->limits) {
               j.lower = joint->limits->lower;
               j.upper = joint->limits->upper;

@@ -43,6 +43,7 @@ struct UrdfJoint {
   double lower = 0.0, upper = 0.0;                           //!< position limits (rad or m); unset if continuous
   double velocity = 0.0;                                     //!< velocity limit (rad/s or m/s); 0 if not given
   double effort = 0.0;                                       //!< effort limit (N m or N); 0 if not given
+  double damping = -1.0;                                     //!< <dynamics damping>; < 0 if not given
 };
 
 /// A mesh collision element: the file as the URDF names it, its scale, and its pose in the joint's link frame.

@@ -13,6 +13,7 @@
 
 #include "redres/model/convex.hpp"
 #include "redres/plant/mujoco_model.hpp"
+#include "redres/plant/plant.hpp"
 
 namespace redres {
 namespace {
@@ -77,6 +78,53 @@ std::string missing_inertia(const JointSpec& joint) {
   return "";
 }
 
+// The attributes of a geom of `spec` placed at `pose` in its body (after `name="..." `); a convex hull adds its
+// <mesh> asset to `assets`. `who` names the shape's owner in errors.
+std::string shape_attributes(const ShapeSpec& spec, const Eigen::Isometry3d& pose, const std::string& name,
+                             std::string& assets, const std::string& who) {
+  std::string g;
+  switch (spec.shape) {
+    case ShapeSpec::Kind::kSphere:
+      g += "type=\"sphere\" size=\"" + num(spec.radius.value_or(0.0)) + "\" " + pose_attributes(pose);
+      break;
+    case ShapeSpec::Kind::kCapsule: {
+      // The capsule's axis is its pose's z axis, centred on its origin (ShapeSpec::pose()).
+      const double half = 0.5 * spec.axis_length();
+      if (half > 0.0) {
+        const Eigen::Vector3d a = pose * Eigen::Vector3d(0, 0, -half), b = pose * Eigen::Vector3d(0, 0, half);
+        g += "type=\"capsule\" size=\"" + num(spec.radius.value_or(0.0)) + "\" fromto=\"" + vec3(a) + " " + vec3(b) +
+             "\"";
+      } else {  // a capsule of no length is a sphere
+        g += "type=\"sphere\" size=\"" + num(spec.radius.value_or(0.0)) + "\" " + pose_attributes(pose);
+      }
+      break;
+    }
+    case ShapeSpec::Kind::kCylinder:
+      g += "type=\"cylinder\" size=\"" + nums({spec.radius.value_or(0.0), 0.5 * spec.length.value_or(0.0)}) + "\" " +
+           pose_attributes(pose);
+      break;
+    case ShapeSpec::Kind::kBox: {
+      const std::array<double, 3> size = spec.size.value_or(std::array<double, 3>{0, 0, 0});
+      g += "type=\"box\" size=\"" + nums({0.5 * size[0], 0.5 * size[1], 0.5 * size[2]}) + "\" " + pose_attributes(pose);
+      break;
+    }
+    case ShapeSpec::Kind::kConvex: {
+      if (!spec.hull) throw std::invalid_argument(who + ": a convex shape without its hull");
+      // MuJoCo makes the hull of the vertices itself; it moves the mesh to its centre of mass and principal axes
+      // and moves the geom's pose the other way, so the shape stays where it is given.
+      std::string vertices;
+      for (const Eigen::Vector3d& v : spec.hull->vertices) vertices += (vertices.empty() ? "" : " ") + vec3(v);
+      assets += "    <mesh name=\"" + name + "\" vertex=\"" + vertices + "\"/>\n";
+      g += "type=\"mesh\" mesh=\"" + name + "\" " + pose_attributes(pose);
+      break;
+    }
+    case ShapeSpec::Kind::kOctree:
+    case ShapeSpec::Kind::kPoints:
+      throw std::invalid_argument(who + " has a point cloud or octree shape, which a MuJoCo model cannot hold");
+  }
+  return g;
+}
+
 }  // namespace
 
 std::string mjcf_body_name(const RobotModel& robot, int j) {
@@ -118,48 +166,8 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
     const std::string name = escaped(mjcf_body_name(robot, s.link)) + "_shape" + std::to_string(count[j]++);
     std::string& g = geoms[j];
     g += "      <geom name=\"" + name + "\" ";
-    const ShapeSpec& spec = s.spec;
-    switch (spec.shape) {
-      case ShapeSpec::Kind::kSphere:
-        g += "type=\"sphere\" size=\"" + num(spec.radius.value_or(0.0)) + "\" " + pose_attributes(s.pose);
-        break;
-      case ShapeSpec::Kind::kCapsule: {
-        // The capsule's axis is its pose's z axis, centred on its origin (ShapeSpec::pose()).
-        const double half = 0.5 * spec.axis_length();
-        if (half > 0.0) {
-          const Eigen::Vector3d a = s.pose * Eigen::Vector3d(0, 0, -half), b = s.pose * Eigen::Vector3d(0, 0, half);
-          g += "type=\"capsule\" size=\"" + num(spec.radius.value_or(0.0)) + "\" fromto=\"" + vec3(a) + " " + vec3(b) +
-               "\"";
-        } else {  // a capsule of no length is a sphere
-          g += "type=\"sphere\" size=\"" + num(spec.radius.value_or(0.0)) + "\" " + pose_attributes(s.pose);
-        }
-        break;
-      }
-      case ShapeSpec::Kind::kCylinder:
-        g += "type=\"cylinder\" size=\"" + nums({spec.radius.value_or(0.0), 0.5 * spec.length.value_or(0.0)}) + "\" " +
-             pose_attributes(s.pose);
-        break;
-      case ShapeSpec::Kind::kBox: {
-        const std::array<double, 3> size = spec.size.value_or(std::array<double, 3>{0, 0, 0});
-        g += "type=\"box\" size=\"" + nums({0.5 * size[0], 0.5 * size[1], 0.5 * size[2]}) + "\" " +
-             pose_attributes(s.pose);
-        break;
-      }
-      case ShapeSpec::Kind::kConvex: {
-        if (!spec.hull) throw std::invalid_argument("robot '" + robot.name() + "': a convex shape without its hull");
-        // MuJoCo makes the hull of the vertices itself; it moves the mesh to its centre of mass and principal axes
-        // and moves the geom's pose the other way, so the shape stays where it is given.
-        std::string vertices;
-        for (const Eigen::Vector3d& v : spec.hull->vertices) vertices += (vertices.empty() ? "" : " ") + vec3(v);
-        assets += "    <mesh name=\"" + name + "\" vertex=\"" + vertices + "\"/>\n";
-        g += "type=\"mesh\" mesh=\"" + name + "\" " + pose_attributes(s.pose);
-        break;
-      }
-      case ShapeSpec::Kind::kOctree:
-      case ShapeSpec::Kind::kPoints:
-        throw std::invalid_argument("robot '" + robot.name() + "': joint '" + robot.joint(s.link).name +
-                                    "' has a point cloud or octree shape, which a MuJoCo model cannot hold");
-    }
+    g += shape_attributes(s.spec, s.pose, name, assets,
+                          "robot '" + robot.name() + "': joint '" + robot.joint(s.link).name + "'");
     g += "/>\n";
   }
 
@@ -171,9 +179,37 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
       << (options.balance_inertia ? " balanceinertia=\"true\"" : "") << "/>\n";
   // MuJoCo leaves out contacts between a body and its parent; redres checks a side branch's links (a URDF's hand)
   // against the neighbouring joint's link, so the excluded pairs below decide alone.
-  out << "  <option>\n    <flag filterparent=\"disable\"/>\n  </option>\n";
+  if (options.plant) {
+    const PlantConfig& plant = *options.plant;
+    if (!(plant.timestep > 0.0)) throw std::invalid_argument("MjcfOptions: the plant's timestep must be > 0");
+    const char* integrator = plant.integrator == PlantIntegrator::kImplicit ? "implicit" : "Euler";
+    out << "  <option timestep=\"" << num(plant.timestep) << "\" integrator=\"" << integrator << "\" gravity=\""
+        << nums({0.0, 0.0, -9.81 * plant.gravity}) << "\">\n";
+  } else {
+    out << "  <option>\n";
+  }
+  out << "    <flag filterparent=\"disable\"/>\n  </option>\n";
+  // Offscreen frames (a film of the run) up to 1920 x 1080.
+  out << "  <visual>\n    <global offwidth=\"1920\" offheight=\"1080\"/>\n  </visual>\n";
+  // Obstacles: contype 2, conaffinity 1 collide with the robot's geoms (1, 1), not with each other.
+  std::string still, moving;
+  for (std::size_t k = 0; k < options.obstacles.size(); ++k) {
+    const ShapeSpec& o = options.obstacles[k];
+    const std::string name = "obstacle" + std::to_string(k);
+    const std::string look = "contype=\"2\" conaffinity=\"1\" rgba=\"0.85 0.3 0.25 0.6\" ";
+    const bool moves = o.velocity && (o.velocity->at(0) != 0.0 || o.velocity->at(1) != 0.0 || o.velocity->at(2) != 0.0);
+    if (!moves) {
+      still += "    <geom name=\"" + name + "\" " + look +
+               shape_attributes(o, o.pose(), name, assets, "obstacle " + std::to_string(k)) + "/>\n";
+    } else {
+      moving += "    <body name=\"" + name + "\" mocap=\"true\" " + pose_attributes(o.pose()) + ">\n      <geom name=\"" +
+                name + "\" " + look +
+                shape_attributes(o, Eigen::Isometry3d::Identity(), name, assets, "obstacle " + std::to_string(k)) +
+                "/>\n    </body>\n";
+    }
+  }
   if (!assets.empty()) out << "  <asset>\n" << assets << "  </asset>\n";
-  out << "  <worldbody>\n";
+  out << "  <worldbody>\n" << still << moving;
   std::string indent = "    ";
   for (int j = 0; j < n; ++j) {
     const JointSpec& joint = robot.joint(j);
@@ -184,7 +220,10 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
     const std::string in = indent + "  ";
     out << in << "<joint name=\"" << escaped(joint.name) << "\" type=\""
         << (joint.type == JointType::kRevolute ? "hinge" : "slide") << "\" pos=\"0 0 0\" axis=\"" << vec3(robot.axis(j))
-        << "\" limited=\"true\" range=\"" << nums({joint.lower, joint.upper}) << "\"/>\n";
+        << "\" limited=\"true\" range=\"" << nums({joint.lower, joint.upper}) << "\"";
+    if (joint.damping) out << " damping=\"" << num(*joint.damping) << "\"";
+    if (joint.armature) out << " armature=\"" << num(*joint.armature) << "\"";
+    out << "/>\n";
     if (missing_inertia(joint).empty()) {
       const Inertia& m = *joint.inertia;
       const Eigen::Matrix3d& I = m.tensor;
@@ -225,6 +264,29 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
                     escaped(mjcf_body_name(robot, k)) + "\"/>\n";
     }
   if (!excludes.empty()) out << "  <contact>\n" << excludes << "  </contact>\n";
+  if (options.plant && options.plant->actuator != PlantActuator::kIdealVelocity) {
+    const PlantConfig& plant = *options.plant;
+    const bool servo = plant.actuator == PlantActuator::kVelocityServo;
+    const Eigen::VectorXd kv = plant.kv.resolve(n, "kv"), kp = plant.kp.resolve(n, "kp"), kd = plant.kd.resolve(n, "kd");
+    out << "  <actuator>\n";
+    for (int j = 0; j < n; ++j) {
+      const JointSpec& joint = robot.joint(j);
+      out << "    <general name=\"" << escaped(joint.name) << "\" joint=\"" << escaped(joint.name)
+          << "\" ctrllimited=\"false\" gaintype=\"fixed\" biastype=\"affine\" ";
+      if (servo) {  // kv (ctrl - qdot): ctrl is the velocity command
+        out << "gainprm=\"" << num(kv(j)) << "\" biasprm=\"0 0 " << num(-kv(j)) << "\"";
+      } else {  // ctrl - kp q - kd qdot: ctrl is kp q_ref + kd theta_dot_cmd
+        out << "gainprm=\"1\" biasprm=\"0 " << num(-kp(j)) << " " << num(-kd(j)) << "\"";
+      }
+      if (joint.effort_limit) {
+        out << " forcelimited=\"true\" forcerange=\"" << nums({-*joint.effort_limit, *joint.effort_limit}) << "\"";
+      } else {
+        out << " forcelimited=\"false\"";
+      }
+      out << "/>\n";
+    }
+    out << "  </actuator>\n";
+  }
   out << "</mujoco>\n";
   return out.str();
 }

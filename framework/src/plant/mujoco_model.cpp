@@ -9,11 +9,17 @@
 #include "redres/plant/mujoco_model.hpp"
 
 #if REDRES_HAVE_MUJOCO
-#include <mujoco/mujoco.h>
 #include <cstring>
+
+#include "plant/mujoco_load.hpp"
 #endif
 
 namespace redres {
+
+std::string mujoco_missing() {
+  return "redres was built without MuJoCo: install Debian's package libmujoco-dev (scripts/install_deps.sh installs "
+         "it) and build again (CMake option REDRES_WITH_MUJOCO, on when MuJoCo is found)";
+}
 
 #if REDRES_HAVE_MUJOCO
 
@@ -28,7 +34,7 @@ struct MujocoModel::Impl {
   }
 };
 
-MujocoModel MujocoModel::from_xml(const std::string& xml) {
+mjModel* plant_detail::load_mjcf(const std::string& xml) {
   // MuJoCo 2.2 reads XML only from a file name; a virtual file holds the text. (mjVFS is megabytes: on the heap.)
   struct Vfs {
     mjVFS vfs;
@@ -44,6 +50,11 @@ MujocoModel MujocoModel::from_xml(const std::string& xml) {
   char error[1000] = "";
   mjModel* m = mj_loadXML(name, &vfs->vfs, error, sizeof error);
   if (!m) throw std::runtime_error(std::string("MuJoCo refused the model: ") + error);
+  return m;
+}
+
+MujocoModel MujocoModel::from_xml(const std::string& xml) {
+  mjModel* m = plant_detail::load_mjcf(xml);
   auto impl = std::make_unique<Impl>();
   impl->m = m;
   impl->d = mj_makeData(m);
@@ -128,9 +139,7 @@ bool mujoco_available() noexcept { return false; }
 
 struct MujocoModel::Impl {};
 
-MujocoModel MujocoModel::from_xml(const std::string&) {
-  throw std::runtime_error("redres was built without MuJoCo (REDRES_WITH_MUJOCO=OFF, or libmujoco-dev not found)");
-}
+MujocoModel MujocoModel::from_xml(const std::string&) { throw std::runtime_error(mujoco_missing()); }
 
 namespace {
 [[noreturn]] void unavailable() { throw std::logic_error("MujocoModel: redres was built without MuJoCo"); }

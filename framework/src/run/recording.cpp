@@ -46,6 +46,18 @@ std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* r
   const auto& constraints = s.scheme->constraints();
   for (std::size_t k = 0; k < objectives.size(); ++k) add_recorder(*objectives[k], k, kNoPlugin);
   for (std::size_t k = 0; k < constraints.size(); ++k) add_recorder(*constraints[k], kNoPlugin, k);
+  if (s.plant.kind == PlantKind::kMujoco) {
+    for (auto& c : plant_columns(s.robot->dof())) columns.push_back(std::move(c));
+  }
+  return columns;
+}
+
+std::vector<std::string> plant_columns(int n) {
+  std::vector<std::string> columns;
+  for (int j = 1; j <= n; ++j) columns.push_back("measured_theta_dot_" + std::to_string(j));
+  for (int j = 1; j <= n; ++j) columns.push_back("torque_" + std::to_string(j));
+  columns.push_back("contacts");
+  columns.push_back("penetration");
   return columns;
 }
 
@@ -71,7 +83,7 @@ RowRecorder::RowRecorder(const Scenario& s, const Controller& ctrl, std::vector<
   for (int r = 0; r < m_; ++r) (r < position_rows_ ? all_position_rows_ : all_orientation_rows_) &= robot_->tracks(r);
 }
 
-const double* RowRecorder::write(int k, double t, const Eigen::VectorXd& theta, const StepOutput& out) {
+double* RowRecorder::write(int k, double t, const Eigen::VectorXd& theta, const StepOutput& out) {
   const KinematicsData& kin = ctrl_->kinematics();
   const QpProblem& qp = ctrl_->qp();
   const Eigen::VectorXd& vlo = ctrl_->velocity_lower();  // the laws at theta, as the step evaluated them

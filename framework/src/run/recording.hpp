@@ -29,8 +29,13 @@ struct Recorder {
 inline constexpr std::size_t kNoPlugin = static_cast<std::size_t>(-1);
 
 /// The columns a run of `s` records: the standard ones, then the plugins' own (a name that an earlier plugin took
-/// is "<plugin>.<column>"), with each recording plugin (its data not yet known) when `recorders` is given.
+/// is "<plugin>.<column>"), with each recording plugin (its data not yet known) when `recorders` is given, then the
+/// MuJoCo plant's (plant_columns()) when the scenario runs on it.
 [[nodiscard]] std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders);
+
+/// The columns the MuJoCo plant adds at the end of a row: measured_theta_dot_1..n, torque_1..n, contacts,
+/// penetration.
+[[nodiscard]] std::vector<std::string> plant_columns(int n);
 
 /// Writes one row per step into a buffer that stays in the cache (the table streams it in). Allocation-free after
 /// construction.
@@ -39,7 +44,8 @@ class RowRecorder {
   /// For a run of `s` by `ctrl` (its plugin data), with the recorders run_columns() found.
   RowRecorder(const Scenario& s, const Controller& ctrl, std::vector<Recorder> recorders, std::size_t width);
   /// The row of step k at time t, after ctrl's step at theta gave `out` (width values).
-  [[nodiscard]] const double* write(int k, double t, const Eigen::VectorXd& theta, const StepOutput& out);
+  /// The row stays writable until the next write() (a plant's columns at its end).
+  [[nodiscard]] double* write(int k, double t, const Eigen::VectorXd& theta, const StepOutput& out);
 
  private:
   // The norm of v's entries that are task rows; v(i) is reference row first + i (a subset leaves some rows free).

@@ -1,6 +1,7 @@
 #include "redres/run/run_summary.hpp"
 
 #include <algorithm>
+#include <sstream>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -128,6 +129,11 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   out.solver.max_relaxed_task_error = run.max_relaxed_task_error;
   out.solver.first_relaxed = run.first_relaxed;
   out.wall_time_s = run.wall_time_s;
+  if (run.plant) {
+    out.plant_kind = "mujoco";
+    out.plant = *run.plant;
+    out.plant.mjcf.clear();
+  }
   out.robot.name = robot.name();
   out.robot.kind = to_string(robot.kind());
   out.robot.task_rows = robot.task_names();
@@ -331,6 +337,68 @@ const std::vector<SummaryField>& summary_fields() {
        "`t = <t> s: rows relaxed (weight ...), missed by ... at most, after <status>: <diagnosis>` for the first "
        "relaxed step; empty if none",
        [](const S& s) { return text(s.solver.first_relaxed); }},
+      {"plant.kind", "string", "`kinematic` or `mujoco` ([plant] kind; docs/plant.md); the `plant.*` figures below "
+       "are empty (or 0) on the kinematic plant",
+       [](const S& s) { return text(s.plant_kind); }},
+      {"plant.actuator", "string", "`velocity_servo`, `impedance` or `ideal_velocity`",
+       [](const S& s) { return text(s.plant.actuator); }},
+      {"plant.timestep", "number", "MuJoCo's time step (s)", [](const S& s) { return SummaryValue(s.plant.timestep); }},
+      {"plant.delay", "number", "the measurement's delay (s)", [](const S& s) { return SummaryValue(s.plant.delay); }},
+      {"plant.max_torque", "array of n numbers", "per joint, the largest \\|torque\\| of any MuJoCo step (N m or N)",
+       [](const S& s) { return SummaryValue(s.plant.max_torque); }},
+      {"plant.effort_limit", "array of n numbers", "per joint, the robot's effort limit (N m or N; 0: none)",
+       [](const S& s) {
+         std::vector<double> v;
+         for (const double e : s.plant.effort_limit) v.push_back(std::isfinite(e) ? e : 0.0);
+         return SummaryValue(v);
+       }},
+      {"plant.max_torque_ratio", "number",
+       "the largest `max_torque` / `effort_limit` over the joints with a limit (1: a torque reached its limit)",
+       [](const S& s) {
+         double r = 0.0;
+         for (std::size_t j = 0; j < s.plant.max_torque.size() && j < s.plant.effort_limit.size(); ++j) {
+           if (std::isfinite(s.plant.effort_limit[j])) r = std::max(r, s.plant.max_torque[j] / s.plant.effort_limit[j]);
+         }
+         return SummaryValue(r);
+       }},
+      {"plant.max_torque_rate", "array of n numbers",
+       "per joint, the largest \\|torque rate\\| between MuJoCo steps (N m/s or N/s)",
+       [](const S& s) { return SummaryValue(s.plant.max_torque_rate); }},
+      {"plant.max_contacts", "integer", "the most contacts involving the robot at any MuJoCo step",
+       [](const S& s) { return count(s.plant.max_contacts); }},
+      {"plant.deepest_penetration", "number", "the deepest penetration MuJoCo found (m)",
+       [](const S& s) { return SummaryValue(s.plant.deepest_penetration); }},
+      {"plant.first_contact_time", "number", "when the first contact began (s; -1: never)",
+       [](const S& s) {
+         return SummaryValue(s.plant.contact_pairs.empty() ? -1.0 : s.plant.contact_pairs.front().first_time);
+       }},
+      {"plant.contact_pairs", "array of strings",
+       "every pair of bodies that touched, by first contact: `\"a vs b from t = ... s (deepest ... m, ... steps)\"`",
+       [](const S& s) {
+         std::vector<std::string> v;
+         for (const PlantContactPair& p : s.plant.contact_pairs) {
+           std::ostringstream line;
+           line << p.a << " vs " << p.b << " from t = " << p.first_time << " s (deepest " << p.deepest << " m, "
+                << p.steps << " steps)";
+           v.push_back(line.str());
+         }
+         return SummaryValue(v);
+       }},
+      {"plant.kinematic_max_position_error", "number",
+       "the same scenario on the kinematic plant: its `max_position_error` (m), beside this run's (under dynamics)",
+       [](const S& s) { return SummaryValue(s.plant.kinematic_max_position_error); }},
+      {"plant.control_step_us", "number", "mean wall time of one controller step (us)",
+       [](const S& s) {
+         return SummaryValue(s.plant.control_steps > 0 ? 1e6 * s.plant.controller_seconds /
+                                                             static_cast<double>(s.plant.control_steps)
+                                                       : 0.0);
+       }},
+      {"plant.mujoco_step_us", "number", "mean wall time of one MuJoCo step, the plant's torques included (us)",
+       [](const S& s) {
+         return SummaryValue(s.plant.mujoco_steps > 0
+                                 ? 1e6 * s.plant.mujoco_seconds / static_cast<double>(s.plant.mujoco_steps)
+                                 : 0.0);
+       }},
       {"wall_time_s", "number", "wall-clock time of the integration loop (s)",
        [](const S& s) { return SummaryValue(s.wall_time_s); }},
       {"robot.name", "string", "robot name", [](const S& s) { return text(s.robot.name); }},

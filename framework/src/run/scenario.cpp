@@ -13,6 +13,8 @@
 #include "redres/control/collision_rows.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/plant/mujoco_model.hpp"
+#include "redres/run/plugin_output.hpp"
 #include "redres/run/simulation.hpp"
 
 namespace redres {
@@ -295,6 +297,8 @@ struct OrientationTable {
   }
 };
 
+void check_plant(const TableReader& r, Scenario& s);
+
 // A scenario file's top level, read key by key in this order: each key's reader may use what the keys before it
 // gave (the robot bounds theta0, the duration bounds the step, the path starts where the arm does).
 struct ScenarioReading {
@@ -515,8 +519,61 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                }),
       field("output", &C::output, "", "what a run writes besides trajectory.csv and summary.json (below)")
           .listed_default("record = \"all\", no figures"),
+      entry<C>("plant", "table [plant]", "", "kind = \"kinematic\"",
+               "what the commands drive: the kinematic plant or a MuJoCo physics plant (below; docs/plant.md)",
+               [](const TableReader& r, C& c) {
+                 if (!r.has("plant")) return;
+                 config_io::read(r, "plant", c.s.plant);
+                 const TableReader t = r.table("plant");
+                 const TableReader plant(t.file_ptr(), t.raw(), "plant");
+                 check_plant(plant, c.s);
+               }),
   }};
   return keys;
+}
+
+// A [plant] table against the rest of the scenario: MuJoCo built in, the robot's mass properties, the gains' sizes,
+// the control period and the delay whole numbers of MuJoCo time steps (which becomes explicit), obstacles MuJoCo can
+// hold.
+void check_plant(const TableReader& r, Scenario& s) {
+  PlantConfig& p = s.plant;
+  if (p.kind != PlantKind::kMujoco) {
+    for (const char* key : {"timestep", "integrator", "actuator", "gravity_compensation", "kv", "kp", "kd", "delay",
+                            "gravity"}) {
+      if (r.has(key)) r.fail(key, "is used only with kind = \"mujoco\" (kind is \"kinematic\")");
+    }
+    return;
+  }
+  if (!mujoco_available()) r.fail("kind", "\"mujoco\": " + mujoco_missing());
+  const int n = s.robot->dof();
+  for (const auto& [key, gains] : {std::pair{"kv", &p.kv}, std::pair{"kp", &p.kp}, std::pair{"kd", &p.kd}}) {
+    try {
+      (void)gains->resolve(n, key);
+    } catch (const FieldError& e) {
+      r.fail(key, e.message());
+    }
+  }
+  const double dt = p.timestep > 0.0 ? p.timestep : std::min(1e-3, s.tau);
+  const auto whole = [dt](double span) {
+    const double ratio = span / dt;
+    return std::abs(ratio - std::round(ratio)) <= 1e-9 * std::max(1.0, ratio) && std::round(ratio) >= 1.0;
+  };
+  std::ostringstream m;
+  if (!whole(s.tau)) {
+    m << "the control period (`step` = " << s.tau << " s) must be a whole number of MuJoCo time steps, and " << dt
+      << " s is not a divisor of it";
+    r.fail(r.has("timestep") ? "timestep" : "kind", m.str());
+  }
+  if (p.delay > 0.0 && !whole(p.delay)) {
+    m << "expected a whole number of MuJoCo time steps (timestep = " << dt << " s), got " << p.delay << " s";
+    r.fail("delay", m.str());
+  }
+  p.timestep = dt;
+  try {
+    (void)scenario_mjcf(s);
+  } catch (const std::invalid_argument& e) {
+    r.fail("kind", std::string("\"mujoco\": ") + e.what());
+  }
 }
 
 // The largest `margin` of the scheme's active joint_angle_margin constraints, per joint (zeros without one).
@@ -617,6 +674,24 @@ void solve_start(Scenario& s, const Theta0Ik& req, const SourceLocation& where) 
 
 }  // namespace
 
+std::vector<ShapeSpec> scenario_obstacles(const Scenario& s, bool inactive) {
+  std::vector<ShapeSpec> out;
+  for (const auto& c : s.scheme->constraints()) {
+    const PluginOutput* output = output_of(*c);
+    if (output != nullptr && (inactive || c->active())) output->scene_obstacles(out);
+  }
+  return out;
+}
+
+std::string scenario_mjcf(const Scenario& s) {
+  if (s.plant.kind != PlantKind::kMujoco)
+    throw std::invalid_argument("scenario '" + s.name + "' runs on the kinematic plant: set [plant] kind = \"mujoco\"");
+  MjcfOptions options;
+  options.plant = s.plant;
+  options.obstacles = scenario_obstacles(s, true);
+  return mjcf_from_robot(*s.robot, options);
+}
+
 int Scenario::steps() const {
   const double ratio = duration / tau;
   REDRES_REQUIRE(ratio >= 0.5 && ratio <= kMaxSteps, "Scenario::steps",
@@ -641,6 +716,8 @@ const std::vector<KeyTable>& scenario_key_tables() {
        describe_keys(Theta0Ik::schema())},
       {"scenario", "theta0.ik = { position, rpy, phi }", "the inverse kinematics' target, in the world frame",
        describe_keys(IkTable::schema())},
+      {"scenario", "[plant]", "what the commands drive: the kinematic plant or MuJoCo (docs/plant.md)",
+       describe_keys(PlantConfig::schema())},
       {"scenario", "[solver]", "the run's policy for a step that is not solved (the engine's keys: redres plugins)",
        solver_policy_keys()},
   };

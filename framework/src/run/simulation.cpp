@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "run/recording.hpp"
 
@@ -131,6 +132,115 @@ class MotionStats {
 
 }  // namespace
 
+namespace {
+
+// The largest value of a column of the run's table (0 for an empty one).
+double column_max(const Trajectory& tr, const std::string& name) {
+  double m = 0.0;
+  for (std::size_t r = 0; r < tr.size(); ++r) m = std::max(m, tr.at(r, name));
+  return m;
+}
+
+// A run on the MuJoCo plant (docs/plant.md, "The plant"): each control step reads the measured state, solves, and
+// holds the command over the plant's MuJoCo steps.
+void simulate_plant(Scenario& s, RunResult& run, const ProgressCallback& progress, const std::atomic<bool>* stop) {
+  const int steps = s.steps();
+  const int n = s.robot->dof();
+  PlantFacts facts;
+  {
+    // The same scenario on the kinematic plant, for the kinematic-vs-dynamic error.
+    const PlantConfig plant = s.plant;
+    s.plant.kind = PlantKind::kKinematic;
+    RunResult kinematic;
+    try {
+      simulate(s, kinematic, {}, stop);
+    } catch (...) {
+      s.plant = plant;
+      throw;
+    }
+    s.plant = plant;
+    facts.kinematic_max_position_error = column_max(kinematic.trajectory, "position_error");
+  }
+  std::vector<Recorder> recorders;
+  std::vector<std::string> columns = run_columns(s, &recorders);
+  const std::size_t plant_first = columns.size() - static_cast<std::size_t>(2 * n + 2);
+  REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
+                 "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
+                     std::to_string(columns.size()) + " columns do not)");
+  run.trajectory.reset(std::move(columns), static_cast<std::size_t>(steps) + 1);
+  run.engines.reserve(4);
+
+  MujocoPlant plant(*s.robot, s.plant, s.tau, scenario_obstacles(s, true), s.theta0);
+  const std::unique_ptr<Controller> controller = Controller::from_scenario(s);
+  Controller& ctrl = *controller;
+  run.plugin_data = ctrl.shared_plugin_data();
+  RowRecorder rows(s, ctrl, std::move(recorders), run.trajectory.width());
+  StepLog log(run, *s.scheme, ctrl.plugin_data());
+  StepOutput out = ctrl.make_output();
+  Eigen::VectorXd theta(n), command = Eigen::VectorXd::Zero(n);
+  const auto start = std::chrono::steady_clock::now();
+  const int report_every = std::max(1, steps / 200);
+  MotionStats motion(*s.robot, run);
+  const auto u = [](std::size_t k) { return static_cast<std::ptrdiff_t>(k); };
+
+  for (int k = 0; k <= steps; ++k) {
+    const double t = k == steps ? s.duration : k * s.tau;
+    theta = plant.theta();
+    const auto c0 = std::chrono::steady_clock::now();
+    ctrl.step(theta, plant.theta_dot(), t, out);
+    facts.controller_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
+    ++facts.control_steps;
+    double* row = rows.write(k, t, theta, out);
+    std::copy_n(plant.theta_dot().data(), n, row + u(plant_first));
+    std::copy_n(plant.torque().data(), n, row + u(plant_first) + n);
+    row[plant_first + 2 * static_cast<std::size_t>(n)] = plant.contacts();
+    row[plant_first + 2 * static_cast<std::size_t>(n) + 1] = plant.penetration();
+    run.trajectory.append_row(row);
+    const int failures_before = run.failures;
+    log.note(out, t);
+    if (run.failures == failures_before) log.check_violations(t);  // one failure per step at most
+    if (progress && (k % report_every == 0 || k == steps)) progress(static_cast<double>(k) / steps, t);
+    if (k == steps) break;
+    if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
+      run.interrupted = true;
+      break;
+    }
+    if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before) {
+      run.stopped = true;
+      break;
+    }
+    if (moves(out.info.status)) {
+      if (out.info.status == SolverStatus::kBraked) ++run.braked_steps;
+      command = out.theta_dot;
+    } else {
+      ++run.held_steps;  // held: the servo is asked for theta_dot = 0
+      command.setZero();
+    }
+    plant.advance(command, t);
+    motion.add(command, theta, s.tau, run);
+  }
+  run.trajectory.publish();
+  run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  facts.actuator = std::string(enum_names(PlantActuator{})[static_cast<std::size_t>(s.plant.actuator)].second);
+  facts.timestep = plant.timestep();
+  facts.substeps = plant.substeps();
+  facts.delay = s.plant.delay;
+  facts.max_torque.assign(plant.max_torque().data(), plant.max_torque().data() + n);
+  facts.max_torque_rate.assign(plant.max_torque_rate().data(), plant.max_torque_rate().data() + n);
+  for (int j = 0; j < n; ++j)
+    facts.effort_limit.push_back(s.robot->joint(j).effort_limit.value_or(std::numeric_limits<double>::quiet_NaN()));
+  facts.max_contacts = static_cast<int>(column_max(run.trajectory, "contacts"));
+  facts.deepest_penetration = column_max(run.trajectory, "penetration");
+  facts.contact_pairs = plant.contact_pairs();
+  facts.mujoco_seconds = plant.mujoco_seconds();
+  facts.mujoco_steps = plant.mujoco_steps();
+  facts.mjcf = plant.mjcf();
+  run.plant = std::move(facts);
+}
+
+}  // namespace
+
 void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, const std::atomic<bool>* stop) {
   const int steps = s.steps();
   {
@@ -143,6 +253,10 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
   REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
                  "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
                      std::to_string(columns.size()) + " columns do not)");
+  if (s.plant.kind == PlantKind::kMujoco) {
+    simulate_plant(s, run, progress, stop);
+    return;
+  }
   run.trajectory.reset(std::move(columns), static_cast<std::size_t>(steps) + 1);
   run.engines.reserve(4);
 

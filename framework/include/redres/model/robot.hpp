@@ -92,6 +92,11 @@ struct JointSpec {
   std::shared_ptr<const VelocityLimitLaw> jerk_limit;
   std::string jerk_limit_source;       //!< where the jerk law was given ("file:line:col")
   std::optional<double> effort_limit;  //!< the largest torque or force (N m or N), > 0; from the URDF's `effort`
+  /// The joint's viscous damping (N m s/rad or N s/m, >= 0) and its armature, the drive's reflected rotor inertia
+  /// (kg m^2 or kg, >= 0): what a physics plant adds to the link's own dynamics (docs/plant.md). Empty: not given (a
+  /// plant takes 0); damping also comes from a URDF's <dynamics damping>.
+  std::optional<double> damping;
+  std::optional<double> armature;
   /// The mass properties of the link this joint moves (with everything riding on it), in the link frame; from the
   /// URDF's <inertial> elements or the robot file's `inertia`. Empty when not given.
   std::optional<Inertia> inertia;

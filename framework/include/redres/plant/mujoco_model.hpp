@@ -11,12 +11,16 @@
 /// end effector E is a site "end_effector" in the last body.
 
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "redres/model/collision.hpp"
 #include "redres/model/robot.hpp"
+#include "redres/plant/plant.hpp"
 
 namespace redres {
 
@@ -36,6 +40,15 @@ struct MjcfOptions {
   bool balance_inertia = false;
   /// The name of the end effector's site.
   std::string end_effector_site = "end_effector";
+  /// The simulation of a physics plant (docs/plant.md, "The plant"): when given, <option> gets its time step
+  /// (`timestep`, which must then be > 0), integrator and gravity, and every joint an actuator of its kind: a velocity
+  /// servo (general, gain kv, bias -kv qdot) or an impedance controller (general, gain 1, bias -kp q - kd qdot), each
+  /// force-limited at the joint's effort limit when it has one; an ideal velocity source has none.
+  std::optional<PlantConfig> plant;
+  /// Obstacles, world-frame shapes (as the scenario's collision constraints give them, PluginOutput::
+  /// scene_obstacles()): a still one is a geom of the world body ("obstacle<k>"), a moving one (`velocity`) a mocap
+  /// body of that name holding its geom, at its pose at t = 0. They collide with the robot, not with each other.
+  std::vector<ShapeSpec> obstacles;
 };
 
 /// The MJCF of `robot` (a complete <mujoco> document; angles in radians). Throws std::invalid_argument naming every
@@ -55,6 +68,8 @@ struct MjcfOptions {
 
 /// Whether this build of redres can load MuJoCo models (MujocoModel).
 [[nodiscard]] bool mujoco_available() noexcept;
+/// What a build without MuJoCo says when asked for it: which Debian package to install.
+[[nodiscard]] std::string mujoco_missing();
 
 /// A MuJoCo model and its data, loaded from MJCF text. Without MuJoCo (mujoco_available() false) from_xml() throws.
 class MujocoModel {

@@ -28,6 +28,8 @@
 
 #include "redres/config/config.hpp"
 #include "redres/control/controller.hpp"
+#include "redres/model/collision.hpp"
+#include "redres/plant/plant.hpp"
 #include "redres/run/ik.hpp"
 #include "redres/run/record.hpp"
 
@@ -73,11 +75,23 @@ struct Scenario {
   RecordOptions record;          //!< [output] record: "all", "none" or "every=N" (rows of trajectory.csv)
   bool plots = false;            //!< [output] plots
   bool animate = false;          //!< [output] animate
+  /// [plant]: what the commands drive, the kinematic plant (default) or MuJoCo (docs/plant.md). For MuJoCo, its
+  /// timestep is resolved (never 0) and the gains checked against the robot when the scenario is loaded.
+  PlantConfig plant;
 
   /// Number of control steps N = round(T / tau); the run records N + 1 rows, t = 0 .. T. Throws
   /// std::invalid_argument when T / tau is not in [1, kMaxSteps].
   [[nodiscard]] int steps() const;
 };
+
+/// The obstacles of the scenario's collision constraints (world-frame shapes at t = 0, each with its velocity if it
+/// moves; PluginOutput::scene_obstacles()), inactive constraints' too when `inactive` (a physics plant's world has
+/// them whether the controller avoids them or not).
+[[nodiscard]] std::vector<ShapeSpec> scenario_obstacles(const Scenario& s, bool inactive);
+
+/// The MuJoCo model a run of `s` on the MuJoCo plant steps (mjcf_from_robot() with the scenario's [plant] and every
+/// obstacle of its collision constraints); std::invalid_argument when the scenario's plant is not "mujoco".
+[[nodiscard]] std::string scenario_mjcf(const Scenario& s);
 
 /// The most control steps a run may have (duration / step).
 inline constexpr double kMaxSteps = 10'000'000;

@@ -5,14 +5,36 @@
 
 #include <atomic>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "redres/plant/mujoco_plant.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/trajectory.hpp"
 
 namespace redres {
+
+/// What a run on the MuJoCo plant ([plant] kind = "mujoco") recorded besides its trajectory (docs/plant.md).
+struct PlantFacts {
+  std::string actuator;      //!< "velocity_servo", "impedance" or "ideal_velocity"
+  double timestep = 0.0;     //!< MuJoCo's time step (s)
+  int substeps = 0;          //!< MuJoCo steps per control step
+  double delay = 0.0;        //!< the measurement's delay (s)
+  /// Per joint over every MuJoCo step: the largest |torque| (N m or N), the joint's effort limit (NaN when it has
+  /// none), and the largest |torque rate| (N m/s or N/s).
+  std::vector<double> max_torque, effort_limit, max_torque_rate;
+  int max_contacts = 0;                      //!< the most contacts (involving the robot) at any MuJoCo step
+  double deepest_penetration = 0.0;          //!< m
+  std::vector<PlantContactPair> contact_pairs;  //!< every pair that touched, by first time
+  /// The same scenario on the kinematic plant: its largest position error (m), beside this run's (the summary's).
+  double kinematic_max_position_error = 0.0;
+  double controller_seconds = 0.0;  //!< wall time in Controller::step over the run
+  double mujoco_seconds = 0.0;      //!< wall time in MuJoCo's steps over the run
+  long control_steps = 0, mujoco_steps = 0;
+  std::string mjcf;  //!< the model MuJoCo ran (`--write-mjcf`, the film)
+};
 
 /// A finished run: the recorded trajectory and what the loop saw.
 struct RunResult {
@@ -38,6 +60,8 @@ struct RunResult {
   bool interrupted = false;   //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
   /// The plugins' data as the run's last step left it (what their summaries read, e.g. FCL's failures).
   std::shared_ptr<const SchemeData> plugin_data;
+  /// [plant] kind = "mujoco": what the physics plant recorded; empty on the kinematic plant.
+  std::optional<PlantFacts> plant;
 
   /// "projection", or "newton+projection" when a fallback ran.
   [[nodiscard]] std::string engine() const;

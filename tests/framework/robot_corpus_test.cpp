@@ -73,10 +73,10 @@ const std::vector<Bad>& corpus() {
       {"joints_zero_axis.toml", "6:8", {"joint 'j1': key 'axis': expected a non-zero axis vector"}},
       {"joints_with_dh_key.toml",
        "6:1",
-       {"unknown key 'd' in joint 'j1'", "axis, collision, effort_limit, inertia, jerk_limit, limits, name, origin"}},
+       {"unknown key 'd' in joint 'j1'", "armature, axis, collision, damping, effort_limit, inertia, jerk_limit, limits, name, origin"}},
       {"dh_with_axis.toml",
        "6:1",
-       {"unknown key 'axis' in joint 'j1'", "a, acceleration_limit, alpha, collision, d, effort_limit"}},
+       {"unknown key 'axis' in joint 'j1'", "a, acceleration_limit, alpha, armature, collision, d, damping, effort_limit"}},
       {"joints_origin_unknown_key.toml", "6:31", {"unknown key 'quat' in joint 'j1' origin", "rpy, xyz"}},
       {"planar_base_rpy.toml", "5:1", {"unknown key 'rpy' in base", "angle, position, xyz"}},
   };

@@ -5,7 +5,7 @@
 //
 // Tolerances: final theta 1e-6 rad; manipulability (initial, final, mean, min, max) 1e-6 relative; joint-velocity
 // norms 1e-6 rad/s absolute; position errors 10 % relative + 1e-8 m (they sit near the solver's tolerance); the
-// number of failed steps exactly.
+// number of failed steps exactly; on the MuJoCo plant, the contacts exactly and the largest torques 1e-3 relative.
 
 #include <cmath>
 #include <cstdlib>
@@ -43,6 +43,8 @@ TEST_P(Golden, SummaryStaysWithinTolerances) {
     nlohmann::json keep = nlohmann::json::parse(to_json(got));
     keep.erase("wall_time_s");
     keep.erase("source");
+    keep["plant"].erase("control_step_us");  // timings: never golden
+    keep["plant"].erase("mujoco_step_us");
     std::ofstream(file) << keep.dump(2) << "\n";
     GTEST_SKIP() << "recorded " << file;
   }
@@ -67,6 +69,14 @@ TEST_P(Golden, SummaryStaysWithinTolerances) {
   EXPECT_NEAR(got.final_position_error, e_final, 0.1 * e_final + 1e-8);
   EXPECT_LE(got.max_joint_angle_violation, 0.0);
   EXPECT_LE(got.max_joint_velocity_violation, 0.0);
+  // The MuJoCo plant: its contacts exactly, its largest torques to 1e-3 relative.
+  EXPECT_EQ(got.plant_kind, want["plant"]["kind"].get<std::string>());
+  EXPECT_EQ(got.plant.max_contacts, want["plant"]["max_contacts"].get<int>());
+  ASSERT_EQ(got.plant.max_torque.size(), want["plant"]["max_torque"].size());
+  for (std::size_t j = 0; j < got.plant.max_torque.size(); ++j) {
+    const double expected = want["plant"]["max_torque"][j];
+    EXPECT_NEAR(got.plant.max_torque[j], expected, 1e-3 * expected + 1e-9) << "plant.max_torque, joint " << j + 1;
+  }
   ASSERT_EQ(got.final_theta.size(), want["final_theta"].size());
   for (std::size_t j = 0; j < got.final_theta.size(); ++j) {
     EXPECT_NEAR(got.final_theta[j], want["final_theta"][j].get<double>(), 1e-6) << "joint " << j + 1;

@@ -41,14 +41,15 @@ from ._redres import (  # noqa: F401  (re-exported)
     StepInfo,
     StepQp,
     check_plugins,
+    mujoco_available,
     trajectory_column_groups,
 )
 
 __version__ = "0.1.0"
 __all__ = [
     "ConfigError", "Constraint", "Controller", "Kinematics", "Objective", "Result", "Robot", "Scenario", "StepContext",
-    "StepInfo", "StepQp", "Comparison", "check_plugins", "compare", "constraints", "engines", "objectives", "paths",
-    "plugins", "register", "sweep",
+    "StepInfo", "StepQp", "Comparison", "check_plugins", "compare", "constraints", "engines", "mujoco_available",
+    "objectives", "paths", "plugins", "register", "sweep",
 ]
 
 

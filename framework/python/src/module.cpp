@@ -30,6 +30,7 @@
 #include "redres/run/run_output.hpp"
 #include "redres/run/run_summary.hpp"
 #include "redres/run/scenario.hpp"
+#include "redres/plant/mujoco_model.hpp"
 #include "redres/run/simulation.hpp"
 #include "redres/run/sweep.hpp"
 #include "redres/run/trajectory_columns.hpp"
@@ -782,5 +783,8 @@ PYBIND11_MODULE(_redres, m) {
       "The standard columns of trajectory.csv (and of a Result), group by group: name (or prefix), count ('1', "
       "'n' per joint, 'm_ref' per reference row), unit and meaning; the same list the C++ run fills its rows from.");
   m.def("_registry", &registry_listing);
+  m.def(
+      "mujoco_available", [] { return mujoco_available(); },
+      "Whether this build of redres has the MuJoCo plant ([plant] kind = \"mujoco\"; docs/plant.md).");
   bind_python_plugins(m);
 }

@@ -614,6 +614,57 @@ def fig_distances(run_dir, data, summary, name):
     plt.close(fig)
 
 
+def fig_plant(run_dir, data, summary, n, name):
+    """A run on the MuJoCo plant: per joint, the commanded and the measured joint velocity (top row) and the torque
+    against the effort limit (bottom row); and the position error under dynamics beside the kinematic plant's."""
+    plant = summary.get("plant", {})
+    if plant.get("kind") != "mujoco" or "torque_1" not in data.dtype.names:
+        return
+    t = data["t"]
+    fig, axes = plt.subplots(3, n, figsize=(2.6 * n, 7.5), squeeze=False)
+    limits = plant.get("effort_limit", [0.0] * n)
+    for j in range(1, n + 1):
+        ax = axes[0][j - 1]
+        ax.plot(t, data[f"theta_dot_{j}"], "b", lw=1, label="commanded")
+        ax.plot(t, data[f"measured_theta_dot_{j}"], "r--", lw=1, label="measured")
+        ax.set_title(f"joint {j}", fontsize=9)
+        ax.grid(alpha=0.3)
+        ax = axes[1][j - 1]
+        ax.plot(t, data[f"torque_{j}"], "k", lw=1, label="torque")
+        limit = limits[j - 1] if j - 1 < len(limits) else 0.0
+        if limit > 0.0:
+            ax.axhline(limit, color="r", ls="--", lw=1, label="effort limit")
+            ax.axhline(-limit, color="r", ls="--", lw=1)
+        ax.set_xlabel("t (s)", fontsize=8)
+        ax.grid(alpha=0.3)
+    axes[0][0].set_ylabel(r"$\dot\theta$ (rad/s)")
+    axes[1][0].set_ylabel("torque (N m)")
+    axes[0][0].legend(fontsize=6)
+    axes[1][0].legend(fontsize=6)
+    for ax in axes[2]:
+        ax.remove()
+    err = fig.add_subplot(3, 1, 3)
+    err.plot(t, data["position_error"], "b", lw=1, label="MuJoCo plant")
+    err.axhline(plant.get("kinematic_max_position_error", 0.0), color="g", ls="--", lw=1,
+                label="kinematic plant's largest")
+    if "contacts" in data.dtype.names and data["contacts"].max() > 0:
+        first = plant.get("first_contact_time", -1.0)
+        err.axvline(first, color="r", lw=1, label=f"first contact (t = {first:.3g} s)")
+    err.set_xlabel("t (s)")
+    err.set_ylabel("position error (m)")
+    err.set_yscale("log" if data["position_error"].max() > 0 else "linear")
+    err.grid(alpha=0.3)
+    err.legend(fontsize=7)
+    ratio = plant.get("max_torque_ratio", 0.0)
+    torques = (f"torques (max {100 * ratio:.0f} % of the limit)" if any(x > 0.0 for x in limits)
+               else "torques (the robot gives no effort limits)")
+    fig.suptitle(f"{name} on MuJoCo ({plant.get('actuator', '')}): velocities, {torques}, "
+                 f"at most {plant.get('max_contacts', 0)} contact(s) at once")
+    fig.tight_layout()
+    save_output(os.path.join(run_dir, "fig_plant.png"), lambda target: fig.savefig(target, dpi=110))
+    plt.close(fig)
+
+
 def fig_profiles(run_dir, data, n, name):
     fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4))
     profiles(a, b, data, n)
@@ -636,6 +687,7 @@ def plot_run(run_dir, quiet):
     fig_accelerations(run_dir, data, n, name)
     fig_error(run_dir, data, name)
     fig_distances(run_dir, data, summary, name)
+    fig_plant(run_dir, data, summary, n, name)
     if not quiet:
         print(f"figures written to {run_dir}")
 

@@ -21,6 +21,8 @@
 #include "commands.hpp"
 #include "figures.hpp"
 #include "progress.hpp"
+#include "redres/plant/film.hpp"
+#include "redres/plant/mujoco_model.hpp"
 #include "redres/run/comparison.hpp"
 #include "redres/run/run_output.hpp"
 #include "redres/run/scenario.hpp"
@@ -41,6 +43,7 @@ struct RunOptions {
   bool no_plots = false;
   bool write_mjcf = false;
   bool film = false;
+  double film_fps = 25.0;
   std::string record;  // --record; empty: the scenario's [output] record
   std::string format;  // --format; empty: the scenario's [output] format
 };
@@ -138,6 +141,45 @@ void print_ik(const Scenario& s, const std::string& prefix = "") {
   std::cout << line.str() << "]\n";
 }
 
+// `--film`: the MuJoCo scene of a finished run, rendered offscreen into the output directory (plant/film.hpp), from
+// the recorded measured angles at the film's frame times; after the run, never inside its loop.
+void film_run(const Outcome& o, const std::filesystem::path& out, double fps, bool quiet) {
+  const Trajectory& tr = o.run.trajectory;
+  const Scenario& s = o.scenario;
+  const int n = s.robot->dof();
+  std::vector<std::size_t> theta(static_cast<std::size_t>(n));
+  for (int j = 0; j < n; ++j) theta[static_cast<std::size_t>(j)] = tr.column("theta_" + std::to_string(j + 1));
+  const std::vector<ShapeSpec> obstacles = scenario_obstacles(s, true);
+  const double last = tr.at(tr.size() - 1, "t");
+  std::vector<FilmFrame> frames;
+  for (const double t : film_times(last, fps)) {
+    const auto row = std::min(tr.size() - 1, static_cast<std::size_t>(std::lround(t / s.tau)));
+    FilmFrame f;
+    f.t = t;
+    f.qpos.resize(n);
+    for (int j = 0; j < n; ++j) f.qpos(j) = tr(row, theta[static_cast<std::size_t>(j)]);
+    f.mocap_pos = mjcf_mocap_positions(obstacles, t);
+    frames.push_back(std::move(f));
+  }
+  FilmOptions options;
+  options.fps = fps;
+  FilmReport report;
+  {
+    ProgressBar bar(s.name + " film", quiet);
+    report = film(o.run.plant->mjcf, frames, out, options, [&bar](int done, int total) {
+      char where[32];
+      std::snprintf(where, sizeof where, "%d/%d frames", done, total);
+      bar.update(static_cast<double>(done) / total, where);
+    });
+  }
+  if (!quiet) {
+    std::cout << "film: " << report.file.string() << " (" << report.frames << " frames at " << fps << " per second, "
+              << std::setprecision(3) << report.seconds_per_frame << " s per frame";
+    if (!report.frames_dir.empty()) std::cout << "; PNG frames in " << report.frames_dir.string();
+    std::cout << ")\n";
+  }
+}
+
 // `redres run`: one scenario, its files, and the figures or the animation asked for.
 int run_scenario(const RunOptions& options) {
   const RunOptions* const opts = &options;
@@ -172,6 +214,14 @@ int run_scenario(const RunOptions& options) {
   if (opts->animate || scenario.animate) {
     animator = find_plotter(opts->animate ? "--animate" : opts->scenarios.front() + ": [output] animate = true");
   }
+  if (opts->film) {
+    if (scenario.plant.kind != PlantKind::kMujoco) {
+      throw std::runtime_error("--film renders the MuJoCo scene: scenario '" + scenario.name +
+                               "' runs on the kinematic plant; add --set plant.kind=mujoco");
+    }
+    if (!(opts->film_fps > 0.0 && opts->film_fps <= 1000.0))
+      throw std::runtime_error("--film-fps: expected 0 < fps <= 1000 frames per second of simulated time");
+  }
   prepare_output_dir(opts->out);  // before the run, so that a bad --out does not cost the run
   if (opts->write_mjcf) {
     if (scenario.plant.kind != PlantKind::kMujoco) {
@@ -193,7 +243,8 @@ int run_scenario(const RunOptions& options) {
     const std::filesystem::path file = render_animation(*animator, opts->out, opts->quiet, written);
     if (!opts->quiet) std::cout << "animation: " << file.string() << "\n";
   }
-  if (plotter || animator) record_new_files(opts->out, before);
+  if (opts->film) film_run(o, opts->out, opts->film_fps, opts->quiet);
+  if (plotter || animator || opts->film) record_new_files(opts->out, before);
   return o.run.failures > 0 || o.summary.task_error_exceeded ? kExitFailedSteps : kExitOk;
 }
 
@@ -207,6 +258,13 @@ int validate_scenario(const RunOptions& options) {
             << s.path->description() << ", " << s.scheme->objectives().size() << " objective(s), "
             << s.scheme->constraints().size() << " constraint(s), engine " << s.engine->name() << "\n";
   print_ik(s);
+  if (s.plant.kind == PlantKind::kMujoco) {
+    const auto substeps = std::lround(s.tau / s.plant.timestep);
+    std::cout << "plant: MuJoCo, " << enum_names(PlantActuator{})[static_cast<std::size_t>(s.plant.actuator)].second
+              << (s.plant.gravity_compensation ? " with" : " without") << " gravity compensation, " << substeps
+              << " MuJoCo step" << (substeps == 1 ? "" : "s") << " of " << s.plant.timestep << " s per control step"
+              << (s.plant.delay > 0.0 ? ", measurement delay " + std::to_string(s.plant.delay) + " s" : "") << "\n";
+  }
   std::cout << "start: within limits, no collision, task rows' smallest singular value " << start.sigma_min
             << " (w = " << start.w << "), path " << start.path_offset << " m from the end effector (checked in "
             << start.seconds << " s)\n";
@@ -285,6 +343,10 @@ void add_run_commands(CLI::App& app, Action& action) {
   run->add_flag("--write-mjcf", opts->write_mjcf,
                 "write the MuJoCo model the run steps ([plant] kind = \"mujoco\") to mujoco_model.xml in the output "
                 "directory, for MuJoCo's own viewer");
+  run->add_flag("--film", opts->film,
+                "render the MuJoCo scene of the run ([plant] kind = \"mujoco\") offscreen after it: film.mp4 when "
+                "ffmpeg is on PATH, else PNG frames in film_frames/ and film.gif (docs/plant.md)");
+  run->add_option("--film-fps", opts->film_fps, "frames per second of simulated time for --film (default 25)");
   run->add_option("--record", opts->record,
                   "rows of trajectory.csv: all, every=N (every N-th step and the last), or none (summary.json only); "
                   "the summary always uses every step (default: the scenario's [output] record, else all)");

@@ -1,5 +1,6 @@
 // mjcf_from_robot(): a RobotModel as MuJoCo's XML (docs/plant.md). Plain text; MuJoCo itself is not needed here.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdio>
@@ -127,6 +128,21 @@ std::string shape_attributes(const ShapeSpec& spec, const Eigen::Isometry3d& pos
 
 }  // namespace
 
+bool mjcf_moving_obstacle(const ShapeSpec& o) {
+  return o.velocity && (o.velocity->at(0) != 0.0 || o.velocity->at(1) != 0.0 || o.velocity->at(2) != 0.0);
+}
+
+Eigen::Matrix3Xd mjcf_mocap_positions(const std::vector<ShapeSpec>& obstacles, double t) {
+  const auto moving = std::count_if(obstacles.begin(), obstacles.end(), mjcf_moving_obstacle);
+  Eigen::Matrix3Xd out(3, moving);
+  Eigen::Index k = 0;
+  for (const ShapeSpec& o : obstacles) {
+    if (!mjcf_moving_obstacle(o)) continue;
+    out.col(k++) = o.pose().translation() + t * Eigen::Vector3d(o.velocity->at(0), o.velocity->at(1), o.velocity->at(2));
+  }
+  return out;
+}
+
 std::string mjcf_body_name(const RobotModel& robot, int j) {
   return robot.bodies().at(static_cast<std::size_t>(robot.body_of_joint(j))).name;
 }
@@ -197,8 +213,7 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
     const ShapeSpec& o = options.obstacles[k];
     const std::string name = "obstacle" + std::to_string(k);
     const std::string look = "contype=\"2\" conaffinity=\"1\" rgba=\"0.85 0.3 0.25 0.6\" ";
-    const bool moves = o.velocity && (o.velocity->at(0) != 0.0 || o.velocity->at(1) != 0.0 || o.velocity->at(2) != 0.0);
-    if (!moves) {
+    if (!mjcf_moving_obstacle(o)) {
       still += "    <geom name=\"" + name + "\" " + look +
                shape_attributes(o, o.pose(), name, assets, "obstacle " + std::to_string(k)) + "/>\n";
     } else {

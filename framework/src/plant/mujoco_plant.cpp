@@ -343,17 +343,7 @@ std::vector<PlantContactPair> MujocoPlant::contact_pairs() const {
   return out;
 }
 
-Eigen::Matrix3Xd MujocoPlant::mocap_positions(double t) const {
-  const Impl& p = *impl_;
-  Eigen::Matrix3Xd out(3, p.m->nmocap);
-  for (std::size_t k = 0; k < p.obstacles.size(); ++k) {
-    const int id = p.mocap[k];
-    if (id < 0) continue;
-    const std::array<double, 3>& v = *p.obstacles[k].velocity;
-    out.col(id) = p.obstacles[k].pose().translation() + t * Eigen::Vector3d(v[0], v[1], v[2]);
-  }
-  return out;
-}
+Eigen::Matrix3Xd MujocoPlant::mocap_positions(double t) const { return mjcf_mocap_positions(impl_->obstacles, t); }
 
 #else  // without MuJoCo
 

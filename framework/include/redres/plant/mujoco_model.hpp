@@ -63,6 +63,12 @@ struct MjcfOptions {
 /// digits, so they read back as the same doubles.
 [[nodiscard]] std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options = {});
 
+/// Whether mjcf_from_robot() makes this obstacle a mocap body (it has a non-zero `velocity`).
+[[nodiscard]] bool mjcf_moving_obstacle(const ShapeSpec& obstacle);
+/// The positions at time t of the mocap bodies mjcf_from_robot() makes of `obstacles` (the moving ones, in their
+/// order: MuJoCo's mocap order), 3 x their number: each obstacle's position at t = 0 plus t times its velocity.
+[[nodiscard]] Eigen::Matrix3Xd mjcf_mocap_positions(const std::vector<ShapeSpec>& obstacles, double t);
+
 /// The body name mjcf_from_robot() gives joint j's link: the redres body's name (a URDF's link name, or the joint's).
 [[nodiscard]] std::string mjcf_body_name(const RobotModel& robot, int j);
 

@@ -6,11 +6,11 @@
 // machines that run the tests need not have ffmpeg). (Built only with REDRES_WITH_MUJOCO.)
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -60,8 +60,11 @@ Picture read_png(const fs::path& file) {
 }
 
 std::string read_bytes(const fs::path& file) {
+  std::string bytes(fs::file_size(file), '\0');
   std::ifstream in(file, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  bytes.resize(static_cast<std::size_t>(in.gcount()));
+  return bytes;
 }
 
 // The pixels of a bright red (a red obstacle under the headlight; the robot's geoms are MuJoCo's grey).
@@ -286,6 +289,29 @@ TEST(Film, RefusesFramesThatAreNotTheModels) {
   EXPECT_THROW(static_cast<void>(film(panda_mjcf(false), panda_frames(1), dir.path() / "missing", small_frames())),
                std::runtime_error);
   EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+// Without Mesa's driver EGL cannot initialise: film() throws, naming the step and the packages, and writes nothing
+// (in a child process: the driver's search path is read when EGL initialises).
+TEST(FilmDeathTest, ReportsAnEglThatCannotInitialise) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");  // a fresh process, not a fork of one with Mesa's threads
+  const TempDir dir;
+  EXPECT_EXIT(
+      {
+        ::setenv("LIBGL_DRIVERS_PATH", "/nonexistent", 1);
+        try {
+          static_cast<void>(film(panda_mjcf(false), panda_frames(1), dir.path(), small_frames()));
+        } catch (const std::runtime_error& e) {
+          const std::string what = e.what();
+          std::fprintf(stderr, "%s\n", what.c_str());
+          std::exit(what.find("eglInitialize failed") != std::string::npos &&
+                            what.find("libegl-mesa0") != std::string::npos && fs::is_empty(dir.path())
+                        ? 3
+                        : 4);
+        }
+        std::exit(5);
+      },
+      ::testing::ExitedWithCode(3), "eglInitialize failed");
 }
 
 // The camera frames the robot and the obstacles over the whole run: an obstacle that starts far off to one side and

@@ -236,15 +236,27 @@ class EglContext {
                              "; rendering needs Mesa's EGL: libegl1, libegl-mesa0 and libgl1-mesa-dri)");
   }
 
+  // The surfaceless display, initialised by the first film and never terminated: terminating the last display
+  // unloads Mesa's driver with memory it still holds, which LeakSanitizer then reports as lost (and each film would
+  // pay the driver's start-up again). A failure is not remembered: the next film tries again.
+  static EGLDisplay display() {
+    static const EGLDisplay initialised = [] {
+      const auto get_platform_display =
+          reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+      if (get_platform_display == nullptr) fail("EGL has no eglGetPlatformDisplayEXT (EGL_EXT_platform_base)");
+      const EGLDisplay d = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+      if (d == EGL_NO_DISPLAY) fail("no EGL display on Mesa's surfaceless platform");
+      EGLint major = 0, minor = 0;
+      if (eglInitialize(d, &major, &minor) != EGL_TRUE) fail("eglInitialize failed on the surfaceless display");
+      return d;
+    }();
+    return initialised;
+  }
+
   void open() {
-    const auto get_platform_display =
-        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-    if (get_platform_display == nullptr) fail("EGL has no eglGetPlatformDisplayEXT (EGL_EXT_platform_base)");
-    display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-    if (display_ == EGL_NO_DISPLAY) fail("no EGL display on Mesa's surfaceless platform");
-    EGLint major = 0, minor = 0;
-    if (eglInitialize(display_, &major, &minor) != EGL_TRUE) fail("eglInitialize failed on the surfaceless display");
-    initialised_ = true;
+    display_ = display();
+    // No window (MuJoCo draws into its own framebuffer object); desktop OpenGL, whose fixed-function pipeline
+    // MuJoCo 2.2 uses; 8-bit colour.
     const EGLint attributes[] = {EGL_SURFACE_TYPE,
                                  EGL_PBUFFER_BIT,
                                  EGL_RENDERABLE_TYPE,
@@ -271,16 +283,12 @@ class EglContext {
   void close() noexcept {
     if (current_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
-    if (initialised_) eglTerminate(display_);
-    eglReleaseThread();
-    current_ = initialised_ = false;
+    current_ = false;
     context_ = EGL_NO_CONTEXT;
-    display_ = EGL_NO_DISPLAY;
   }
 
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLContext context_ = EGL_NO_CONTEXT;
-  bool initialised_ = false;
   bool current_ = false;
 };
 

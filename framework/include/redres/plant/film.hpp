@@ -3,7 +3,7 @@
 /// Filming a run (docs/plant.md, "Filming a run"): film() renders recorded frames of a MuJoCo model offscreen, with
 /// MuJoCo's own renderer on an EGL context of Mesa's surfaceless platform (no X server, no window), and writes an MP4
 /// through `ffmpeg` when it is on PATH, else PNG frames and an animated GIF. It runs after a run, from the frames the
-/// run recorded, never inside the control loop: a frame costs a tenth of a second or more in software rendering.
+/// run recorded, never inside the control loop: a frame costs tens of milliseconds in software rendering.
 ///
 /// This header includes no MuJoCo or EGL header. Without MuJoCo (film_available() false) film() throws.
 

@@ -26,7 +26,7 @@ std::string read_text(const std::filesystem::path& p) {
 
 TEST(PlantCommand, AMujocoScenarioRunsOrNamesThePackageToInstall) {
   const std::filesystem::path out = scratch("plant_run");
-  const Cli r = redres("run configs/paper_r_mujoco.toml --out '" + out.string() + "' --write-mjcf --set duration=4");
+  const Cli r = redres("run configs/paper_r_mujoco.toml --out '" + out.string() + "' --write-mjcf");
   if (!mujoco_available()) {
     EXPECT_EQ(r.code, 2) << r.out;
     EXPECT_NE(r.out.find("libmujoco-dev"), std::string::npos) << r.out;
@@ -45,6 +45,28 @@ TEST(PlantCommand, AMujocoScenarioRunsOrNamesThePackageToInstall) {
   const std::string xml = read_text(out / "mujoco_model.xml");
   EXPECT_NE(xml.find("<actuator>"), std::string::npos);
   EXPECT_NO_THROW((void)MujocoModel::from_xml(xml));
+  std::filesystem::remove_all(out);
+}
+
+TEST(PlantCommand, FilmRendersTheRunAfterIt) {
+  if (!mujoco_available()) GTEST_SKIP() << "no MuJoCo in this build: AMujocoScenarioRunsOrNamesThePackageToInstall";
+  const std::filesystem::path out = scratch("plant_film");
+  // PATH without ffmpeg: PNG frames and a GIF, 40 s at 0.5 frames per second: 21 frames.
+  const Cli r = redres_env("PATH=/nonexistent ", "run configs/paper_r_mujoco.toml --out '" + out.string() +
+                                                     "' --film --film-fps 0.5");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("film: " + (out / "film.gif").string() + " (21 frames at 0.5 per second"), std::string::npos)
+      << r.out;
+  EXPECT_TRUE(std::filesystem::is_regular_file(out / "film_frames" / "frame_00020.png"));
+  EXPECT_FALSE(std::filesystem::exists(out / "film_frames" / "frame_00021.png"));
+  EXPECT_EQ(read_text(out / "film.gif").substr(0, 6), "GIF89a");
+  // Again into the same directory: refused before the run (exit code 2), the first film untouched.
+  const auto stamp = std::filesystem::last_write_time(out / "summary.json");
+  const Cli again = redres_env("PATH=/nonexistent ", "run configs/paper_r_mujoco.toml --out '" + out.string() +
+                                                         "' --film --film-fps 0.5");
+  EXPECT_EQ(again.code, 2) << again.out;
+  EXPECT_NE(again.out.find("--film: " + (out / "film.gif").string() + " exists"), std::string::npos) << again.out;
+  EXPECT_EQ(std::filesystem::last_write_time(out / "summary.json"), stamp);  // the run did not start
   std::filesystem::remove_all(out);
 }
 

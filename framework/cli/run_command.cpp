@@ -223,7 +223,7 @@ int run_scenario(const RunOptions& options) {
       throw std::runtime_error("--film-fps: expected 0 < fps <= 1000 frames per second of simulated time");
   }
   prepare_output_dir(opts->out);  // before the run, so that a bad --out does not cost the run
-  if (opts->film) {  // film() replaces nothing: say so before the run, not after it
+  if (opts->film) {               // film() replaces nothing: say so before the run, not after it
     for (const char* name : {"film.mp4", "film.gif", "film_frames"}) {
       const std::filesystem::path p = std::filesystem::path(opts->out) / name;
       if (std::filesystem::exists(std::filesystem::symlink_status(p))) {

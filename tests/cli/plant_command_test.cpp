@@ -52,8 +52,8 @@ TEST(PlantCommand, FilmRendersTheRunAfterIt) {
   if (!mujoco_available()) GTEST_SKIP() << "no MuJoCo in this build: AMujocoScenarioRunsOrNamesThePackageToInstall";
   const std::filesystem::path out = scratch("plant_film");
   // PATH without ffmpeg: PNG frames and a GIF, 40 s at 0.5 frames per second: 21 frames.
-  const Cli r = redres_env("PATH=/nonexistent ", "run configs/paper_r_mujoco.toml --out '" + out.string() +
-                                                     "' --film --film-fps 0.5");
+  const Cli r = redres_env("PATH=/nonexistent ",
+                           "run configs/paper_r_mujoco.toml --out '" + out.string() + "' --film --film-fps 0.5");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("film: " + (out / "film.gif").string() + " (21 frames at 0.5 per second"), std::string::npos)
       << r.out;
@@ -62,8 +62,8 @@ TEST(PlantCommand, FilmRendersTheRunAfterIt) {
   EXPECT_EQ(read_text(out / "film.gif").substr(0, 6), "GIF89a");
   // Again into the same directory: refused before the run (exit code 2), the first film untouched.
   const auto stamp = std::filesystem::last_write_time(out / "summary.json");
-  const Cli again = redres_env("PATH=/nonexistent ", "run configs/paper_r_mujoco.toml --out '" + out.string() +
-                                                         "' --film --film-fps 0.5");
+  const Cli again = redres_env("PATH=/nonexistent ",
+                               "run configs/paper_r_mujoco.toml --out '" + out.string() + "' --film --film-fps 0.5");
   EXPECT_EQ(again.code, 2) << again.out;
   EXPECT_NE(again.out.find("--film: " + (out / "film.gif").string() + " exists"), std::string::npos) << again.out;
   EXPECT_EQ(std::filesystem::last_write_time(out / "summary.json"), stamp);  // the run did not start

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <toml++/toml.h>
 
+#include "mujoco_configs.hpp"
 #include "redres/common/error.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/parsers/robot_toml.hpp"
@@ -20,7 +21,6 @@
 #include "redres/run/scenario.hpp"
 #include "redres/run/sweep.hpp"
 #include "test_util.hpp"
-#include "mujoco_configs.hpp"
 
 namespace redres {
 namespace {

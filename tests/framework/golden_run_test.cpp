@@ -15,9 +15,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "mujoco_configs.hpp"
 #include "redres/run/run_summary.hpp"
 #include "test_util.hpp"
-#include "mujoco_configs.hpp"
 
 namespace redres {
 namespace {

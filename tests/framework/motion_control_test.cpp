@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "alloc_counter.hpp"
+#include "mujoco_configs.hpp"
 #include "qp_util.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/constraints/joint_acceleration_limits.hpp"
@@ -22,7 +23,6 @@
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
 #include "test_util.hpp"
-#include "mujoco_configs.hpp"
 
 namespace redres {
 namespace {
@@ -297,9 +297,8 @@ TEST(NoVelocityJump, EveryShippedScenarioAndForcedFailures) {
     // A scenario that turns the robot's acceleration limits off on purpose (to show what they prevent) is not held
     // to them.
     const auto& constraints = probe.scheme->constraints();
-    if (std::any_of(constraints.begin(), constraints.end(), [](const auto& c) {
-          return c->type() == "joint_acceleration_limits" && !c->active();
-        })) {
+    if (std::any_of(constraints.begin(), constraints.end(),
+                    [](const auto& c) { return c->type() == "joint_acceleration_limits" && !c->active(); })) {
       ++turned_off;
       continue;
     }
@@ -322,7 +321,7 @@ TEST(NoVelocityJump, EveryShippedScenarioAndForcedFailures) {
       ++checked;
     }
   }
-  EXPECT_GE(checked, 8);  // the Panda's scenarios, twice each
+  EXPECT_GE(checked, 8);     // the Panda's scenarios, twice each
   EXPECT_LE(turned_off, 1);  // panda_helix_fast_unlimited_mujoco.toml alone
 }
 

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "alloc_counter.hpp"
 #include "redres/config/toml_reader.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/plant/mujoco_model.hpp"
@@ -20,7 +21,6 @@
 #include "redres/run/run_summary.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
-#include "alloc_counter.hpp"
 
 namespace redres {
 namespace {

@@ -7,10 +7,10 @@
 
 #include <gtest/gtest.h>
 
-#include "redres/run/start_check.hpp"
-#include "redres/run/simulation.hpp"
-#include "test_util.hpp"
 #include "mujoco_configs.hpp"
+#include "redres/run/simulation.hpp"
+#include "redres/run/start_check.hpp"
+#include "test_util.hpp"
 
 namespace redres {
 namespace {
@@ -77,9 +77,9 @@ TEST(StartCheck, APathThatStartsAwayFromTheEndEffectorIsRefused) {
 
 TEST(StartCheck, EveryProblemIsReportedTogether) {
   // Singular and away from the path at once.
-  Scenario s = load_scenario(source_path("configs/iiwa_pose_circle.toml"),
-                             {"theta0=[0, 0, 0, 0, 0, 0, 0]", "path.placement=\"absolute\"",
-                              "path.origin=[0.9, 0.0, 0.3]"});
+  Scenario s =
+      load_scenario(source_path("configs/iiwa_pose_circle.toml"),
+                    {"theta0=[0, 0, 0, 0, 0, 0, 0]", "path.placement=\"absolute\"", "path.origin=[0.9, 0.0, 0.3]"});
   const StartReport r = check_start(s);
   ASSERT_EQ(r.problems.size(), 2u) << r.text();
   try {

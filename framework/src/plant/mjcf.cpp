@@ -138,7 +138,8 @@ Eigen::Matrix3Xd mjcf_mocap_positions(const std::vector<ShapeSpec>& obstacles, d
   Eigen::Index k = 0;
   for (const ShapeSpec& o : obstacles) {
     if (!mjcf_moving_obstacle(o)) continue;
-    out.col(k++) = o.pose().translation() + t * Eigen::Vector3d(o.velocity->at(0), o.velocity->at(1), o.velocity->at(2));
+    out.col(k++) =
+        o.pose().translation() + t * Eigen::Vector3d(o.velocity->at(0), o.velocity->at(1), o.velocity->at(2));
   }
   return out;
 }
@@ -217,8 +218,8 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
       still += "    <geom name=\"" + name + "\" " + look +
                shape_attributes(o, o.pose(), name, assets, "obstacle " + std::to_string(k)) + "/>\n";
     } else {
-      moving += "    <body name=\"" + name + "\" mocap=\"true\" " + pose_attributes(o.pose()) + ">\n      <geom name=\"" +
-                name + "\" " + look +
+      moving += "    <body name=\"" + name + "\" mocap=\"true\" " + pose_attributes(o.pose()) +
+                ">\n      <geom name=\"" + name + "\" " + look +
                 shape_attributes(o, Eigen::Isometry3d::Identity(), name, assets, "obstacle " + std::to_string(k)) +
                 "/>\n    </body>\n";
     }
@@ -282,7 +283,8 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
   if (options.plant && options.plant->actuator != PlantActuator::kIdealVelocity) {
     const PlantConfig& plant = *options.plant;
     const bool servo = plant.actuator == PlantActuator::kVelocityServo;
-    const Eigen::VectorXd kv = plant.kv.resolve(n, "kv"), kp = plant.kp.resolve(n, "kp"), kd = plant.kd.resolve(n, "kd");
+    const Eigen::VectorXd kv = plant.kv.resolve(n, "kv"), kp = plant.kp.resolve(n, "kp"),
+                          kd = plant.kd.resolve(n, "kd");
     out << "  <actuator>\n";
     for (int j = 0; j < n; ++j) {
       const JointSpec& joint = robot.joint(j);

@@ -45,17 +45,17 @@ Timing resolve_timing(const PlantConfig& config, double control_period) {
   t.dt = config.timestep > 0.0 ? config.timestep : std::min(1e-3, control_period);
   const long k = whole_multiple(control_period, t.dt);
   if (k < 1) {
-    throw std::invalid_argument("the control period (the scenario's `step` = " + seconds_text(control_period) +
-                                ") is not a whole number of MuJoCo time steps ([plant] timestep = " +
-                                seconds_text(t.dt) + ")");
+    throw std::invalid_argument(
+        "the control period (the scenario's `step` = " + seconds_text(control_period) +
+        ") is not a whole number of MuJoCo time steps ([plant] timestep = " + seconds_text(t.dt) + ")");
   }
   if (k > 100000) throw std::invalid_argument("more than 100000 MuJoCo time steps per control period");
   t.substeps = static_cast<int>(k);
   const long delay = config.delay > 0.0 ? whole_multiple(config.delay, t.dt) : 0;
   if (delay < 0) {
-    throw std::invalid_argument("[plant] delay = " + seconds_text(config.delay) +
-                                " is not a whole number of MuJoCo time steps ([plant] timestep = " +
-                                seconds_text(t.dt) + ")");
+    throw std::invalid_argument(
+        "[plant] delay = " + seconds_text(config.delay) +
+        " is not a whole number of MuJoCo time steps ([plant] timestep = " + seconds_text(t.dt) + ")");
   }
   t.delay_steps = static_cast<int>(delay);
   return t;

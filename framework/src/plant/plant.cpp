@@ -21,12 +21,14 @@ const Schema<PlantConfig>& PlantConfig::schema() {
             "the servo and the impedance controller add the torques that hold the arm against gravity, g(q)"),
       field("kv", &C::kv, "N m s/rad or N s/m", "velocity servo gain: one number or one per joint",
             greater<PerJoint>(0.0)),
-      field("kp", &C::kp, "N m/rad or N/m", "impedance stiffness: one number or one per joint", at_least<PerJoint>(0.0)),
+      field("kp", &C::kp, "N m/rad or N/m", "impedance stiffness: one number or one per joint",
+            at_least<PerJoint>(0.0)),
       field("kd", &C::kd, "N m s/rad or N s/m", "impedance damping: one number or one per joint",
             at_least<PerJoint>(0.0)),
-      field("delay", &C::delay, "s",
-            "the measurement's delay, a whole number of MuJoCo time steps: the controller reads the state this long ago",
-            between(0.0, 1.0)),
+      field(
+          "delay", &C::delay, "s",
+          "the measurement's delay, a whole number of MuJoCo time steps: the controller reads the state this long ago",
+          between(0.0, 1.0)),
       field("gravity", &C::gravity, "", "scale of MuJoCo's gravity (1: 9.81 m/s^2 along the world's -z)",
             between(0.0, 10.0)),
   }};

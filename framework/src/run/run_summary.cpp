@@ -1,8 +1,8 @@
 #include "redres/run/run_summary.hpp"
 
 #include <algorithm>
-#include <sstream>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -337,7 +337,8 @@ const std::vector<SummaryField>& summary_fields() {
        "`t = <t> s: rows relaxed (weight ...), missed by ... at most, after <status>: <diagnosis>` for the first "
        "relaxed step; empty if none",
        [](const S& s) { return text(s.solver.first_relaxed); }},
-      {"plant.kind", "string", "`kinematic` or `mujoco` ([plant] kind; docs/plant.md); the `plant.*` figures below "
+      {"plant.kind", "string",
+       "`kinematic` or `mujoco` ([plant] kind; docs/plant.md); the `plant.*` figures below "
        "are empty (or 0) on the kinematic plant",
        [](const S& s) { return text(s.plant_kind); }},
       {"plant.actuator", "string", "`velocity_servo`, `impedance` or `ideal_velocity`",
@@ -389,15 +390,14 @@ const std::vector<SummaryField>& summary_fields() {
        [](const S& s) { return SummaryValue(s.plant.kinematic_max_position_error); }},
       {"plant.control_step_us", "number", "mean wall time of one controller step (us)",
        [](const S& s) {
-         return SummaryValue(s.plant.control_steps > 0 ? 1e6 * s.plant.controller_seconds /
-                                                             static_cast<double>(s.plant.control_steps)
-                                                       : 0.0);
+         return SummaryValue(s.plant.control_steps > 0
+                                 ? 1e6 * s.plant.controller_seconds / static_cast<double>(s.plant.control_steps)
+                                 : 0.0);
        }},
       {"plant.mujoco_step_us", "number", "mean wall time of one MuJoCo step, the plant's torques included (us)",
        [](const S& s) {
-         return SummaryValue(s.plant.mujoco_steps > 0
-                                 ? 1e6 * s.plant.mujoco_seconds / static_cast<double>(s.plant.mujoco_steps)
-                                 : 0.0);
+         return SummaryValue(
+             s.plant.mujoco_steps > 0 ? 1e6 * s.plant.mujoco_seconds / static_cast<double>(s.plant.mujoco_steps) : 0.0);
        }},
       {"wall_time_s", "number", "wall-clock time of the integration loop (s)",
        [](const S& s) { return SummaryValue(s.wall_time_s); }},

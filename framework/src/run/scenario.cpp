@@ -538,8 +538,8 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
 void check_plant(const TableReader& r, Scenario& s) {
   PlantConfig& p = s.plant;
   if (p.kind != PlantKind::kMujoco) {
-    for (const char* key : {"timestep", "integrator", "actuator", "gravity_compensation", "kv", "kp", "kd", "delay",
-                            "gravity"}) {
+    for (const char* key :
+         {"timestep", "integrator", "actuator", "gravity_compensation", "kv", "kp", "kd", "delay", "gravity"}) {
       if (r.has(key)) r.fail(key, "is used only with kind = \"mujoco\" (kind is \"kinematic\")");
     }
     return;

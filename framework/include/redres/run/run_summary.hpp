@@ -100,7 +100,7 @@ struct RunSummary {
   std::vector<PluginMetrics> metrics;    //!< per plugin that reports figures
   std::vector<ObstacleFacts> obstacles;  //!< every active plugin's obstacles, in the scenario's order
   std::string plant_kind = "kinematic";  //!< [plant] kind: "kinematic" or "mujoco"
-  PlantFacts plant;                       //!< the MuJoCo plant's figures (all empty on the kinematic plant; no mjcf)
+  PlantFacts plant;                      //!< the MuJoCo plant's figures (all empty on the kinematic plant; no mjcf)
 
   /// A plugin's metric by plugin instance name and metric name, or nullptr.
   [[nodiscard]] const Metric* metric(const std::string& plugin, const std::string& metric_name) const;

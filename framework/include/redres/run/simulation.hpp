@@ -18,15 +18,15 @@ namespace redres {
 
 /// What a run on the MuJoCo plant ([plant] kind = "mujoco") recorded besides its trajectory (docs/plant.md).
 struct PlantFacts {
-  std::string actuator;      //!< "velocity_servo", "impedance" or "ideal_velocity"
-  double timestep = 0.0;     //!< MuJoCo's time step (s)
-  int substeps = 0;          //!< MuJoCo steps per control step
-  double delay = 0.0;        //!< the measurement's delay (s)
+  std::string actuator;   //!< "velocity_servo", "impedance" or "ideal_velocity"
+  double timestep = 0.0;  //!< MuJoCo's time step (s)
+  int substeps = 0;       //!< MuJoCo steps per control step
+  double delay = 0.0;     //!< the measurement's delay (s)
   /// Per joint over every MuJoCo step: the largest |torque| (N m or N), the joint's effort limit (NaN when it has
   /// none), and the largest |torque rate| (N m/s or N/s).
   std::vector<double> max_torque, effort_limit, max_torque_rate;
-  int max_contacts = 0;                      //!< the most contacts (involving the robot) at any MuJoCo step
-  double deepest_penetration = 0.0;          //!< m
+  int max_contacts = 0;                         //!< the most contacts (involving the robot) at any MuJoCo step
+  double deepest_penetration = 0.0;             //!< m
   std::vector<PlantContactPair> contact_pairs;  //!< every pair that touched, by first time
   /// The same scenario on the kinematic plant: its largest position error (m), beside this run's (the summary's).
   double kinematic_max_position_error = 0.0;

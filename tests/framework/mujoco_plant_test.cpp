@@ -162,6 +162,20 @@ TEST(MujocoPlant, ThePaperArmWritesItsLetterOnTheMujocoPlant) {
   EXPECT_GT(std::get<double>(summary_value(r.summary, "plant.mujoco_step_us")), 0.0);
 }
 
+TEST(MujocoPlant, ARunThatMujocoCannotSimulateStopsWithTheDiagnosisAndKeepsItsRows) {
+  // An explicit integrator with a servo far too stiff for the links' inertia, and no effort limit to bound it (the
+  // push-rod arm): MuJoCo's state blows up in the first control period.
+  Scenario s = load_scenario("configs/paper_r_mujoco.toml", {"plant.integrator=euler", "plant.kv=1e6"});
+  const RunResult run = simulate(s);
+  EXPECT_TRUE(run.stopped);
+  EXPECT_GE(run.failures, 1);
+  EXPECT_NE(run.first_failure.find("MuJoCo plant: MuJoCo's simulation"), std::string::npos) << run.first_failure;
+  EXPECT_NE(run.first_failure.find("timestep"), std::string::npos) << run.first_failure;
+  EXPECT_GT(run.trajectory.size(), 1U);  // the rows up to there are kept
+  EXPECT_LT(run.trajectory.size(), 4001U);
+  EXPECT_EQ(summarise(s, run).status, "stopped");
+}
+
 TEST(MujocoPlant, TheModelCarriesActuatorsGainsObstaclesAndDriveKeys) {
   const Scenario s = load_scenario("configs/panda_table_pole_mujoco.toml", {"plant.kv=[1,2,3,4,5,6,7]"});
   const std::string xml = scenario_mjcf(s);

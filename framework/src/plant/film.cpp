@@ -33,6 +33,7 @@
 
 #include <Eigen/Geometry>
 
+#include "plant/mujoco_load.hpp"
 #include "redres/common/output_file.hpp"
 
 extern char** environ;
@@ -82,23 +83,7 @@ std::string hex(long value) {
 
 // ---- MuJoCo: the model, and its errors as exceptions ---------------------------------------------------------------
 
-// MuJoCo reports a failure inside a call (an offscreen buffer it cannot allocate, an OpenGL too old) through
-// mju_user_error, and without a handler prints it and exits the process. While film() runs, the handler throws
-// instead. (The handler is global: film() must not run while another thread uses MuJoCo.)
-[[noreturn]] void throw_mujoco_error(const char* message) {
-  throw std::runtime_error(std::string("film: MuJoCo failed: ") + message);
-}
-
-class MujocoErrorsThrow {
- public:
-  MujocoErrorsThrow() : previous_(mju_user_error) { mju_user_error = throw_mujoco_error; }
-  MujocoErrorsThrow(const MujocoErrorsThrow&) = delete;
-  MujocoErrorsThrow& operator=(const MujocoErrorsThrow&) = delete;
-  ~MujocoErrorsThrow() { mju_user_error = previous_; }
-
- private:
-  void (*previous_)(const char*);
-};
+// MuJoCo's errors inside a call are exceptions (plant_detail::throw_on_mujoco_errors(), set by load_mjcf()).
 
 struct Model {
   mjModel* m = nullptr;
@@ -112,21 +97,13 @@ struct Model {
   }
 };
 
-// Loads MJCF text through a virtual file, as MujocoModel does (MuJoCo 2.2 reads XML only by file name).
+// Loads MJCF text (plant_detail::load_mjcf: through a virtual file); a model MuJoCo refuses is a bad argument.
 void load_model(const std::string& xml, Model& model) {
-  struct Vfs {
-    mjVFS vfs;
-    Vfs() { mj_defaultVFS(&vfs); }
-    ~Vfs() { mj_deleteVFS(&vfs); }
-  };
-  auto vfs = std::make_unique<Vfs>();  // megabytes: on the heap
-  const char* name = "redres_film.xml";
-  if (mj_makeEmptyFileVFS(&vfs->vfs, name, static_cast<int>(xml.size())) != 0)
-    throw std::runtime_error("film: MuJoCo cannot make a virtual file for the model");
-  std::memcpy(vfs->vfs.filedata[mj_findFileVFS(&vfs->vfs, name)], xml.data(), xml.size());
-  char error[1000] = "";
-  model.m = mj_loadXML(name, &vfs->vfs, error, sizeof error);
-  if (!model.m) throw std::invalid_argument(std::string("film: MuJoCo refused the model: ") + error);
+  try {
+    model.m = plant_detail::load_mjcf(xml);
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(std::string("film: ") + e.what());
+  }
   model.d = mj_makeData(model.m);
   if (!model.d) throw std::runtime_error("film: MuJoCo cannot make the model's data");
 }
@@ -693,7 +670,7 @@ FilmReport film(const std::string& mjcf, const std::vector<FilmFrame>& frames, c
   if (!std::filesystem::is_directory(dir, error))
     throw std::runtime_error("film: " + dir.string() + " is not an existing directory");
 
-  const MujocoErrorsThrow errors_throw;
+  plant_detail::throw_on_mujoco_errors();
   Model model;
   load_model(mjcf, model);
   mjModel* m = model.m;

@@ -10,6 +10,7 @@
 
 #if REDRES_HAVE_MUJOCO
 #include <cstring>
+#include <mutex>
 
 #include "plant/mujoco_load.hpp"
 #endif
@@ -34,7 +35,23 @@ struct MujocoModel::Impl {
   }
 };
 
+namespace {
+[[noreturn]] void throw_mujoco_error(const char* message) {
+  throw std::runtime_error(std::string("MuJoCo failed: ") + message);
+}
+}  // namespace
+
+void plant_detail::throw_on_mujoco_errors() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    mju_user_error = throw_mujoco_error;
+    // Warnings are counted in mjData, where the plant reads the ones that matter and says so in its own words.
+    mju_user_warning = [](const char*) {};
+  });
+}
+
 mjModel* plant_detail::load_mjcf(const std::string& xml) {
+  throw_on_mujoco_errors();
   // MuJoCo 2.2 reads XML only from a file name; a virtual file holds the text. (mjVFS is megabytes: on the heap.)
   struct Vfs {
     mjVFS vfs;

@@ -313,6 +313,22 @@ void MujocoPlant::advance(const Eigen::Ref<const Eigen::VectorXd>& command, doub
   }
   p.steps += p.timing.substeps;
   p.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // MuJoCo resets a state it finds bad (a non-finite or huge acceleration, velocity or position) and goes on with a
+  // warning: a run on after that would be garbage. A full contact or constraint buffer drops contacts: the same.
+  static constexpr std::pair<int, const char*> kFatal[] = {
+      {mjWARN_BADQACC, "a bad acceleration (MuJoCo reset the state)"},
+      {mjWARN_BADQVEL, "a bad velocity (MuJoCo reset the state)"},
+      {mjWARN_BADQPOS, "a bad position (MuJoCo reset the state)"},
+      {mjWARN_CONTACTFULL, "more contacts than its buffer holds"},
+      {mjWARN_CNSTRFULL, "more constraints than its buffer holds"}};
+  for (const auto& [warning, what] : kFatal) {
+    if (p.d->warning[warning].number > 0) {
+      throw std::runtime_error("MuJoCo's simulation failed between t = " + std::to_string(t) + " and " +
+                               std::to_string(t + p.timing.substeps * p.timing.dt) + " s: " + what +
+                               "; try a smaller [plant] timestep, smaller gains, an `armature` on light joints, or "
+                               "the implicit integrator");
+    }
+  }
   for (int j = 0; j < p.n; ++j) {
     if (!std::isfinite(p.d->qpos[p.qadr[static_cast<std::size_t>(j)]])) {
       throw std::runtime_error("MuJoCo's simulation diverged at t = " + std::to_string(t) + " s (joint '" +

@@ -216,7 +216,14 @@ void simulate_plant(Scenario& s, RunResult& run, const ProgressCallback& progres
       ++run.held_steps;  // held: the servo is asked for theta_dot = 0
       command.setZero();
     }
-    plant.advance(command, t);
+    try {
+      plant.advance(command, t);
+    } catch (const std::runtime_error& e) {
+      // MuJoCo failed (diverged, or an error inside it): the run ends here, with every row up to this step.
+      if (run.failures++ == 0) run.first_failure = "t = " + std::to_string(t) + " s: MuJoCo plant: " + e.what();
+      run.stopped = true;
+      break;
+    }
     motion.add(command, theta, s.tau, run);
   }
   run.trajectory.publish();

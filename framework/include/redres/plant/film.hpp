@@ -62,8 +62,7 @@ struct FilmReport {
 /// link), and a failure removes what it had written. Throws std::invalid_argument for bad options or frames (a qpos
 /// or mocap size that is not the model's, no frames), std::runtime_error naming the step that failed (the EGL
 /// display, initialisation or context, MuJoCo's rendering context, writing a file, ffmpeg's exit status with the end
-/// of its messages). While it runs, MuJoCo's errors are turned into exceptions through MuJoCo's global error handler:
-/// film() must not run while another thread uses MuJoCo.
+/// of its messages; MuJoCo's own errors, which redres makes exceptions).
 FilmReport film(const std::string& mjcf, const std::vector<FilmFrame>& frames, const std::filesystem::path& dir,
                 const FilmOptions& options, const std::function<void(int done, int total)>& progress = {});
 

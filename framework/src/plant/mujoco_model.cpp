@@ -65,6 +65,10 @@ mjModel* plant_detail::load_mjcf(const std::string& xml) {
   const int index = mj_findFileVFS(&vfs->vfs, name);
   std::memcpy(vfs->vfs.filedata[index], xml.data(), xml.size());
   char error[1000] = "";
+  // One load at a time: MuJoCo 2.2's XML reader and compiler are not documented as safe to run in parallel (a sweep
+  // loads its runs' plants from several threads). The models it makes are independent.
+  static std::mutex loading;
+  const std::lock_guard<std::mutex> lock(loading);
   mjModel* m = mj_loadXML(name, &vfs->vfs, error, sizeof error);
   if (!m) throw std::runtime_error(std::string("MuJoCo refused the model: ") + error);
   return m;

@@ -19,46 +19,10 @@ namespace redres {
 
 namespace {
 
-// The whole number of `unit`s in `span` (to 1e-9 relative), or -1 when it is not one.
-long whole_multiple(double span, double unit) {
-  const double ratio = span / unit;
-  const long k = std::lround(ratio);
-  return std::abs(ratio - static_cast<double>(k)) <= 1e-9 * std::max(1.0, ratio) ? k : -1;
-}
-
-std::string seconds_text(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g s", s);
-  return buf;
-}
-
-// The resolved time step and the number of MuJoCo steps per control period and per measurement delay.
-struct Timing {
-  double dt = 0.0;
-  int substeps = 1;
-  int delay_steps = 0;
-};
-
-Timing resolve_timing(const PlantConfig& config, double control_period) {
+// The plant's timing (plant_timing()); a control period that is not positive is refused first.
+PlantTiming resolve_timing(const PlantConfig& config, double control_period) {
   if (!(control_period > 0.0)) throw std::invalid_argument("MujocoPlant: the control period must be > 0");
-  Timing t;
-  t.dt = config.timestep > 0.0 ? config.timestep : std::min(1e-3, control_period);
-  const long k = whole_multiple(control_period, t.dt);
-  if (k < 1) {
-    throw std::invalid_argument(
-        "the control period (the scenario's `step` = " + seconds_text(control_period) +
-        ") is not a whole number of MuJoCo time steps ([plant] timestep = " + seconds_text(t.dt) + ")");
-  }
-  if (k > 100000) throw std::invalid_argument("more than 100000 MuJoCo time steps per control period");
-  t.substeps = static_cast<int>(k);
-  const long delay = config.delay > 0.0 ? whole_multiple(config.delay, t.dt) : 0;
-  if (delay < 0) {
-    throw std::invalid_argument(
-        "[plant] delay = " + seconds_text(config.delay) +
-        " is not a whole number of MuJoCo time steps ([plant] timestep = " + seconds_text(t.dt) + ")");
-  }
-  t.delay_steps = static_cast<int>(delay);
-  return t;
+  return plant_timing(config, control_period);
 }
 
 }  // namespace
@@ -70,7 +34,7 @@ struct MujocoPlant::Impl {
   mjData* d = nullptr;
   std::string xml;
   PlantConfig config;
-  Timing timing;
+  PlantTiming timing;
   int n = 0;
   Eigen::VectorXd kv, kp, kd, effort;  // effort: +inf where the joint has no limit
   std::vector<int> qadr, dofadr;       // joint j's qpos and dof addresses
@@ -182,7 +146,7 @@ struct MujocoPlant::Impl {
   void note_torque() {
     for (int j = 0; j < n; ++j) {
       max_torque(j) = std::max(max_torque(j), std::abs(torque(j)));
-      if (have_torque) max_rate(j) = std::max(max_rate(j), std::abs(torque(j) - torque_prev(j)) / timing.dt);
+      if (have_torque) max_rate(j) = std::max(max_rate(j), std::abs(torque(j) - torque_prev(j)) / timing.timestep);
     }
     torque_prev = torque;
     have_torque = true;
@@ -215,7 +179,7 @@ struct MujocoPlant::Impl {
     note_contacts(t);  // the collisions of the step's position stage: the state at t
     for (int j = 0; j < n; ++j) {
       torque(j) = d->actuator_force[j] + gravity(j);
-      q_ref(j) += timing.dt * command(j);
+      q_ref(j) += timing.timestep * command(j);
     }
   }
 
@@ -223,14 +187,14 @@ struct MujocoPlant::Impl {
     move_obstacles(t);
     for (int j = 0; j < n; ++j) {
       const int dof = dofadr[static_cast<std::size_t>(j)];
-      d->qacc[dof] = (command(j) - command_prev(j)) / timing.dt;
+      d->qacc[dof] = (command(j) - command_prev(j)) / timing.timestep;
       d->qvel[dof] = command(j);
     }
     mj_inverse(m, d);  // the torques this motion takes, and the collisions at the current state
     note_contacts(t);
     for (int j = 0; j < n; ++j) torque(j) = d->qfrc_inverse[dofadr[static_cast<std::size_t>(j)]];
-    mj_integratePos(m, d->qpos, d->qvel, timing.dt);
-    d->time += timing.dt;
+    mj_integratePos(m, d->qpos, d->qvel, timing.timestep);
+    d->time += timing.timestep;
     command_prev = command;
   }
 };
@@ -246,7 +210,7 @@ MujocoPlant::MujocoPlant(const RobotModel& robot, const PlantConfig& config, dou
                                 std::to_string(n));
   p.config = config;
   p.timing = resolve_timing(config, control_period);
-  p.config.timestep = p.timing.dt;
+  p.config.timestep = p.timing.timestep;
   p.kv = config.kv.resolve(n, "kv");
   p.kp = config.kp.resolve(n, "kp");
   p.kd = config.kd.resolve(n, "kd");
@@ -302,7 +266,7 @@ void MujocoPlant::advance(const Eigen::Ref<const Eigen::VectorXd>& command, doub
   p.contacts = 0;
   p.penetration = 0.0;
   for (int s = 0; s < p.timing.substeps; ++s) {
-    const double ts = t + s * p.timing.dt;
+    const double ts = t + s * p.timing.timestep;
     if (p.config.actuator == PlantActuator::kIdealVelocity) {
       p.step_ideal(command, ts);
     } else {
@@ -324,7 +288,7 @@ void MujocoPlant::advance(const Eigen::Ref<const Eigen::VectorXd>& command, doub
   for (const auto& [warning, what] : kFatal) {
     if (p.d->warning[warning].number > 0) {
       throw std::runtime_error("MuJoCo's simulation failed between t = " + std::to_string(t) + " and " +
-                               std::to_string(t + p.timing.substeps * p.timing.dt) + " s: " + what +
+                               std::to_string(t + p.timing.substeps * p.timing.timestep) + " s: " + what +
                                "; try a smaller [plant] timestep, smaller gains, an `armature` on light joints, or "
                                "the implicit integrator");
     }
@@ -339,7 +303,7 @@ void MujocoPlant::advance(const Eigen::Ref<const Eigen::VectorXd>& command, doub
 }
 
 const std::string& MujocoPlant::mjcf() const { return impl_->xml; }
-double MujocoPlant::timestep() const { return impl_->timing.dt; }
+double MujocoPlant::timestep() const { return impl_->timing.timestep; }
 int MujocoPlant::substeps() const { return impl_->timing.substeps; }
 const Eigen::VectorXd& MujocoPlant::theta() const { return impl_->theta_m; }
 const Eigen::VectorXd& MujocoPlant::theta_dot() const { return impl_->theta_dot_m; }

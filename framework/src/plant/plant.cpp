@@ -2,7 +2,45 @@
 
 #include "redres/plant/plant.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
 namespace redres {
+
+namespace {
+
+// The whole number of `unit`s in `span` (to 1e-9 relative), or -1 when it is not one.
+long whole_multiple(double span, double unit) {
+  const double ratio = span / unit;
+  const long k = std::lround(ratio);
+  return std::abs(ratio - static_cast<double>(k)) <= 1e-9 * std::max(1.0, ratio) ? k : -1;
+}
+
+}  // namespace
+
+PlantTiming plant_timing(const PlantConfig& config, double control_period) {
+  PlantTiming t;
+  t.timestep = config.timestep > 0.0 ? config.timestep : std::min(1e-3, control_period);
+  const long k = whole_multiple(control_period, t.timestep);
+  if (k < 1 || k > 100000) {
+    std::ostringstream m;
+    m << "the control period (the scenario's `step` = " << control_period
+      << " s) must be a whole number of MuJoCo time steps (at most 100000), and " << t.timestep
+      << " s is not a divisor of it";
+    throw FieldError("timestep", m.str());
+  }
+  t.substeps = static_cast<int>(k);
+  const long delay = config.delay > 0.0 ? whole_multiple(config.delay, t.timestep) : 0;
+  if (delay < 0) {
+    std::ostringstream m;
+    m << "expected a whole number of MuJoCo time steps (timestep = " << t.timestep << " s), got " << config.delay
+      << " s";
+    throw FieldError("delay", m.str());
+  }
+  t.delay_steps = static_cast<int>(delay);
+  return t;
+}
 
 const Schema<PlantConfig>& PlantConfig::schema() {
   using C = PlantConfig;

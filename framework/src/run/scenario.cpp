@@ -553,22 +553,12 @@ void check_plant(const TableReader& r, Scenario& s) {
       r.fail(key, e.message());
     }
   }
-  const double dt = p.timestep > 0.0 ? p.timestep : std::min(1e-3, s.tau);
-  const auto whole = [dt](double span) {
-    const double ratio = span / dt;
-    return std::abs(ratio - std::round(ratio)) <= 1e-9 * std::max(1.0, ratio) && std::round(ratio) >= 1.0;
-  };
-  std::ostringstream m;
-  if (!whole(s.tau)) {
-    m << "the control period (`step` = " << s.tau << " s) must be a whole number of MuJoCo time steps, and " << dt
-      << " s is not a divisor of it";
-    r.fail(r.has("timestep") ? "timestep" : "kind", m.str());
+  try {
+    p.timestep = plant_timing(p, s.tau).timestep;
+  } catch (const FieldError& e) {
+    // A default time step that does not divide the period is the table's `kind` choice: reported there.
+    r.fail(e.key() == "timestep" && !r.has("timestep") ? "kind" : e.key(), e.message());
   }
-  if (p.delay > 0.0 && !whole(p.delay)) {
-    m << "expected a whole number of MuJoCo time steps (timestep = " << dt << " s), got " << p.delay << " s";
-    r.fail("delay", m.str());
-  }
-  p.timestep = dt;
   try {
     (void)scenario_mjcf(s);
   } catch (const std::invalid_argument& e) {

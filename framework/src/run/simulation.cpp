@@ -134,6 +134,28 @@ class MotionStats {
 
 namespace {
 
+// After step k's row is recorded: the step's outcome into the log (one failure per step at most) and the progress.
+// Whether the run goes on to apply the step's command; false (the row of this step is the last) at the last step, when
+// `stop` is set, or at a failed step under on_infeasible = "stop".
+bool step_goes_on(const Scenario& s, StepLog& log, RunResult& run, int k, int steps, double t, const StepOutput& out,
+                  const ProgressCallback& progress, const std::atomic<bool>* stop) {
+  const int failures_before = run.failures;
+  log.note(out, t);
+  if (run.failures == failures_before) log.check_violations(t);
+  const int report_every = std::max(1, steps / 200);
+  if (progress && (k % report_every == 0 || k == steps)) progress(static_cast<double>(k) / steps, t);
+  if (k == steps) return false;
+  if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
+    run.interrupted = true;
+    return false;
+  }
+  if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before) {
+    run.stopped = true;
+    return false;
+  }
+  return true;
+}
+
 // The largest value of a column of the run's table (0 for an empty one).
 double column_max(const Trajectory& tr, const std::string& name) {
   double m = 0.0;
@@ -179,7 +201,6 @@ void simulate_plant(Scenario& s, RunResult& run, const ProgressCallback& progres
   StepOutput out = ctrl.make_output();
   Eigen::VectorXd theta(n), command = Eigen::VectorXd::Zero(n);
   const auto start = std::chrono::steady_clock::now();
-  const int report_every = std::max(1, steps / 200);
   MotionStats motion(*s.robot, run);
   const auto u = [](std::size_t k) { return static_cast<std::ptrdiff_t>(k); };
 
@@ -196,19 +217,7 @@ void simulate_plant(Scenario& s, RunResult& run, const ProgressCallback& progres
     row[plant_first + 2 * static_cast<std::size_t>(n)] = plant.contacts();
     row[plant_first + 2 * static_cast<std::size_t>(n) + 1] = plant.penetration();
     run.trajectory.append_row(row);
-    const int failures_before = run.failures;
-    log.note(out, t);
-    if (run.failures == failures_before) log.check_violations(t);  // one failure per step at most
-    if (progress && (k % report_every == 0 || k == steps)) progress(static_cast<double>(k) / steps, t);
-    if (k == steps) break;
-    if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
-      run.interrupted = true;
-      break;
-    }
-    if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before) {
-      run.stopped = true;
-      break;
-    }
+    if (!step_goes_on(s, log, run, k, steps, t, out, progress, stop)) break;
     if (moves(out.info.status)) {
       if (out.info.status == SolverStatus::kBraked) ++run.braked_steps;
       command = out.theta_dot;
@@ -275,7 +284,6 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
   Eigen::VectorXd theta = s.theta0, theta_pred(s.robot->dof()), velocity = Eigen::VectorXd::Zero(s.robot->dof());
   const auto start = std::chrono::steady_clock::now();
-  const int report_every = std::max(1, steps / 200);
   MotionStats motion(*s.robot, run);
   Eigen::VectorXd theta_start(s.robot->dof());
 
@@ -283,19 +291,7 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
     const double t = k == steps ? s.duration : k * s.tau;
     ctrl.step(theta, t, out);
     run.trajectory.append_row(rows.write(k, t, theta, out));
-    const int failures_before = run.failures;
-    log.note(out, t);
-    if (run.failures == failures_before) log.check_violations(t);  // one failure per step at most
-    if (progress && (k % report_every == 0 || k == steps)) progress(static_cast<double>(k) / steps, t);
-    if (k == steps) break;
-    if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
-      run.interrupted = true;  // the row of this step is the last
-      break;
-    }
-    if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before) {
-      run.stopped = true;  // the row of the failed step is the last
-      break;
-    }
+    if (!step_goes_on(s, log, run, k, steps, t, out, progress, stop)) break;
     theta_start = theta;
     if (!integrate(s, ctrl, log, run, t, out, out2, theta, theta_pred, velocity)) break;
     motion.add(velocity, theta_start, s.tau, run);

@@ -63,4 +63,16 @@ struct PlantConfig {
   static const Schema<PlantConfig>& schema();
 };
 
+/// The MuJoCo time steps of a run: the step (the config's `timestep`, or when 0 the smaller of 1 ms and the control
+/// period), how many make one control period, and how many the measurement's delay is.
+struct PlantTiming {
+  double timestep = 0.0;
+  int substeps = 1;
+  int delay_steps = 0;
+};
+
+/// The timing of `config` for control periods of `control_period` s. FieldError at key "timestep" when the period is
+/// not a whole number of time steps (or more than 100000 of them), at "delay" when the delay is not.
+[[nodiscard]] PlantTiming plant_timing(const PlantConfig& config, double control_period);
+
 }  // namespace redres

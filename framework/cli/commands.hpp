@@ -35,6 +35,8 @@ void add_plugins_command(CLI::App& app, Action& action);
 /// `redres keys [scenario|robot|sweep] [--json]`.
 void add_keys_command(CLI::App& app, Action& action);
 
+void add_view_command(CLI::App& app, Action& action);
+
 /// Prints the keys of the input files (all when `file` is empty), text or JSON; returns the exit code.
 int print_file_keys(const std::string& file, bool json);
 

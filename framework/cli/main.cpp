@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   redres::cli::add_keys_command(app, action);
   redres::cli::add_run_commands(app, action);
   redres::cli::add_sweep_command(app, action);
+  redres::cli::add_view_command(app, action);
   // The first word that is not an option must be a command: an unknown one names itself and lists the known ones
   // (CLI11 would say only "A subcommand is required").
   for (int i = 1; i < argc; ++i) {

@@ -28,6 +28,7 @@
 #include "redres/run/scenario.hpp"
 #include "redres/run/start_check.hpp"
 #include "stop_signals.hpp"
+#include "view_command.hpp"
 
 namespace redres::cli {
 
@@ -43,6 +44,7 @@ struct RunOptions {
   bool no_plots = false;
   bool write_mjcf = false;
   bool film = false;
+  bool view = false;
   double film_fps = 25.0;
   std::string record;  // --record; empty: the scenario's [output] record
   std::string format;  // --format; empty: the scenario's [output] format
@@ -202,10 +204,13 @@ int run_scenario(const RunOptions& options) {
       throw std::runtime_error(std::string("--format: ") + e.what());
     }
   }
-  if (record.none && (opts->plots || opts->animate || scenario.plots || scenario.animate)) {
+  if (record.none && (opts->plots || opts->animate || opts->view || scenario.plots || scenario.animate)) {
     throw std::runtime_error(
-        "the figures and the animation are made from trajectory.csv and frames.csv, which "
+        "the figures, the animation and the view are made from trajectory.csv and frames.csv, which "
         "--record none does not write: use --record every=N");
+  }
+  if (opts->view && record.format == TrajectoryFormat::kHdf5) {
+    throw std::runtime_error("--view reads trajectory.csv and frames.csv, which --format hdf5 does not write");
   }
   std::optional<Plotter> plotter, animator;
   if (opts->plots || scenario.plots) {
@@ -254,6 +259,7 @@ int run_scenario(const RunOptions& options) {
   }
   if (opts->film) film_run(o, opts->out, opts->film_fps, opts->quiet);
   if (plotter || animator || opts->film) record_new_files(opts->out, before);
+  if (opts->view) print_view_report(write_run_view({opts->out}, opts->out, ViewOptions{}), opts->quiet);
   return o.run.failures > 0 || o.summary.task_error_exceeded ? kExitFailedSteps : kExitOk;
 }
 
@@ -330,6 +336,11 @@ int compare_scenarios(const RunOptions& options) {
     plot_args.insert(plot_args.end(), {"--out", out.string()});
     render_plots(*plotter, std::move(plot_args), opts->quiet, "the runs and comparison.md in " + out.string());
   }
+  if (opts->view) {
+    std::vector<std::filesystem::path> run_dirs;
+    for (const std::string& d : dirs) run_dirs.push_back(out / d);
+    print_view_report(write_run_view(run_dirs, out, ViewOptions{}), opts->quiet);
+  }
   return failures > 0 ? kExitFailedSteps : kExitOk;
 }
 
@@ -355,6 +366,9 @@ void add_run_commands(CLI::App& app, Action& action) {
   run->add_flag("--film", opts->film,
                 "render the MuJoCo scene of the run ([plant] kind = \"mujoco\") offscreen after it: film.mp4 when "
                 "ffmpeg is on PATH, else PNG frames in film_frames/ and film.gif (docs/plant.md)");
+  run->add_flag("--view", opts->view,
+                "write view.html into the output directory after the run: the run replayed in 3-D with its plots, "
+                "one file for any browser (docs/viewer.md)");
   run->add_option("--film-fps", opts->film_fps, "frames per second of simulated time for --film (default 25)");
   run->add_option("--record", opts->record,
                   "rows of trajectory.csv: all, every=N (every N-th step and the last), or none (summary.json only); "
@@ -376,6 +390,9 @@ void add_run_commands(CLI::App& app, Action& action) {
   compare->add_option("--set", opts->overrides, "override applied to every scenario: key.path=value");
   compare->add_flag("--quiet", opts->quiet, "no progress bar and no summary lines");
   compare->add_flag("--no-plots", opts->no_plots, "skip the figures");
+  compare->add_flag("--view", opts->view,
+                    "write view.html into the output directory: the runs overlaid in 3-D with their plots "
+                    "(docs/viewer.md)");
   compare->callback([opts, &action] { action = [opts] { return compare_scenarios(*opts); }; });
 }
 

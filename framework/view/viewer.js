@@ -175,7 +175,8 @@
     var path = pathPoints(run.series, 'rd_');
     if (path.length) group.add(lineOf(path, 0x555555, true));
     var tracePoints = pathPoints(run.series, 'r_');
-    var trace = lineOf(tracePoints.length ? tracePoints : [0, 0, 0], colour, false);
+    // One run: its trace in red over the dashed path; several: each in its run's colour.
+    var trace = lineOf(tracePoints.length ? tracePoints : [0, 0, 0], runs.length > 1 ? colour : 0xd62728, false);
     group.add(trace);
     // Obstacles: where they are at t (moving ones at p + v t).
     var obstacleMat = material(new THREE.Color(0x8a8f99), 0.45);
@@ -225,7 +226,7 @@
     if (planar) {
       camera.position.set(centre.x, centre.y - 1e-3 * size, centre.z + 1.6 * size);
     } else {
-      camera.position.copy(centre).add(new THREE.Vector3(1.1, -1.5, 0.8).normalize().multiplyScalar(1.7 * size));
+      camera.position.copy(centre).add(new THREE.Vector3(1.1, -1.5, 0.8).normalize().multiplyScalar(2.0 * size));
     }
     camera.near = size / 500;
     camera.far = size * 50;

@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libfcl-dev libccd-dev liboctomap-dev libnlopt-cxx-dev libnlopt-dev libtomlplusplus-dev
   libmuparser-dev libcli11-dev nlohmann-json3-dev liburdfdom-dev libtinyxml-dev libhdf5-dev libassimp-dev libqhull-dev
   libmujoco-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri libpng-dev libgif-dev
+  libjs-three chromium
   libgtest-dev libgmock-dev librapidcheck-dev libbenchmark-dev liborocos-kdl-dev
   python3 python3-dev python3-matplotlib python3-numpy python3-pil python3-h5py
   pybind11-dev python3-pybind11 python3-pytest

@@ -3,6 +3,7 @@
 // three.js and its orbit controls are inlined before this script. No network access: everything is in the file.
 (function () {
   'use strict';
+  var scriptStartMs = performance.now();
 
   // ---- errors are kept, so that a test (and the status line) can see them ----
   var errors = [];
@@ -65,8 +66,10 @@
   var bodies = 0;
 
   function material(colour, opacity) {
-    return new THREE.MeshStandardMaterial({
-      color: colour, roughness: 0.65, metalness: 0.05, transparent: opacity < 1, opacity: opacity,
+    // Lambert shading: its shaders compile in a fraction of the physically based ones' time, which is most of the
+    // time to the first frame where WebGL runs in software.
+    return new THREE.MeshLambertMaterial({
+      color: colour, transparent: opacity < 1, opacity: opacity,
       side: opacity < 1 ? THREE.DoubleSide : THREE.FrontSide, depthWrite: opacity >= 1
     });
   }
@@ -309,7 +312,10 @@
       var lines = [];
       runs.forEach(function (run, ri) {
         if (run.series[column]) {
-          lines.push({ run: ri, t: run.series.t, y: run.series[column], colour: colourOfRun(ri), label: run.label });
+          // Overlaid runs: the first widest, each later one narrower and drawn over it, so that curves that
+          // coincide stay visible side by side.
+          lines.push({ run: ri, t: run.series.t, y: run.series[column], colour: colourOfRun(ri), label: run.label,
+                       width: runs.length > 1 ? Math.max(0.9, 3.2 - 1.0 * ri) : 1.4 });
         }
       });
       if (!lines.length) return;
@@ -427,7 +433,15 @@
         l.y.forEach(function (y) { if (y !== null && isFinite(y)) { lo = Math.min(lo, y); hi = Math.max(hi, y); } });
       });
       p.hlines.forEach(function (h) { lo = Math.min(lo, h.y); hi = Math.max(hi, h.y); });
-      if (!isFinite(lo)) { lo = 0; hi = 1; }
+      if (!isFinite(lo)) {
+        lo = 0; hi = 1;
+        var none = document.createElement('span');
+        none.className = 'value';
+        none.textContent = p.value && /distance/.test(p.value)
+          ? 'no pair measured: every pair stayed beyond its influence distance'
+          : 'no finite value recorded';
+        head.appendChild(none);
+      }
       if (hi - lo < 1e-12 * Math.max(1, Math.abs(hi))) { lo -= 0.5 * Math.max(1e-9, Math.abs(lo)); hi += 0.5 * Math.max(1e-9, Math.abs(hi)); }
       var pad = 0.06 * (hi - lo);
       p.y0 = lo - pad; p.y1 = hi + pad;
@@ -482,7 +496,7 @@
       });
       p.lines.forEach(function (l) {
         g.strokeStyle = l.colour;
-        g.lineWidth = (l.thin ? 0.8 : 1.4) * dpr;
+        g.lineWidth = (l.thin ? 0.8 : (l.width || 1.4)) * dpr;
         g.setLineDash(l.dash ? [4 * dpr, 3 * dpr] : []);
         g.beginPath();
         var pen = false;
@@ -637,9 +651,12 @@
     requestAnimationFrame(loop);
   }
 
+  var sceneBuiltMs = performance.now();
   setupPanels();
+  var plotsDrawnMs = performance.now();
   resize();
   resetCamera();
+  var posedMs = performance.now();
   setFrame(params.frame !== undefined ? Number(params.frame) : 0);
   render();
 
@@ -651,7 +668,8 @@
     var gl = renderer.getContext();
     return {
       errors: errors.slice(), bodies: count, runs: runs.length, frames: timeline.length,
-      frame: Number(slider.value), t: current, first_frame_ms: firstFrameMs,
+      frame: Number(slider.value), t: current, first_frame_ms: firstFrameMs, script_start_ms: scriptStartMs,
+      scene_built_ms: sceneBuiltMs, plots_drawn_ms: plotsDrawnMs, posed_ms: posedMs,
       webgl: !!gl && !gl.isContextLost(),
       ee: views.map(function (v) { var p = v.tip.getWorldPosition(new THREE.Vector3()); return [p.x, p.y, p.z]; }),
       canvas: [renderer.domElement.width, renderer.domElement.height], plots: panels.length

@@ -50,11 +50,11 @@ std::string run_command(const std::string& cmd) {
   return out;
 }
 
-// Headless Chromium with WebGL on SwiftShader (software), no sandbox (CI runs as root), a fresh profile.
+// Headless Chromium with WebGL in software (SwiftShader), no sandbox (CI runs as root), a fresh profile.
 std::string browser(const fs::path& profile, const std::string& args) {
   return "'" + chromium() +
-         "' --headless --no-sandbox --disable-gpu-sandbox --use-angle=swiftshader "
-         "--enable-unsafe-swiftshader --no-first-run --disable-extensions --hide-scrollbars "
+         "' --headless --no-sandbox --disable-gpu-sandbox --enable-unsafe-swiftshader --no-first-run "
+         "--disable-extensions --hide-scrollbars "
          "--window-size=1400,850 --virtual-time-budget=2000 --user-data-dir='" +
          profile.string() + "' " + args;
 }
@@ -140,8 +140,7 @@ TEST(ViewBrowser, ThePaperRunReplaysWithTheEndEffectorWhereTheRunPutIt) {
 TEST(ViewBrowser, ThePandaAmongItsObstaclesIsDrawnAndNotBlank) {
   REQUIRE_CHROMIUM();
   const fs::path run = scratch("browser_panda");
-  const Cli r =
-      redres("run configs/panda_hulls_table_pole.toml --quiet --view --out '" + run.string() + "'");
+  const Cli r = redres("run configs/panda_hulls_table_pole.toml --quiet --view --out '" + run.string() + "'");
   ASSERT_EQ(r.code, 0) << r.out;
   const json state = page_state(run / "view.html", 50);
   ASSERT_TRUE(state.contains("errors")) << state.dump();

@@ -125,6 +125,55 @@
     return g;
   }
 
+  // The visual meshes, decoded once each (base64 float32 positions, uint32 indices) and shared by every run.
+  var meshGeometries = {};
+  function decode(text, Type) {
+    var bin = atob(text), bytes = new Uint8Array(bin.length);
+    for (var i = 0; i < bin.length; ++i) bytes[i] = bin.charCodeAt(i);
+    return new Type(bytes.buffer);
+  }
+  function meshParts(key) {
+    if (meshGeometries[key]) return meshGeometries[key];
+    var m = data.meshes[key];
+    meshGeometries[key] = m.parts.map(function (part) {
+      var g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(decode(part.positions, Float32Array), 3));
+      g.setIndex(new THREE.BufferAttribute(part.indices16 ? decode(part.indices16, Uint16Array)
+                                                          : decode(part.indices, Uint32Array), 1));
+      g.computeVertexNormals();
+      return { geometry: g, colour: part.colour };
+    });
+    return meshGeometries[key];
+  }
+  var visualMaterials = {};
+  function visualMaterial(rgb) {
+    var key = rgb.join(',');
+    if (!visualMaterials[key]) {
+      visualMaterials[key] = new THREE.MeshLambertMaterial({ color: new THREE.Color(rgb[0], rgb[1], rgb[2]) });
+    }
+    return visualMaterials[key];
+  }
+  // A visual element of a URDF robot (summary.json robot.visuals): a mesh in its parts' colours (else the URDF
+  // material's, else grey), or a box, cylinder or sphere.
+  function makeVisual(v) {
+    var g;
+    var rgb = v.rgba ? [v.rgba[0], v.rgba[1], v.rgba[2]] : [0.75, 0.75, 0.75];
+    if (v.shape === 'mesh') {
+      g = new THREE.Group();
+      meshParts(v.mesh).forEach(function (part) {
+        g.add(new THREE.Mesh(part.geometry, visualMaterial(part.colour || rgb)));
+      });
+    } else {
+      g = makeShape({ shape: v.shape, size: v.size, radius: v.radius, length: v.length, position: [0, 0, 0],
+                      quaternion: [0, 0, 0, 1] }, visualMaterial(rgb));
+      g.userData.body = false;
+    }
+    g.position.fromArray(v.position);
+    g.quaternion.fromArray(v.quaternion);
+    g.userData.visual = true;
+    return g;
+  }
+
   function lineOf(points, colour, dashed) {
     var geo = new THREE.BufferGeometry();
     geo.setAttribute('position', new THREE.BufferAttribute(new Float32Array(points), 3));
@@ -159,9 +208,17 @@
       group.add(f);
       frames.push(f);
     }
+    var collision = [], visual = [];
     run.link_shapes.forEach(function (s) {
-      frames[s.joint - 1].add(makeShape(s, linkMat));
+      var shape = makeShape(s, linkMat);
+      frames[s.joint - 1].add(shape);
+      collision.push(shape);
       bodies += 1;
+    });
+    (run.visuals || []).forEach(function (v) {
+      var shape = makeVisual(v);
+      if (v.joint > 0) frames[v.joint - 1].add(shape); else group.add(shape);  // the base's are in the world
+      visual.push(shape);
     });
     // The links as a polyline (base, joint origins, end effector) and the joints as dots.
     var stick = lineOf(new Array(3 * (n + 2)).fill(0), colour.clone().multiplyScalar(0.6), false);
@@ -192,7 +249,7 @@
       return mesh;
     });
     return { run: run, group: group, frames: frames, stick: stick, dots: dots, tip: tip, trace: trace,
-             obstacles: obstacles, n: n, scale: scale, ri: ri };
+             obstacles: obstacles, n: n, scale: scale, ri: ri, collision: collision, visual: visual };
   });
 
   // The scene's extent: the joints over all frames, the path and the obstacles.
@@ -619,6 +676,25 @@
   }
   if (data.notes && data.notes.length) document.getElementById('notes').textContent = data.notes.join('; ');
 
+  // What the robot is drawn as: its visual meshes (a URDF robot's, one run) or its collision shapes (in the run's
+  // colour, which tells overlaid runs apart), or both.
+  var drawSelect = document.getElementById('draw');
+  var anyVisual = views.some(function (v) { return v.visual.length > 0; });
+  function showBodies(mode) {
+    views.forEach(function (v) {
+      v.visual.forEach(function (m) { m.visible = mode !== 'collision'; });
+      v.collision.forEach(function (m) { m.visible = mode !== 'visual' || v.visual.length === 0; });
+    });
+    requestRender();
+  }
+  if (anyVisual) {
+    drawSelect.value = params.draw || (runs.length > 1 ? 'collision' : 'visual');
+    drawSelect.addEventListener('change', function () { showBodies(drawSelect.value); });
+    showBodies(drawSelect.value);
+  } else {
+    document.getElementById('draw-label').style.display = 'none';
+  }
+
   function resize() {
     var w = sceneBox.clientWidth, h = sceneBox.clientHeight;
     renderer.setSize(w, h);
@@ -668,6 +744,7 @@
     var gl = renderer.getContext();
     return {
       errors: errors.slice(), bodies: count, runs: runs.length, frames: timeline.length,
+      visuals: views.reduce(function (a, v) { return a + v.visual.length; }, 0),
       frame: Number(slider.value), t: current, first_frame_ms: firstFrameMs, script_start_ms: scriptStartMs,
       scene_built_ms: sceneBuiltMs, plots_drawn_ms: plotsDrawnMs, posed_ms: posedMs,
       webgl: !!gl && !gl.isContextLost(),

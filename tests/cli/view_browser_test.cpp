@@ -145,7 +145,8 @@ TEST(ViewBrowser, ThePandaAmongItsObstaclesIsDrawnAndNotBlank) {
   const json state = page_state(run / "view.html", 50);
   ASSERT_TRUE(state.contains("errors")) << state.dump();
   EXPECT_TRUE(state["errors"].empty()) << state["errors"].dump();
-  EXPECT_EQ(state["bodies"].get<std::size_t>(), 12U);  // 10 hulls, a table and a pole
+  EXPECT_EQ(state["bodies"].get<std::size_t>(), 12U);   // 10 hulls, a table and a pole
+  EXPECT_EQ(state["visuals"].get<std::size_t>(), 11U);  // the maker's visual meshes, link0 to the fingers
   EXPECT_EQ(bodies_in(run), 12U);
   expect_end_effectors(state, {run});
   // The screenshot: the page's size, and a picture (many colours, most of the scene not background).

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -16,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.hpp"
+#include "redres/model/mesh.hpp"
 #include "redres/run/view.hpp"
 #include "run_tables.hpp"
 
@@ -90,6 +92,56 @@ TEST_F(View, HullsCarryTheirGeometryAndObstaclesTheirShapes) {
   EXPECT_EQ(run["obstacles"][0]["shape"], "box");
   EXPECT_EQ(run["obstacles"][1]["shape"], "capsule");
   EXPECT_DOUBLE_EQ(run["safety_distances"]["obstacle_avoidance"].get<double>(), 0.02);
+}
+
+std::vector<unsigned char> from_base64(const std::string& text) {
+  std::vector<unsigned char> out;
+  unsigned acc = 0;
+  int bits = 0;
+  for (const char c : text) {
+    int v = -1;
+    if (c >= 'A' && c <= 'Z') v = c - 'A';
+    if (c >= 'a' && c <= 'z') v = c - 'a' + 26;
+    if (c >= '0' && c <= '9') v = c - '0' + 52;
+    if (c == '+') v = 62;
+    if (c == '/') v = 63;
+    if (v < 0) continue;  // '=' padding
+    acc = (acc << 6) | static_cast<unsigned>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<unsigned char>((acc >> bits) & 0xFF));
+    }
+  }
+  return out;
+}
+
+TEST_F(View, TheMakersVisualMeshesAreDrawnEachOnceWithEveryTriangle) {
+  const json data = data_of(*panda_);
+  const json& run = data["runs"][0];
+  ASSERT_EQ(run["visuals"].size(), 11U);     // link0 to link7, the hand and two fingers (one finger mesh, twice)
+  EXPECT_EQ(run["visuals"][0]["joint"], 0);  // the base's, in the world
+  EXPECT_EQ(data["meshes"].size(), 10U);     // the fingers share theirs
+  for (const auto& v : run["visuals"]) {
+    const std::string key = v["mesh"];
+    ASSERT_TRUE(data["meshes"].contains(key)) << key;
+    const json& mesh = data["meshes"][key];
+    const DrawMesh read = read_draw_mesh(mesh["file"].get<std::string>(), Eigen::Vector3d::Ones());
+    ASSERT_EQ(mesh["parts"].size(), read.parts.size());
+    for (std::size_t p = 0; p < read.parts.size(); ++p) {
+      const json& part = mesh["parts"][p];
+      const std::vector<unsigned char> pos = from_base64(part["positions"]);
+      ASSERT_EQ(pos.size(), read.parts[p].positions.size() * sizeof(float));
+      EXPECT_EQ(std::memcmp(pos.data(), read.parts[p].positions.data(), pos.size()), 0);
+      ASSERT_TRUE(part.contains("indices16"));  // every Panda part has fewer than 65,536 vertices
+      const std::vector<unsigned char> idx = from_base64(part["indices16"]);
+      ASSERT_EQ(idx.size(), read.parts[p].indices.size() * 2);
+      for (std::size_t i = 0; i < read.parts[p].indices.size(); ++i) {
+        const unsigned got = idx[2 * i] | (unsigned{idx[2 * i + 1]} << 8);
+        ASSERT_EQ(got, read.parts[p].indices[i]) << key << " part " << p << " index " << i;
+      }
+    }
+  }
 }
 
 TEST_F(View, PlotsKeepAtMostTheStatedNumberOfRowsAndTheLast) {

@@ -255,3 +255,67 @@ TEST(Mesh, TheMakersXarm6LoadsWithACapsulePerLink) {
 
 }  // namespace
 }  // namespace redres
+
+namespace redres {
+namespace {
+
+// Visual elements (drawn by `redres view` only): the base's links and the chain's, posed in their frames, their
+// materials' colours, and a visual mesh that cannot be found is noted, never an error (nothing is computed from it).
+TEST(Mesh, VisualElementsArePosedInTheirFramesAndAMissingOneIsOnlyNoted) {
+  const fs::path dir = scratch("mesh_visuals");
+  fs::create_directories(dir);
+  std::ofstream(dir / "cube.obj") << cube_obj("a", Eigen::Vector3d(0, 0, 0), 0);
+  std::ofstream(dir / "arm.urdf") << R"(<robot name="arm">
+  <material name="red"><color rgba="1 0 0 1"/></material>
+  <link name="base"><visual><geometry><box size="0.2 0.2 0.1"/></geometry></visual></link>
+  <link name="plate"><visual><origin xyz="0 0 0.05"/><geometry><cylinder radius="0.1" length="0.02"/></geometry>
+    <material name="red"/></visual></link>
+  <link name="l1"><visual><origin xyz="0 0 0.1" rpy="0 0 1.5707963267948966"/>
+    <geometry><mesh filename="cube.obj" scale="0.5 0.5 0.5"/></geometry></visual></link>
+  <link name="l2"><visual><geometry><mesh filename="package://gone/l2.stl"/></geometry></visual>
+    <visual><geometry><sphere radius="0.03"/></geometry></visual></link>
+  <joint name="fix" type="fixed"><parent link="base"/><child link="plate"/><origin xyz="0 0 0.1"/></joint>
+  <joint name="j1" type="revolute"><parent link="plate"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+</robot>)";
+  std::ofstream(dir / "arm.toml") << "urdf = \"arm.urdf\"\nbase_link = \"base\"\ntip_link = \"l2\"\n";
+  const RobotModel robot = load_robot(dir / "arm.toml");
+  const auto& v = robot.visuals();
+  ASSERT_EQ(v.size(), 5U);
+  // The base's two, in the base frame: the box at its origin, the plate 0.1 + 0.05 up, red.
+  EXPECT_EQ(v[0].joint, -1);
+  EXPECT_EQ(v[0].kind, VisualSpec::Kind::kBox);
+  EXPECT_EQ(v[1].joint, -1);
+  EXPECT_EQ(v[1].link, "plate");
+  EXPECT_NEAR(v[1].pose.translation().z(), 0.15, 1e-15);
+  ASSERT_TRUE(v[1].rgba.has_value());
+  EXPECT_EQ((*v[1].rgba)[0], 1.0);
+  // l1's mesh, found beside the URDF (an absolute path, for a viewer run from elsewhere), in joint 1's frame.
+  EXPECT_EQ(v[2].joint, 0);
+  EXPECT_EQ(v[2].kind, VisualSpec::Kind::kMesh);
+  EXPECT_EQ(v[2].file, fs::absolute(dir / "cube.obj"));
+  EXPECT_TRUE(v[2].file.is_absolute());
+  EXPECT_NEAR(v[2].pose.translation().z(), 0.1, 1e-15);
+  EXPECT_NEAR((v[2].pose.linear() * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm(), 0.0, 1e-12);
+  // l2's mesh is not found: noted, with where it was looked for; its sphere is kept.
+  EXPECT_EQ(v[3].joint, 1);
+  EXPECT_TRUE(v[3].file.empty());
+  EXPECT_NE(v[3].problem.find("not found"), std::string::npos) << v[3].problem;
+  EXPECT_EQ(v[4].kind, VisualSpec::Kind::kSphere);
+  EXPECT_EQ(v[4].radius, 0.03);
+  // The mesh for drawing: its 12 triangles, scaled.
+  const DrawMesh m = read_draw_mesh(v[2].file, v[2].scale);
+  EXPECT_EQ(m.triangles(), 12U);
+  float top = -1e9F;
+  for (const auto& part : m.parts) {
+    for (std::size_t i = 2; i < part.positions.size(); i += 3) top = std::max(top, part.positions[i]);
+    for (const std::uint32_t i : part.indices) EXPECT_LT(i, part.positions.size() / 3);
+  }
+  EXPECT_NEAR(top, 0.5F, 1e-6F);
+  EXPECT_THROW((void)read_draw_mesh(dir / "none.obj", Eigen::Vector3d::Ones()), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace redres

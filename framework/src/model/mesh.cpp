@@ -161,6 +161,65 @@ MeshData read_mesh(const std::filesystem::path& file, const Eigen::Vector3d& sca
   return out;
 }
 
+std::size_t DrawMesh::triangles() const {
+  std::size_t n = 0;
+  for (const Part& p : parts) n += p.indices.size() / 3;
+  return n;
+}
+
+DrawMesh read_draw_mesh(const std::filesystem::path& file, const Eigen::Vector3d& scale) {
+  if (!scale.allFinite() || (scale.array() <= 0.0).any()) {
+    throw std::runtime_error("mesh '" + file.string() + "': expected a scale > 0 on every axis");
+  }
+  const std::string data = read_input_file(file, "mesh file");
+  std::string hint = file.extension().string();
+  if (!hint.empty()) hint.erase(0, 1);
+  Assimp::Importer importer;
+  // The node transforms baked into the vertices, the meshes of one material merged: one part per colour.
+  const aiScene* scene = importer.ReadFileFromMemory(
+      data.data(), data.size(),
+      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices | aiProcess_SortByPType,
+      hint.c_str());
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    throw std::runtime_error("mesh '" + file.string() + "': Assimp could not read it: " + importer.GetErrorString());
+  }
+  DrawMesh out;
+  std::vector<int> part_of_material(scene->mNumMaterials + 1, -1);
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh& mesh = *scene->mMeshes[m];
+    if ((mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0 || mesh.mNumVertices == 0) continue;
+    const unsigned material = std::min(mesh.mMaterialIndex, scene->mNumMaterials);
+    if (part_of_material[material] < 0) {
+      part_of_material[material] = static_cast<int>(out.parts.size());
+      DrawMesh::Part part;
+      aiColor4D diffuse;
+      if (material < scene->mNumMaterials &&
+          scene->mMaterials[material]->Get(AI_MATKEY_COLOR_DIFFUSE, diffuse) == aiReturn_SUCCESS) {
+        part.colour = {std::clamp(diffuse.r, 0.0F, 1.0F), std::clamp(diffuse.g, 0.0F, 1.0F),
+                       std::clamp(diffuse.b, 0.0F, 1.0F)};
+        part.coloured = true;
+      }
+      out.parts.push_back(std::move(part));
+    }
+    DrawMesh::Part& part = out.parts[static_cast<std::size_t>(part_of_material[material])];
+    const auto first = static_cast<std::uint32_t>(part.positions.size() / 3);
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      const aiVector3D& p = mesh.mVertices[v];
+      part.positions.push_back(static_cast<float>(static_cast<double>(p.x) * scale.x()));
+      part.positions.push_back(static_cast<float>(static_cast<double>(p.y) * scale.y()));
+      part.positions.push_back(static_cast<float>(static_cast<double>(p.z) * scale.z()));
+    }
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      for (unsigned k = 0; k < 3; ++k) part.indices.push_back(first + face.mIndices[k]);
+    }
+  }
+  std::erase_if(out.parts, [](const DrawMesh::Part& p) { return p.indices.empty(); });
+  if (out.parts.empty()) throw std::runtime_error("mesh '" + file.string() + "' holds no triangle");
+  return out;
+}
+
 ShapeSpec fit_capsule(const std::vector<Eigen::Vector3d>& vertices) {
   if (vertices.empty()) throw std::invalid_argument("fit_capsule: expected at least one vertex");
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();

@@ -505,6 +505,33 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
       &c.problems);
   std::vector<std::string> problems;  // every mesh that cannot be used, reported together
   const std::filesystem::path base_dir = c.urdf.parent_path();
+  // The visual elements, for a viewer: a mesh that cannot be found is not drawn (and says why), never an error.
+  const auto add_visual = [&](const UrdfVisual& v, int joint, const Eigen::Isometry3d& at) {
+    VisualSpec out;
+    out.kind = static_cast<VisualSpec::Kind>(static_cast<int>(v.kind));
+    out.joint = joint;
+    out.link = v.link;
+    out.pose = at * v.pose;
+    out.uri = v.filename;
+    out.scale = v.scale;
+    out.size = v.size;
+    out.radius = v.radius;
+    out.length = v.length;
+    out.rgba = v.rgba;
+    if (v.kind == UrdfVisual::Kind::kMesh) {
+      try {
+        out.file = std::filesystem::absolute(resolve_mesh(v.filename, base_dir, c.packages));
+      } catch (const std::exception& ex) {
+        out.problem = ex.what();
+      }
+    }
+    c.spec.visuals.push_back(std::move(out));
+  };
+  for (const UrdfVisual& v : c.chain.base_visuals) add_visual(v, -1, Eigen::Isometry3d::Identity());
+  for (const UrdfLink& link : c.chain.links) {
+    if (c.spec.joints.size() <= static_cast<std::size_t>(link.joint)) break;
+    for (const UrdfVisual& v : link.visuals) add_visual(v, link.joint, link.pose);
+  }
   for (const UrdfLink& link : c.chain.links) {
     if (c.spec.joints.size() <= static_cast<std::size_t>(link.joint)) break;
     JointSpec& jt = c.spec.joints[static_cast<std::size_t>(link.joint)];
@@ -564,7 +591,8 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
     // material groups, or a convex decomposition's pieces) together; or ("hull") the convex hull of each piece.
     for (const UrdfMesh& mesh : link.meshes) {
       try {
-        const MeshData data = read_mesh(resolve_mesh(mesh.filename, base_dir, c.packages), mesh.scale);
+        const MeshData data =
+            read_mesh(std::filesystem::absolute(resolve_mesh(mesh.filename, base_dir, c.packages)), mesh.scale);
         if (model == "hull") {
           const int pieces = static_cast<int>(data.pieces.size());
           for (int k = 0; k < pieces; ++k) {

@@ -274,6 +274,61 @@ void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometr
   }
 }
 
+// The visual elements of `link`, whose frame is `at` in the frame they are gathered in. Checked as the collision
+// elements are (a bad one is an error: the file is wrong), but a viewer alone uses them.
+void add_visuals(const Namer& names, const urdf::Link& link, const Eigen::Isometry3d& at,
+                 std::vector<UrdfVisual>& out) {
+  const std::string who = names.link(link.name);
+  for (const urdf::VisualSharedPtr& v : link.visual_array) {
+    if (!v || !v->geometry) continue;  // urdfdom reports a visual it cannot read as it parses; nothing to draw
+    check_pose(who, "<visual> <origin>", v->origin);
+    UrdfVisual u;
+    u.link = link.name;
+    u.pose = at * pose_of(v->origin);
+    switch (v->geometry->type) {
+      case urdf::Geometry::SPHERE:
+        u.kind = UrdfVisual::Kind::kSphere;
+        u.radius = static_cast<const urdf::Sphere&>(*v->geometry).radius;
+        check_length(who, "<visual> <sphere> radius", u.radius, true);
+        break;
+      case urdf::Geometry::BOX: {
+        const urdf::Vector3& d = static_cast<const urdf::Box&>(*v->geometry).dim;
+        u.kind = UrdfVisual::Kind::kBox;
+        u.size = {d.x, d.y, d.z};
+        for (double x : u.size) check_length(who, "<visual> <box> size", x, true);
+        break;
+      }
+      case urdf::Geometry::CYLINDER: {
+        const auto& cyl = static_cast<const urdf::Cylinder&>(*v->geometry);
+        u.kind = UrdfVisual::Kind::kCylinder;
+        u.radius = cyl.radius;
+        u.length = cyl.length;
+        check_length(who, "<visual> <cylinder> radius", cyl.radius, true);
+        check_length(who, "<visual> <cylinder> length", cyl.length, true);
+        break;
+      }
+      case urdf::Geometry::MESH: {
+        const auto& mesh = static_cast<const urdf::Mesh&>(*v->geometry);
+        u.kind = UrdfVisual::Kind::kMesh;
+        u.filename = mesh.filename;
+        u.scale = Eigen::Vector3d(mesh.scale.x, mesh.scale.y, mesh.scale.z);
+        if (!u.scale.allFinite() || (u.scale.array() <= 0.0).any()) {
+          throw UrdfError(who + ": <visual> <mesh> scale expected > 0 on every axis");
+        }
+        break;
+      }
+    }
+    if (v->material) {
+      const urdf::Color& c = v->material->color;
+      const std::array<double, 4> rgba{c.r, c.g, c.b, c.a};
+      if (std::all_of(rgba.begin(), rgba.end(), [](double x) { return std::isfinite(x) && x >= 0.0 && x <= 1.0; })) {
+        u.rgba = rgba;
+      }
+    }
+    out.push_back(std::move(u));
+  }
+}
+
 void check_name(const std::string& who, const std::string& name) {
   if (!is_printable_name(name)) {
     throw UrdfError(who + ": the name is not UTF-8 without control characters (it reads '" + printable(name) + "')");
@@ -396,6 +451,7 @@ void add_branch(const Namer& names, const urdf::ModelInterface& model, const urd
     l.joint = index;
     l.pose = frame;
     add_shapes(names, *link, Eigen::Isometry3d::Identity(), messages, l);
+    add_visuals(names, *link, Eigen::Isometry3d::Identity(), l.visuals);
     chain.links.push_back(std::move(l));
     for (auto it = link->child_joints.rbegin(); it != link->child_joints.rend(); ++it) {
       if (*it) stack.push_back({it->get(), frame, item.branch || moves});
@@ -591,6 +647,7 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
     Holder holder{names, *model, held, chain_joints, chain};
 
     Eigen::Isometry3d fixed = Eigen::Isometry3d::Identity();  // fixed joints since the last moving one
+    add_visuals(names, *links.front(), fixed, chain.base_visuals);
     for (std::size_t k = 1; k < links.size(); ++k) {
       const urdf::JointConstSharedPtr joint = links[k]->parent_joint;
       const std::string who = names.joint(joint->name);
@@ -663,13 +720,17 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
                             " joint; a chain of revolute, continuous, prismatic and fixed joints is expected");
         }
       }
-      if (chain.joints.empty()) continue;  // still on the base: these links do not move
+      if (chain.joints.empty()) {  // still on the base: these links do not move
+        add_visuals(names, *links[k], fixed, chain.base_visuals);
+        continue;
+      }
       UrdfLink l;
       l.name = links[k]->name;
       l.where = names.link(links[k]->name);
       l.joint = static_cast<int>(chain.joints.size()) - 1;
       l.pose = fixed;
       add_shapes(names, *links[k], Eigen::Isometry3d::Identity(), messages, l);
+      add_visuals(names, *links[k], Eigen::Isometry3d::Identity(), l.visuals);
       chain.links.push_back(std::move(l));
       // Side branches hanging from this link (a hand, a camera, a head): each of their links a body of its own, riding
       // on this joint, their movable joints held (Holder).

@@ -6,6 +6,7 @@
 /// after the last moving joint), and the collision elements of the links the chain moves become collision shapes.
 /// urdfdom is included only by urdf.cpp.
 
+#include <array>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -53,6 +54,20 @@ struct UrdfMesh {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< the mesh's frame in the link's frame
 };
 
+/// A visual element (what a viewer draws; nothing is computed from it): a mesh as the URDF names it, or a box,
+/// cylinder or sphere, its pose in the frame of the link (or the base) it rides on, and its material's colour.
+struct UrdfVisual {
+  enum class Kind { kMesh, kBox, kCylinder, kSphere };
+  Kind kind = Kind::kMesh;
+  std::string filename;                                    //!< a mesh: as written (package://..., file://, a path)
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();         //!< a mesh's <mesh scale="...">
+  std::array<double, 3> size{0.0, 0.0, 0.0};               //!< a box's sides (m)
+  double radius = 0.0, length = 0.0;                       //!< a cylinder's or sphere's (m)
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< in the frame its shapes are placed in
+  std::optional<std::array<double, 4>> rgba;               //!< the <material> colour, when it has one
+  std::string link;                                        //!< the URDF link it belongs to
+};
+
 /// A link that moves with a joint of the chain: a link of the chain itself (after the joint, and those fixed to it), or
 /// a link of a side branch hanging from one (a hand, a head, a finger), its branch's joints held. Its shapes are
 /// placed in that joint's link frame.
@@ -66,6 +81,7 @@ struct UrdfLink {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< the link's frame in that joint's link frame
   std::vector<ShapeSpec> shapes;                           //!< its sphere, box and cylinder collision elements
   std::vector<UrdfMesh> meshes;                            //!< its mesh collision elements
+  std::vector<UrdfVisual> visuals;                         //!< its visual elements, in the link's frame
   std::optional<Inertia> inertia;     //!< its <inertial> and those riding on it, in the link's frame; none if none
   std::vector<std::string> warnings;  //!< what is wrong with them (kept as given)
 };
@@ -96,6 +112,9 @@ struct UrdfChain {
   Eigen::Isometry3d tip = Eigen::Isometry3d::Identity();  //!< tip_link's frame in the last joint's link frame
   std::vector<UrdfHeldJoint> held;                        //!< the held joints met (side branches, off-chain mimics)
   std::vector<std::string> all_links;                     //!< every link of the URDF, in file order (for messages)
+  /// The visual elements of the links that do not move (the base link and those fixed to it before the first moving
+  /// joint), in the base link's frame.
+  std::vector<UrdfVisual> base_visuals;
 };
 
 /// Reads the chain. Throws UrdfError naming the file and the element for: a missing or unparsable file (with

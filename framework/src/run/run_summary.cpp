@@ -146,6 +146,8 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
     out.robot.link_lengths.push_back(robot.joint(j).length);
   }
   for (const auto& l : robot.link_shapes()) out.robot.link_shapes.push_back({l.link + 1, l.spec});
+  out.robot.visuals = robot.visuals();
+  out.robot.base = robot.base();
   // Each plugin's figures from the recorded run and its data of the run (none without one: a run made elsewhere).
   const SchemeData* data = run.plugin_data.get();
   const auto collect = [&](const Plugin& p, const std::vector<std::unique_ptr<PluginData>>* datas, std::size_t k) {
@@ -422,6 +424,13 @@ const std::vector<SummaryField>& summary_fields() {
        "`frames.csv` it moves with) and the shape keys below, its pose in that joint's frame (a capsule along the link "
        "resolved to its end points). `[]` for a robot without collision shapes",
        nullptr},
+      {"robot.visuals", "array of objects",
+       "a URDF robot's visual elements (what `redres view` draws; docs/viewer.md): `joint` (1-based, the frame of "
+       "`frames.csv` it rides in; 0: the base's links, posed in the world), `link`, `shape` (`mesh`, `box`, "
+       "`cylinder`, `sphere`), `file` (a mesh found; empty with `problem` saying why when not), `scale`, `size`, "
+       "`radius`, `length`, `position`, `rotation` (as for the shapes), `rgba` (the material's colour, when given). "
+       "`[]` for other robots",
+       nullptr},
       {"metrics", "object", "figures reported by plugins, by plugin instance name; see below", nullptr},
       {"obstacles", "array of objects",
        "the obstacles of the active plugins that have some (`obstacle_avoidance`), for drawing; see below. `[]` when "
@@ -479,6 +488,35 @@ std::string to_json(const RunSummary& s) {
     link_shapes.push_back(shape);
   }
   j["robot"]["link_shapes"] = link_shapes;
+  nlohmann::json visuals = nlohmann::json::array();
+  for (const VisualSpec& v : s.robot.visuals) {
+    static const char* const kinds[] = {"mesh", "box", "cylinder", "sphere"};
+    const Eigen::Isometry3d pose = v.joint < 0 ? s.robot.base * v.pose : v.pose;
+    const Eigen::Matrix3d R = pose.linear();
+    nlohmann::json e = {
+        {"joint", v.joint + 1},
+        {"link", v.link},
+        {"shape", kinds[static_cast<int>(v.kind)]},
+        {"position", vector_json(pose.translation())},
+        {"rotation",
+         {vector_json(R.row(0).transpose()), vector_json(R.row(1).transpose()), vector_json(R.row(2).transpose())}}};
+    switch (v.kind) {
+      case VisualSpec::Kind::kMesh:
+        e["file"] = v.file.string();
+        e["scale"] = vector_json(v.scale);
+        if (!v.problem.empty()) e["problem"] = v.problem;
+        break;
+      case VisualSpec::Kind::kBox: e["size"] = v.size; break;
+      case VisualSpec::Kind::kCylinder:
+        e["radius"] = v.radius;
+        e["length"] = v.length;
+        break;
+      case VisualSpec::Kind::kSphere: e["radius"] = v.radius; break;
+    }
+    if (v.rgba) e["rgba"] = *v.rgba;
+    visuals.push_back(std::move(e));
+  }
+  j["robot"]["visuals"] = visuals;
   j["metrics"] = metrics;
   j["obstacles"] = obstacles;
   require_finite_numbers(j, "");

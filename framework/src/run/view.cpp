@@ -227,6 +227,59 @@ json column_json(const Table& t, int col, const std::vector<std::size_t>& rows, 
   return out;
 }
 
+std::string base64(const void* bytes, std::size_t size) {
+  static const char* const digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  const auto* b = static_cast<const unsigned char*>(bytes);
+  std::string out;
+  out.reserve((size + 2) / 3 * 4);
+  for (std::size_t i = 0; i < size; i += 3) {
+    const unsigned v = (unsigned{b[i]} << 16) | (i + 1 < size ? unsigned{b[i + 1]} << 8 : 0U) |
+                       (i + 2 < size ? unsigned{b[i + 2]} : 0U);
+    out += digits[(v >> 18) & 63];
+    out += digits[(v >> 12) & 63];
+    out += i + 1 < size ? digits[(v >> 6) & 63] : '=';
+    out += i + 2 < size ? digits[v & 63] : '=';
+  }
+  return out;
+}
+
+// The visual meshes of every run, read once each (keyed by file and scale) and shared by the runs and frames that
+// draw them: per part its colour and its triangles as little-endian float32 positions and uint16 (or, past 65,536
+// vertices, uint32) indices, base64.
+struct DrawMeshes {
+  json meshes = json::object();
+  std::size_t triangles = 0;
+  // The key of the mesh (read now if new); empty when it cannot be read (a note says why).
+  std::string add(const std::string& file, const Eigen::Vector3d& scale, std::vector<std::string>& notes,
+                  const std::string& owner) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "|%.9g,%.9g,%.9g", scale.x(), scale.y(), scale.z());
+    const std::string key = file + buf;
+    if (meshes.contains(key)) return key;
+    try {
+      const DrawMesh mesh = read_draw_mesh(file, scale);
+      json parts = json::array();
+      for (const DrawMesh::Part& p : mesh.parts) {
+        json part = {{"positions", base64(p.positions.data(), p.positions.size() * sizeof(float))}};
+        if (p.positions.size() / 3 <= 65536) {  // 16-bit indices where they reach every vertex: half the size
+          const std::vector<std::uint16_t> small(p.indices.begin(), p.indices.end());
+          part["indices16"] = base64(small.data(), small.size() * sizeof(std::uint16_t));
+        } else {
+          part["indices"] = base64(p.indices.data(), p.indices.size() * sizeof(std::uint32_t));
+        }
+        if (p.coloured) part["colour"] = {p.colour[0], p.colour[1], p.colour[2]};
+        parts.push_back(std::move(part));
+      }
+      triangles += mesh.triangles();
+      meshes[key] = {{"file", file}, {"parts", std::move(parts)}};
+      return key;
+    } catch (const std::exception& e) {
+      notes.push_back(owner + ": " + e.what() + "; not drawn");
+      return "";
+    }
+  }
+};
+
 fs::path in_run(const fs::path& dir, const char* name) {
   const fs::path file = dir / name;
   if (fs::exists(file)) return file;
@@ -241,7 +294,7 @@ fs::path in_run(const fs::path& dir, const char* name) {
   throw std::runtime_error(why);
 }
 
-json run_json(const fs::path& dir, const ViewOptions& options, HullCache& hulls, ViewReport& report) {
+json run_json(const fs::path& dir, const ViewOptions& options, HullCache& hulls, DrawMeshes& draw, ViewReport& report) {
   const fs::path summary_file = in_run(dir, "summary.json");
   json summary;
   try {
@@ -333,6 +386,35 @@ json run_json(const fs::path& dir, const ViewOptions& options, HullCache& hulls,
     obstacles.push_back(std::move(shape));
   }
   report.bodies += static_cast<int>(run["link_shapes"].size() + obstacles.size());
+  // A URDF robot's visual elements: meshes (shared), boxes, cylinders, spheres.
+  json visuals = json::array();
+  index = 0;
+  for (const auto& v : robot.value("visuals", json::array())) {
+    ++index;
+    json out = {{"joint", v.value("joint", 0)},
+                {"shape", v.value("shape", "mesh")},
+                {"position", vec_json(vec_of(v.value("position", json::array({0.0, 0.0, 0.0}))))},
+                {"quaternion", quaternion_json(rotation_of(v.value("rotation", json())))}};
+    if (v.contains("rgba")) out["rgba"] = v["rgba"];
+    if (out["shape"] == "mesh") {
+      const std::string who = name + ": visual " + std::to_string(index) + " (link '" + v.value("link", "") + "')";
+      if (v.contains("problem")) {
+        report.notes.push_back(who + ": " + v["problem"].get<std::string>() + "; not drawn");
+        continue;
+      }
+      const std::string key =
+          draw.add(v.value("file", ""), vec_of(v.value("scale", json::array({1.0, 1.0, 1.0}))), report.notes, who);
+      if (key.empty()) continue;
+      out["mesh"] = key;
+    } else {
+      for (const char* k : {"size", "radius", "length"}) {
+        if (v.contains(k)) out[k] = v[k];
+      }
+    }
+    visuals.push_back(std::move(out));
+  }
+  report.visuals += static_cast<int>(visuals.size());
+  run["visuals"] = std::move(visuals);
   run["obstacles"] = std::move(obstacles);
 
   // The plots' series, at most max_plot_points rows of trajectory.csv.
@@ -391,14 +473,20 @@ std::string view_data(const std::vector<fs::path>& run_dirs, const ViewOptions& 
   if (run_dirs.empty()) throw std::invalid_argument("view: no run directory given");
   if (options.max_plot_points < 2) throw std::invalid_argument("view: max_plot_points must be at least 2");
   HullCache hulls;
+  DrawMeshes draw;
   json runs = json::array();
-  for (const fs::path& dir : run_dirs) runs.push_back(run_json(dir, options, hulls, report));
+  for (const fs::path& dir : run_dirs) runs.push_back(run_json(dir, options, hulls, draw, report));
+  report.visual_triangles = draw.triangles;
   report.runs = static_cast<int>(runs.size());
   std::string title = options.title;
   if (title.empty()) {
     for (const auto& r : runs) title += (title.empty() ? "" : " vs ") + r["label"].get<std::string>();
   }
-  json data = {{"format", 1}, {"title", title}, {"runs", std::move(runs)}, {"notes", report.notes}};
+  json data = {{"format", 1},
+               {"title", title},
+               {"runs", std::move(runs)},
+               {"meshes", std::move(draw.meshes)},
+               {"notes", report.notes}};
   return data.dump();
 }
 

@@ -4,6 +4,8 @@
 /// (`package://NAME/...`, `file://...`, paths relative to the description) and turning them into the shapes redres
 /// measures distances to (docs/robot_format.md, "Meshes").
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -42,6 +44,24 @@ struct PackagePaths {
 /// meshes together (an OBJ's material groups are one piece; a convex decomposition's pieces are its objects), each
 /// vertex scaled by `scale`. Throws std::runtime_error naming the file when it cannot be read or holds no vertex.
 [[nodiscard]] MeshData read_mesh(const std::filesystem::path& file, const Eigen::Vector3d& scale);
+
+/// A mesh for drawing (a URDF's visual meshes, `redres view`): its triangles, in parts of one colour each (the
+/// file's materials' diffuse colours), in the mesh file's frame, scaled.
+struct DrawMesh {
+  struct Part {
+    std::vector<float> positions;                   //!< x, y, z per vertex
+    std::vector<std::uint32_t> indices;             //!< three per triangle
+    std::array<float, 3> colour{0.7F, 0.7F, 0.7F};  //!< the material's diffuse colour (grey when it has none)
+    bool coloured = false;                          //!< the file gives the colour
+  };
+  std::vector<Part> parts;
+  [[nodiscard]] std::size_t triangles() const;
+};
+
+/// Reads a mesh file for drawing (as read_mesh(), within the same bounds): every mesh of its scene, its node
+/// transforms applied, triangulated, one part per material. Throws std::runtime_error naming the file when it
+/// cannot be read or holds no triangle.
+[[nodiscard]] DrawMesh read_draw_mesh(const std::filesystem::path& file, const Eigen::Vector3d& scale);
 
 /// The capsule fitted to `vertices`: along their principal axis (the covariance's largest eigenvector), its radius
 /// the smallest circle that encloses their projections on the plane across it, its segment the shortest that then

@@ -29,6 +29,7 @@
 /// keeps every row of the position or pose task it belongs to, while J, the task constraint and w = det(J J') use
 /// the named rows only (a selection matrix S: S J x = S (r_d_dot + K e)).
 
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -118,6 +119,24 @@ struct JointSpec {
 /// URDF, say) would need gigabytes; robots are refused beyond it at load.
 inline constexpr std::size_t kMaxJoints = 1000;
 
+/// A visual element of a URDF robot: what a viewer draws (`redres view`, docs/viewer.md); nothing is computed from it.
+/// A mesh (the file found for the URDF's name), a box, a cylinder (along z) or a sphere, posed in the frame of the
+/// joint it rides on (the frame frames.csv records), or for the base's links in the base pose P's frame.
+struct VisualSpec {
+  enum class Kind { kMesh, kBox, kCylinder, kSphere };
+  Kind kind = Kind::kMesh;
+  int joint = -1;                                          //!< the joint it rides on (0-based); -1: the base
+  std::string link;                                        //!< the URDF link it belongs to
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  //!< in that joint's frame (the base: in P's frame)
+  std::string uri;                                         //!< a mesh: the name the URDF gives
+  std::filesystem::path file;                              //!< a mesh: the file found (empty: not found)
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();         //!< a mesh: its scale
+  std::array<double, 3> size{0.0, 0.0, 0.0};               //!< a box: its sides (m)
+  double radius = 0.0, length = 0.0;                       //!< a cylinder's or a sphere's (m)
+  std::optional<std::array<double, 4>> rgba;               //!< the URDF material's colour, if it gives one
+  std::string problem;  //!< why a mesh is not drawn (its file was not found); empty when it is
+};
+
 struct RobotSpec {
   std::string name;                                   //!< robot name
   ChainKind kind = ChainKind::kPlanar;                //!< planar or spatial
@@ -138,6 +157,8 @@ struct RobotSpec {
   std::vector<std::pair<std::string, double>> held_joints;
   /// Body pairs, by name (RobotModel::bodies(): a URDF's links), never checked against each other.
   std::vector<std::pair<std::string, std::string>> collision_exclude_bodies;
+  /// A URDF robot's visual elements (drawn by the viewer only).
+  std::vector<VisualSpec> visuals;
 };
 
 /// An immutable robot model. Construction validates the spec and throws std::invalid_argument on misuse.
@@ -236,6 +257,8 @@ class RobotModel {
   };
   /// Every collision shape of every link, in joint order.
   [[nodiscard]] const std::vector<LinkShape>& link_shapes() const noexcept { return link_shapes_; }
+  /// A URDF robot's visual elements (empty for other robots): what a viewer draws.
+  [[nodiscard]] const std::vector<VisualSpec>& visuals() const noexcept { return spec_.visuals; }
   /// Whether links i and j are checked against each other for self-collision (not equal, not adjacent, not
   /// excluded by the robot file).
   [[nodiscard]] bool self_collision_pair(int i, int j) const;

@@ -51,8 +51,10 @@ struct RobotFacts {
   std::vector<std::string> joint_names;
   std::vector<std::string> task_rows;  //!< the task's rows, e.g. {"x", "y", "z", "wx", "wy"}
   std::vector<double> lower_limits, upper_limits, link_lengths;
-  std::vector<double> base_position;        //!< the base pose's origin in the world (3)
-  std::vector<LinkShapeFacts> link_shapes;  //!< the links' collision shapes, in joint order
+  std::vector<double> base_position;                       //!< the base pose's origin in the world (3)
+  std::vector<LinkShapeFacts> link_shapes;                 //!< the links' collision shapes, in joint order
+  std::vector<VisualSpec> visuals;                         //!< a URDF robot's visual elements (the viewer draws them)
+  Eigen::Isometry3d base = Eigen::Isometry3d::Identity();  //!< the base pose P (the base's visuals ride on it)
 };
 
 /// The figures one plugin reported.

@@ -28,11 +28,13 @@ struct ViewOptions {
 /// What was written.
 struct ViewReport {
   std::filesystem::path file;
-  std::uintmax_t bytes = 0;        //!< the file's size
-  int runs = 0;                    //!< runs in it
-  int frames = 0;                  //!< 3-D frames (of the longest run)
-  int bodies = 0;                  //!< robot shapes and obstacles drawn (all runs)
-  std::vector<std::string> notes;  //!< what could not be drawn as recorded (e.g. a hull whose mesh is gone)
+  std::uintmax_t bytes = 0;          //!< the file's size
+  int runs = 0;                      //!< runs in it
+  int frames = 0;                    //!< 3-D frames (of the longest run)
+  int bodies = 0;                    //!< robot shapes and obstacles drawn (all runs)
+  int visuals = 0;                   //!< visual elements drawn (all runs)
+  std::size_t visual_triangles = 0;  //!< triangles of the visual meshes (each mesh once)
+  std::vector<std::string> notes;    //!< what could not be drawn as recorded (e.g. a hull whose mesh is gone)
 };
 
 /// The page's data for the runs in `run_dirs` (each holding summary.json, frames.csv and trajectory.csv), as JSON

@@ -158,6 +158,20 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
   }
   nlohmann::json held = nlohmann::json::array();
   for (const auto& [name, value] : model.spec().held_joints) held.push_back({{"name", name}, {"value", value}});
+  nlohmann::json visuals = nlohmann::json::array();
+  for (const VisualSpec& v : model.visuals()) {
+    static const char* const kinds[] = {"mesh", "box", "cylinder", "sphere"};
+    visuals.push_back({{"link", v.link},
+                       {"joint", v.joint + 1},
+                       {"kind", kinds[static_cast<int>(v.kind)]},
+                       {"position", to_vector(v.pose.translation())},
+                       {"rpy", rpy_of(v.pose.linear())}});
+    if (v.kind == VisualSpec::Kind::kMesh) {
+      visuals.back()["file"] = v.file.string();
+      visuals.back()["uri"] = v.uri;
+      if (!v.problem.empty()) visuals.back()["problem"] = v.problem;
+    }
+  }
   nlohmann::json J = nlohmann::json::array();
   for (Eigen::Index r = 0; r < k.J.rows(); ++r) J.push_back(to_vector(k.J.row(r).transpose()));
   return {{"name", model.name()},
@@ -168,6 +182,7 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
           {"source", model.source()},
           {"joints", joints},
           {"collision_shapes", shapes},
+          {"visuals", visuals},
           {"held_joints", held},
           {"self_collision_distances", self_pairs},
           {"inertias", inertias},
@@ -267,6 +282,27 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
       }
     }
     o << (body.branch ? "  (side branch)" : "") << "\n";
+  }
+  if (!model.visuals().empty()) {
+    // What `redres view` draws: one line per link, a mesh that was not found named with why.
+    std::size_t meshes = 0, missing = 0;
+    for (const VisualSpec& v : model.visuals()) {
+      if (v.kind != VisualSpec::Kind::kMesh) continue;
+      ++meshes;
+      if (!v.problem.empty()) ++missing;
+    }
+    o << "\nvisual elements (" << model.visuals().size() << ", " << meshes << " meshes"
+      << (missing > 0 ? ", " + std::to_string(missing) + " not found" : std::string()) << "; drawn by redres view)\n";
+    for (const VisualSpec& v : model.visuals()) {
+      static const char* const kinds[] = {"mesh", "box", "cylinder", "sphere"};
+      o << "  " << std::left << std::setw(width) << v.link << "  " << std::setw(8)
+        << (v.joint < 0 ? std::string("base") : "joint " + std::to_string(v.joint + 1)) << std::right << "  "
+        << kinds[static_cast<int>(v.kind)];
+      if (v.kind == VisualSpec::Kind::kMesh) {
+        o << " " << (v.problem.empty() ? v.file.filename().string() : v.uri + ": " + v.problem);
+      }
+      o << "\n";
+    }
   }
   if (!model.spec().held_joints.empty()) {
     o << "\nheld joints (side branches; `held_joints` in the robot file)\n";

@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include <filesystem>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -16,8 +18,9 @@ namespace {
 TEST(RobotCommand, ABareUrdfPrintsItsFramesShapesAndInertias) {
   const Cli r = redres("robot robots/franka_panda_description/panda.urdf");
   ASSERT_EQ(r.code, 0) << r.out;
-  for (const char* part : {"end effector  xyz", "link frames", "collision shapes (10)", "mass (kg)",
-                           "self-collision pairs at theta", "panda_joint7"}) {
+  for (const char* part :
+       {"end effector  xyz", "link frames", "collision shapes (10)", "mass (kg)", "self-collision pairs at theta",
+        "panda_joint7", "visual elements (11, 11 meshes; drawn by redres view)"}) {
     EXPECT_NE(r.out.find(part), std::string::npos) << part << " in\n" << r.out;
   }
   const Cli tip = redres("robot robots/franka_panda_description/panda.urdf --tip-link no_such_link");
@@ -55,6 +58,14 @@ TEST(RobotCommand, TheJsonGivesPosesAndTheSelfDistancesNearestFirst) {
     EXPECT_NE(shape["source_mesh"].get<std::string>().find(".obj"), std::string::npos) << shape;
   }
   EXPECT_TRUE(finger);
+  // The visual elements: the base's link0 and the others on their joints, each mesh found (an absolute path).
+  ASSERT_EQ(j["visuals"].size(), 11u);
+  EXPECT_EQ(j["visuals"][0]["link"], "panda_link0");
+  EXPECT_EQ(j["visuals"][0]["joint"], 0);
+  for (const auto& v : j["visuals"]) {
+    EXPECT_FALSE(v.contains("problem")) << v;
+    EXPECT_TRUE(std::filesystem::path(v["file"].get<std::string>()).is_absolute()) << v;
+  }
   ASSERT_EQ(j["held_joints"].size(), 2u);
   bool finger_pair = false;
   for (const auto& p : pairs) {

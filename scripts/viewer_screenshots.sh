@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 redres=build/release/bin/redres
 work=$(mktemp -d)
 shoot() {  # shoot PAGE FRAGMENT PNG
-  chromium --headless --no-sandbox --enable-unsafe-swiftshader --hide-scrollbars --window-size=1400,850 \
+  chromium --headless --no-sandbox --disable-dev-shm-usage --enable-unsafe-swiftshader --hide-scrollbars --window-size=1400,850 \
     --user-data-dir="$work/profile" --virtual-time-budget=3000 --screenshot="$3" "file://$1#$2" 2>/dev/null
 }
 "$redres" compare configs/paper_r_tvcmm.toml configs/paper_r_constant_p.toml configs/paper_r_mvn.toml \

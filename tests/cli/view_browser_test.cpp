@@ -53,7 +53,8 @@ std::string run_command(const std::string& cmd) {
 // Headless Chromium with WebGL in software (SwiftShader), no sandbox (CI runs as root), a fresh profile.
 std::string browser(const fs::path& profile, const std::string& args) {
   return "'" + chromium() +
-         "' --headless --no-sandbox --disable-gpu-sandbox --enable-unsafe-swiftshader --no-first-run "
+         "' --headless --no-sandbox --disable-gpu-sandbox --disable-dev-shm-usage --enable-unsafe-swiftshader "
+         "--no-first-run "
          "--disable-extensions --hide-scrollbars "
          "--window-size=1400,850 --virtual-time-budget=2000 --user-data-dir='" +
          profile.string() + "' " + args;

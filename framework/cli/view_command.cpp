@@ -37,6 +37,11 @@ fs::path run_directory(const std::string& dir, int row) {
       throw std::runtime_error("view: " + r.string() + " holds no run: --row K needs a sweep that kept its runs (" +
                                "`runs = true` in the sweep file, or `redres sweep --runs`)");
     }
+    if (!fs::exists(r / "frames.csv")) {
+      throw std::runtime_error("view: " + r.string() +
+                               " has no rows to replay: the sweep kept its runs' summaries "
+                               "only; set [output] record = \"all\" (or \"every=N\") in the sweep file");
+    }
     return r;
   }
   if (!fs::exists(d / "summary.json") && fs::exists(d / "sweep.csv")) {

@@ -229,6 +229,27 @@ TEST_F(View, WhatCannotBeViewedSaysWhy) {
   for (const fs::path& d : {empty, none, h5}) fs::remove_all(d);
 }
 
+TEST_F(View, ASweepRowIsViewedFromTheRunTheSweepKept) {
+  const fs::path dir = scratch("view_sweep");
+  fs::create_directories(dir);
+  std::ofstream(dir / "two.toml") << "scenario = \"" << source_path("configs/paper_r_tvcmm.toml").string()
+                                  << "\"\n[[vary]]\nkey = \"objectives.1.p\"\nvalues = [0.0, 1.0]\n"
+                                     "[output]\nruns = true\nrecord = \"every=10\"\n";
+  const Cli sweep =
+      redres("sweep '" + (dir / "two.toml").string() + "' --quiet --out '" + (dir / "out").string() + "'");
+  ASSERT_EQ(sweep.code, 0) << sweep.out;
+  Cli r = redres("view '" + (dir / "out").string() + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--row"), std::string::npos) << r.out;
+  r = redres("view '" + (dir / "out").string() + "' --row 1");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "out" / "runs" / "1" / "view.html"));
+  r = redres("view '" + (dir / "out").string() + "' --row 7");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("runs = true"), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
 TEST_F(View, ATitleCannotEndTheScriptEarly) {
   const fs::path out = scratch("view_title.html");
   const Cli r = redres("view '" + paper_->string() + "' --title '</script><b>x' --out '" + out.string() + "'");

@@ -16,9 +16,11 @@ Per run:
   fig9b_position_error.png  the position error over time (and the orientation error, for pose tasks)
   fig_collision_distances.png  (runs with obstacle_avoidance or self_collision) the smallest distances over time,
                             with each plugin's safety and influence distances
-With --animate: animation.mp4 (matplotlib's FFMpegWriter) when ffmpeg is on PATH, else animation.gif (PillowWriter),
-at most MAX_ANIMATION_FRAMES frames: the arm (and its collision shapes when there are obstacles), the obstacles where
-they are at each time, the end-effector trail and the desired path.
+With --animate: animation.mp4 (H.264 by ffmpeg) when ffmpeg is on PATH, else animation.gif (Pillow): the arm (and
+its collision shapes when there are obstacles), the obstacles where they are at each time, the end-effector trail and
+the desired path; about ANIMATION_FPS frames per second of the run, at least MIN_ANIMATION_FRAMES (or every row of
+frames.csv) and at most MAX_ANIMATION_FRAMES. The frames are drawn by blitting (the still parts once), so a short run
+takes a few seconds.
 
 The arm is drawn from frames.csv (joint frames computed by redres, so no kinematics here) and the obstacles and link
 shapes from summary.json (docs/output_formats.md). Uses matplotlib and numpy (Debian: python3-matplotlib,
@@ -29,6 +31,7 @@ import argparse
 import json
 import os
 import shutil
+import subprocess
 import sys
 
 from redres_output import OutputError, save_output  # noqa: E402  (beside this script)
@@ -37,11 +40,12 @@ from redres_output import OutputError, save_output  # noqa: E402  (beside this s
 # failed plot; the check costs nothing, as the figures need these imports anyway.
 EXIT_MISSING_LIBRARY = 3
 MAX_ANIMATION_FRAMES = 240
+MIN_ANIMATION_FRAMES = 30
+ANIMATION_FPS = 12
 try:
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.animation  # noqa: E402
     import matplotlib.patches  # noqa: E402
     import matplotlib.pyplot as plt  # noqa: E402
     import numpy as np  # noqa: E402
@@ -692,27 +696,94 @@ def plot_run(run_dir, quiet):
         print(f"figures written to {run_dir}")
 
 
-def animation_writer(fps):
-    """(writer, file name): FFMpegWriter to animation.mp4 when ffmpeg is on PATH, else PillowWriter to
-    animation.gif (Pillow is a dependency of matplotlib, so the GIF can always be made)."""
-    if shutil.which("ffmpeg"):
-        return matplotlib.animation.FFMpegWriter(fps=fps, bitrate=1800), "animation.mp4"
-    return matplotlib.animation.PillowWriter(fps=fps), "animation.gif"
+def animation_rows(t_f, duration):
+    """The rows of frames.csv that become frames, and the frame rate: about ANIMATION_FPS frames per second of the run
+    (real time), at least MIN_ANIMATION_FRAMES (or every row, when there are fewer) and at most MAX_ANIMATION_FRAMES
+    (longer runs play faster, never below 4 frames per second)."""
+    wanted = int(np.clip(round(ANIMATION_FPS * duration), MIN_ANIMATION_FRAMES, MAX_ANIMATION_FRAMES))
+    rows = np.unique(np.linspace(0, len(t_f) - 1, min(len(t_f), wanted)).round().astype(int))
+    fps = int(np.clip(round(len(rows) / max(duration, 1e-9)), 4, 25)) if duration > 0 else 10
+    return rows, fps
+
+
+class SectionCache:
+    """A shape's z = 0 section, computed once and moved rigidly while the shape only turns about z and moves in x and
+    y (a planar arm's links, an obstacle moving in the plane); computed anew otherwise."""
+
+    def __init__(self, shape):
+        self.shape = shape
+        self.reference = None  # (p, R, section) of the last computation
+
+    def polygon(self, p, R):
+        if self.reference is not None:
+            p0, R0, poly0 = self.reference
+            turn = R @ R0.T
+            if abs(p[2] - p0[2]) <= 1e-12 and abs(turn[2, 2] - 1.0) <= 1e-12:
+                return None if poly0 is None else (poly0 - p0[:2]) @ turn[:2, :2].T + p[:2]
+        poly = plane_section(self.shape, p, R)
+        self.reference = (np.array(p), np.array(R), poly)
+        return poly
+
+
+class PlanarSection:
+    """The artist of one shape's section on 2-D axes, updated in place each frame (hidden where the shape misses the
+    plane); clouds are a scatter of the cells near the plane."""
+
+    def __init__(self, ax, shape, **style):
+        self.shape, self.cache = shape, SectionCache(shape)
+        if is_cloud(shape):
+            self.artist = ax.scatter([], [], s=2, marker="s", color=style.get("facecolor", "grey"), animated=True)
+        else:
+            self.artist = matplotlib.patches.Polygon(np.zeros((3, 2)), closed=True, animated=True, **style)
+            ax.add_patch(self.artist)
+
+    def update(self, p, R):
+        if is_cloud(self.shape):
+            centres, edges = cloud_cells(self.shape, p, R)
+            near = np.abs(centres[:, 2]) <= 0.5 * edges + self.shape.get("radius", 0.0)
+            self.artist.set_offsets(centres[near, :2] if near.any() else np.zeros((0, 2)))
+            self.artist.set_visible(bool(near.any()))
+            return
+        poly = self.cache.polygon(p, R)
+        self.artist.set_visible(poly is not None)
+        if poly is not None:
+            self.artist.set_xy(poly)
+
+
+def write_animation(path, images, fps):
+    """The frames (h x w x 3 uint8 arrays) as an MP4 (ffmpeg on PATH: H.264 from raw RGB frames on its stdin) or a
+    GIF (Pillow), as the file name says."""
+    if path.endswith(".mp4"):
+        h, w = images[0].shape[:2]
+        command = [shutil.which("ffmpeg"), "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s",
+                   f"{w}x{h}", "-r", str(fps), "-i", "-", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-vcodec", "libx264",
+                   "-pix_fmt", "yuv420p", "-b:v", "1800k", path]
+        with subprocess.Popen(command, stdin=subprocess.PIPE, stderr=subprocess.PIPE) as ffmpeg:
+            _, err = ffmpeg.communicate(b"".join(image.tobytes() for image in images))
+        if ffmpeg.returncode != 0:
+            raise RuntimeError(f"ffmpeg failed (exit code {ffmpeg.returncode}): {err.decode(errors='replace').strip()}")
+        return
+    from PIL import Image  # Pillow comes with matplotlib
+
+    frames = [Image.fromarray(image) for image in images]
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=int(round(1000 / fps)), loop=0)
 
 
 def animate_run(run_dir, quiet):
     """The arm, its collision shapes (when there are obstacles), the obstacles where they are, the end-effector
-    trail and the desired path, over the run: animation.mp4 or animation.gif in run_dir."""
+    trail and the desired path, over the run: animation.mp4 or animation.gif in run_dir.
+
+    Fast: what does not move (axes, path, legend, fixed obstacles) is drawn once; each frame restores that background
+    and draws only the moving artists (arm, trail, sections or moving obstacles, title) into the canvas, whose pixels
+    are the frame (blitting); the frames are then written in one go."""
     data, summary = load(run_dir)
     frames = load_frames(run_dir, summary)
     if frames is None:
         raise SystemExit(f"plot_run.py: --animate: no frames.csv in {run_dir} (runs of redres before it wrote one)")
-    name = summary.get("name", os.path.basename(os.path.normpath(run_dir)))
+    name = summary.get("label", summary.get("name", os.path.basename(os.path.normpath(run_dir))))
     t_f, pts, rots = frames
     duration = float(data["t"][-1])
-    rows = np.unique(np.linspace(0, len(t_f) - 1, min(len(t_f), MAX_ANIMATION_FRAMES)).round().astype(int))
-    # About real time for runs of 6 to 24 s, faster for longer ones, never below 4 frames per second.
-    fps = int(np.clip(round(len(rows) / max(duration, 1e-9)), 4, 25)) if duration > 0 else 10
+    rows, fps = animation_rows(t_f, duration)
     planar = summary["robot"]["kind"] == "planar"
     obs = obstacles(summary)
     shapes = bool(obs) and bool(summary["robot"].get("link_shapes"))
@@ -725,13 +796,13 @@ def animate_run(run_dir, quiet):
         k = int(np.argmin(np.abs(t_data - t)))
         return min(float(data[c][k]) for c in distance_columns)
 
-    writer, file_name = animation_writer(fps)
+    file_name = "animation.mp4" if shutil.which("ffmpeg") else "animation.gif"
     fig = plt.figure(figsize=(6.4, 6.0))
     if planar:
         ax = fig.add_subplot(1, 1, 1)
         ax.plot(data["rd_x"], data["rd_y"], "b-", lw=3, alpha=0.25, label="desired path")
-        (trail,) = ax.plot([], [], "r", lw=1.2, label="end-effector trajectory")
-        (arm,) = ax.plot([], [], "-o", color="k", lw=2, ms=4, label="arm")
+        (trail,) = ax.plot([], [], "r", lw=1.2, label="end-effector trajectory", animated=True)
+        (arm,) = ax.plot([], [], "-o", color="k", lw=2, ms=4, label="arm", animated=True, zorder=3)
         all_pts = [pts[:, :, :2].reshape(-1, 2), np.column_stack([data["rd_x"], data["rd_y"]])]
         for o in obs:
             r = bounding_radius(o)
@@ -755,47 +826,36 @@ def animate_run(run_dir, quiet):
         ax.grid(alpha=0.3)
         if obs:
             ax.plot([], [], "s", color=OBSTACLE_COLOUR, label="obstacles")
-        ax.legend(fontsize=7, loc="upper right")
-        dynamic = []  # patches redrawn every frame
+        obstacle_sections = [PlanarSection(ax, o, facecolor=OBSTACLE_COLOUR, edgecolor="k", lw=0.6, alpha=0.8)
+                             for o in obs]
+        link_sections = [PlanarSection(ax, shape, facecolor=CLOSEST_COLOUR, edgecolor=CLOSEST_COLOUR, lw=0.5,
+                                       alpha=0.25) for shape in summary["robot"]["link_shapes"]] if shapes else []
 
-        def update(i):
-            k = rows[i]
+        def update(k):
             t = t_f[k]
-            for artist in dynamic:
-                artist.remove()
-            dynamic.clear()
-            for o in obs:
-                patch = draw_section(ax, o, *obstacle_pose(o, t), facecolor=OBSTACLE_COLOUR, edgecolor="k", lw=0.6,
-                                     alpha=0.8)
-                if patch is not None:
-                    dynamic.append(patch)
-            if shapes:
-                for shape, p, R in link_shape_poses(summary, rots[k], pts[k]):
-                    patch = draw_section(ax, shape, p, R, facecolor=CLOSEST_COLOUR, edgecolor=CLOSEST_COLOUR,
-                                         lw=0.5, alpha=0.25)
-                    if patch is not None:
-                        dynamic.append(patch)
+            for section, o in zip(obstacle_sections, obs):
+                section.update(*obstacle_pose(o, t))
+            for section, (_, p, R) in zip(link_sections, link_shape_poses(summary, rots[k], pts[k])):
+                section.update(p, R)
             arm.set_data(pts[k, :, 0], pts[k, :, 1])
             shown = t_data <= t + 1e-12
             trail.set_data(data["r_x"][shown], data["r_y"][shown])
-            set_title(t)
+            return [s.artist for s in obstacle_sections + link_sections if s.artist.get_visible()] + [trail, arm]
     else:
         ax = fig.add_subplot(1, 1, 1, projection="3d")
         ax.plot(data["rd_x"], data["rd_y"], data["rd_z"], "b-", lw=3, alpha=0.25, label="desired path")
-        (trail,) = ax.plot([], [], [], "r", lw=1.2, label="end-effector trajectory")
-        (arm,) = ax.plot([], [], [], "-o", color="k", lw=3, ms=4, label="arm")
+        (trail,) = ax.plot([], [], [], "r", lw=1.2, label="end-effector trajectory", animated=True)
+        (arm,) = ax.plot([], [], [], "-o", color="k", lw=3, ms=4, label="arm", animated=True)
         equal_3d(ax, np.vstack([scene_points(summary, frames, duration),
                                 np.column_stack([data["rd_x"], data["rd_y"], data["rd_z"]])]))
         if obs:
             ax.plot([], [], "s", color=OBSTACLE_COLOUR, label="obstacles")
-        ax.legend(fontsize=7, loc="upper left")
-        static = [o for o in obs if not moving(o)]
-        for o in static:
-            draw_solid(ax, o, *obstacle_pose(o, 0.0), OBSTACLE_COLOUR, 0.5)
-        dynamic = []
+        for o in obs:
+            if not moving(o):
+                draw_solid(ax, o, *obstacle_pose(o, 0.0), OBSTACLE_COLOUR, 0.5)
+        dynamic = []  # moving obstacles: drawn anew each frame
 
-        def update(i):
-            k = rows[i]
+        def update(k):
             t = t_f[k]
             for artist in dynamic:
                 artist.remove()
@@ -803,10 +863,14 @@ def animate_run(run_dir, quiet):
             for o in obs:
                 if moving(o):
                     dynamic.extend(draw_solid(ax, o, *obstacle_pose(o, t), OBSTACLE_COLOUR, 0.5))
+            for artist in dynamic:
+                artist.set_animated(True)
+                if hasattr(artist, "do_3d_projection"):
+                    artist.do_3d_projection()  # what the 3-D axes' draw does for its collections
             arm.set_data_3d(pts[k, :, 0], pts[k, :, 1], pts[k, :, 2])
             shown = t_data <= t + 1e-12
             trail.set_data_3d(data["r_x"][shown], data["r_y"][shown], data["r_z"][shown])
-            set_title(t)
+            return dynamic + [trail, arm]
 
     def set_title(t):
         d = min_distance(t)
@@ -814,14 +878,28 @@ def animate_run(run_dir, quiet):
         ax.set_title(f"{name}: t = {t:.2f} s{extra}", fontsize=9)
 
     set_title(t_f[rows[0]])  # before the layout, so that it keeps room for the title
-    fig.tight_layout()
-    anim = matplotlib.animation.FuncAnimation(fig, update, frames=len(rows), blit=False)
-    path = os.path.join(run_dir, file_name)
-    save_output(path, lambda target: anim.save(target, writer=writer, dpi=90 if planar else 80))
+    # The legend below the axes, where the arm never goes.
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.1, 1, 1))
+    fig.set_dpi(90 if planar else 80)
+    ax.title.set_animated(True)
+    canvas = fig.canvas
+    canvas.draw()  # everything that is not animated: the background of every frame
+    background = canvas.copy_from_bbox(fig.bbox)
+    images = []
+    for k in rows:
+        canvas.restore_region(background)
+        set_title(t_f[k])
+        for artist in update(k) + [ax.title]:
+            ax.draw_artist(artist)
+        images.append(np.asarray(canvas.buffer_rgba())[..., :3].copy())
     plt.close(fig)
+    path = os.path.join(run_dir, file_name)
+    save_output(path, lambda target: write_animation(target, images, fps))
     if not quiet:
-        print(f"{len(rows)} frames at {fps} frames/s with {type(writer).__name__}"
-              + ("" if file_name.endswith(".mp4") else " (ffmpeg is not on PATH: a GIF)"))
+        print(f"{len(rows)} frames at {fps} frames/s, " + ("an MP4 (ffmpeg)" if file_name.endswith(".mp4") else
+                                                           "a GIF (ffmpeg is not on PATH)"))
     return path
 
 

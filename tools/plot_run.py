@@ -96,6 +96,39 @@ def joints(summary):
     return len(summary["robot"]["joint_names"])
 
 
+def legend_outside(ax, where="right", ncol=None, fontsize=8):
+    """The axes' legend outside its data: to the right of the axes, or below them (under the x label); tight_layout
+    keeps room for it. None when nothing is labelled."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not handles:
+        return None
+    if where == "below":
+        return ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=fontsize,
+                         ncol=ncol or min(len(handles), 3), frameon=False)
+    return ax.legend(handles, labels, loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=fontsize,
+                     ncol=ncol or max(1, -(-len(handles) // 14)), frameon=False, handlelength=1.5)
+
+
+def shared_legend(fig, axes, ncol=None, fontsize=9):
+    """One legend for the whole figure, below every panel, of the distinct labels of `axes`; returns the figure
+    fraction it takes at the bottom (for tight_layout's rect)."""
+    entries = {}
+    for ax in axes:
+        for h, label in zip(*ax.get_legend_handles_labels()):
+            entries.setdefault(label, h)
+    if not entries:
+        return 0.0
+    legend = fig.legend(list(entries.values()), list(entries.keys()), loc="lower center", fontsize=fontsize,
+                        ncol=ncol or min(len(entries), 4), frameon=False, bbox_to_anchor=(0.5, 0.0))
+    fig.canvas.draw()
+    return float(legend.get_window_extent().height / fig.bbox.height) + 0.01
+
+
+def run_name(summary, run_dir):
+    """The run's name in titles and legends: summary.json's label (the scenario's `label`, default its name)."""
+    return summary.get("label") or summary.get("name") or os.path.basename(os.path.normpath(run_dir))
+
+
 def profiles(ax_v, ax_q, data, n):
     t = data["t"]
     for j in range(1, n + 1):
@@ -105,8 +138,8 @@ def profiles(ax_v, ax_q, data, n):
     ax_v.set_ylabel("rad/s")
     ax_q.set_xlabel("t (s)")
     ax_q.set_ylabel("rad")
-    ax_v.legend(fontsize=7, ncol=2)
-    ax_q.legend(fontsize=7, ncol=2)
+    legend_outside(ax_v)
+    legend_outside(ax_q)
     ax_v.grid(alpha=0.3)
     ax_q.grid(alpha=0.3)
 
@@ -353,7 +386,7 @@ def snapshot_planar(ax, data, summary, frames, duration):
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.legend(fontsize=6, loc="lower right")
+    legend_outside(ax, "below", ncol=2)
 
 
 def zoom_closest(ax, summary, frames, closest):
@@ -424,7 +457,7 @@ def snapshot_spatial(ax, data, summary, frames, duration):
                 label=f"closest approach: t = {t:.2f} s, d = {d * 1000:.1f} mm")
     equal_3d(ax, np.vstack([scene_points(summary, frames, duration),
                             np.column_stack([data["rd_x"], data["rd_y"], data["rd_z"]])]))
-    ax.legend(fontsize=7, loc="upper left")
+    legend_outside(ax, "below", ncol=2)
 
 
 def fig_task(run_dir, data, summary, frames, n, name):
@@ -470,7 +503,7 @@ def fig_task(run_dir, data, summary, frames, n, name):
         ax_b.set_xlabel("t (s)")
         ax_b.set_ylabel("desired displacement (m)")
     ax_b.set_title("(b) end-effector path and trajectory")
-    ax_b.legend(fontsize=8)
+    legend_outside(ax_b, "below", fontsize=8)
     ax_c, ax_d = fig.add_subplot(grid[1, 0:3]), fig.add_subplot(grid[1, 3:6])
     profiles(ax_c, ax_d, data, n)
     ax_c.set_title(r"(c) $\dot\theta$ profiles")
@@ -491,11 +524,12 @@ def joint_panels(run_dir, n, name, title, filename, ylabel, draw):
         ax.set_title(f"({chr(96 + j)}) " + draw(ax, j), fontsize=9)
         ax.set_xlabel("t (s)")
         ax.set_ylabel(ylabel)
-        ax.legend(fontsize=6)
     for k in range(n, rows * cols):
         axes[k // cols][k % cols].axis("off")
     fig.suptitle(f"{name}: {title}")
-    fig.tight_layout()
+    # One legend for every panel, below them (the panels' titles name the joint).
+    bottom = shared_legend(fig, [ax for row in axes for ax in row])
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     save_output(os.path.join(run_dir, filename), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
 
@@ -519,11 +553,11 @@ def fig_angles(run_dir, data, summary, n, name):
 
     def draw(ax, j):
         k = j - 1
-        ax.plot(t, data[f"theta_{j}"], "b", label=rf"$\theta_{j}$")
-        ax.axhline(hi[k], color="r", lw=1, label=r"$\theta^\pm$")
+        ax.plot(t, data[f"theta_{j}"], "b", label=r"joint angle $\theta_j$")
+        ax.axhline(hi[k], color="r", lw=1, label=r"joint limits $\theta_j^\pm$")
         ax.axhline(lo[k], color="r", lw=1)
         if margin[k] > 0:
-            ax.axhspan(hi[k] - margin[k], hi[k], color="r", alpha=0.15, label="safety region")
+            ax.axhspan(hi[k] - margin[k], hi[k], color="r", alpha=0.15, label="safety regions")
             ax.axhspan(lo[k], lo[k] + margin[k], color="r", alpha=0.15)
         return rf"$\theta_{j}$ and limits"
 
@@ -534,10 +568,10 @@ def fig_velocities(run_dir, data, n, name):
     t = data["t"]
 
     def draw(ax, j):
-        ax.plot(t, data[f"theta_dot_{j}"], "b", label=rf"$\dot\theta_{j}$")
+        ax.plot(t, data[f"theta_dot_{j}"], "b", label=r"joint velocity $\dot\theta_j$")
         ax.plot(t, data[f"vel_hi_{j}"], "r", lw=1, label="velocity limits")
         ax.plot(t, data[f"vel_lo_{j}"], "r", lw=1)
-        ax.plot(t, data[f"hi_{j}"], "g--", lw=1, label=r"bounds $\zeta^\pm$")
+        ax.plot(t, data[f"hi_{j}"], "g--", lw=1, label=r"merged bounds $\zeta^\pm$")
         ax.plot(t, data[f"lo_{j}"], "g--", lw=1)
         span = max(np.abs(data[f"vel_hi_{j}"]).max(), np.abs(data[f"vel_lo_{j}"]).max())
         ax.set_ylim(-1.1 * span, 1.1 * span)
@@ -612,7 +646,7 @@ def fig_distances(run_dir, data, summary, name):
     ax.set_ylabel("distance (m)")
     ax.set_title(f"{name}: smallest collision distances")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+    legend_outside(ax)
     fig.tight_layout()
     save_output(os.path.join(run_dir, "fig_collision_distances.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
@@ -643,8 +677,6 @@ def fig_plant(run_dir, data, summary, n, name):
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel(r"$\dot\theta$ (rad/s)")
     axes[1][0].set_ylabel("torque (N m)")
-    axes[0][0].legend(fontsize=6)
-    axes[1][0].legend(fontsize=6)
     for ax in axes[2]:
         ax.remove()
     err = fig.add_subplot(3, 1, 3)
@@ -658,13 +690,14 @@ def fig_plant(run_dir, data, summary, n, name):
     err.set_ylabel("position error (m)")
     err.set_yscale("log" if data["position_error"].max() > 0 else "linear")
     err.grid(alpha=0.3)
-    err.legend(fontsize=7)
+    legend_outside(err)
     ratio = plant.get("max_torque_ratio", 0.0)
     torques = (f"torques (max {100 * ratio:.0f} % of the limit)" if any(x > 0.0 for x in limits)
                else "torques (the robot gives no effort limits)")
     fig.suptitle(f"{name} on MuJoCo ({plant.get('actuator', '')}): velocities, {torques}, "
-                 f"at most {plant.get('max_contacts', 0)} contact(s) at once")
-    fig.tight_layout()
+                 f"at most {plant.get('max_contacts', 0)} contact(s) at once", wrap=True)
+    bottom = shared_legend(fig, [axes[0][0], axes[1][0]], fontsize=8)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     save_output(os.path.join(run_dir, "fig_plant.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
 
@@ -683,7 +716,7 @@ def fig_profiles(run_dir, data, n, name):
 def plot_run(run_dir, quiet):
     data, summary = load(run_dir)
     n = joints(summary)
-    name = summary.get("name", os.path.basename(os.path.normpath(run_dir)))
+    name = run_name(summary, run_dir)
     fig_profiles(run_dir, data, n, name)
     fig_task(run_dir, data, summary, load_frames(run_dir, summary), n, name)
     fig_angles(run_dir, data, summary, n, name)
@@ -780,7 +813,7 @@ def animate_run(run_dir, quiet):
     frames = load_frames(run_dir, summary)
     if frames is None:
         raise SystemExit(f"plot_run.py: --animate: no frames.csv in {run_dir} (runs of redres before it wrote one)")
-    name = summary.get("label", summary.get("name", os.path.basename(os.path.normpath(run_dir))))
+    name = run_name(summary, run_dir)
     t_f, pts, rots = frames
     duration = float(data["t"][-1])
     rows, fps = animation_rows(t_f, duration)
@@ -903,17 +936,85 @@ def animate_run(run_dir, quiet):
     return path
 
 
+# Line styles of the compared runs, the first drawn widest and lowest, so that a curve under another stays visible.
+COMPARE_STYLES = [
+    dict(ls="-", lw=4.0, alpha=0.45, marker=None),
+    dict(ls="--", lw=1.8, alpha=1.0, marker="o"),
+    dict(ls="-.", lw=1.6, alpha=1.0, marker="s"),
+    dict(ls=":", lw=2.0, alpha=1.0, marker="^"),
+    dict(ls=(0, (5, 1, 1, 1, 1, 1)), lw=1.4, alpha=1.0, marker="D"),
+]
+COINCIDE_FRACTION = 2e-3  # two curves coincide where they differ by less than this fraction of w's range
+
+
+def zoom_range(t, curves):
+    """The time range where the compared curves differ: from the start to a little after the last pair of them
+    comes within COINCIDE_FRACTION of w's range and stays there; the whole run when no pair coincides for good (or
+    all do from the start). (t_end, the pairs that coincide for good with the time each starts to)."""
+    values = np.vstack(curves)
+    span = max(float(np.nanmax(values) - np.nanmin(values)), 1e-300)
+    joined = []
+    for a in range(len(curves)):
+        for b in range(a + 1, len(curves)):
+            apart = np.abs(curves[a] - curves[b]) > COINCIDE_FRACTION * span
+            if not apart.any():
+                continue  # the same curve throughout: nothing to zoom on for this pair
+            last = int(np.nonzero(apart)[0][-1])
+            if last < len(t) - 1 and t[last] < 0.9 * t[-1]:
+                joined.append((a, b, float(t[last + 1])))
+    if not joined:
+        return float(t[-1]), []
+    end = float(t[0]) + 1.25 * (max(j[2] for j in joined) - float(t[0]))
+    return min(float(t[-1]), nice_ceiling(end)), joined
+
+
+def nice_ceiling(x):
+    """The smallest of 1, 2, 2.5, 5 times a power of ten that is >= x (x > 0): a round end for the zoom."""
+    if x <= 0:
+        return x
+    scale = 10.0 ** np.floor(np.log10(x))
+    return next(m * scale for m in (1.0, 2.0, 2.5, 5.0, 10.0) if m * scale >= x * (1 - 1e-12))
+
+
 def plot_compare(dirs, out, quiet):
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    """Fig. 5: w of every run over the whole time (a), and zoomed on the time where the curves differ (b)."""
+    runs = []
     for d in dirs:
         data, summary = load(d)
-        ax.plot(data["t"], data["manipulability"], label=summary.get("name", d))
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel(r"$w = \det(JJ^T)$")
-    ax.set_title("Manipulability of the compared schemes")
-    ax.legend()
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
+        runs.append((data["t"], data["manipulability"], run_name(summary, d)))
+    t_common = runs[0][0]
+    same_time = all(len(r[0]) == len(t_common) and np.allclose(r[0], t_common) for r in runs)
+    t_end, joined = zoom_range(t_common, [r[1] for r in runs]) if same_time and len(runs) > 1 else (None, [])
+    zoom = t_end is not None and t_end < 0.9 * float(t_common[-1])
+    fig, axes = plt.subplots(1, 2 if zoom else 1, figsize=(12, 4.8) if zoom else (8, 4.8), squeeze=False)
+    panels = axes[0]
+    for ax in panels:
+        for i, (t, w, label) in enumerate(runs):
+            style = COMPARE_STYLES[i % len(COMPARE_STYLES)]
+            colour = f"C{i % 10}"
+            ax.plot(t, w, color=colour, ls=style["ls"], lw=style["lw"], alpha=style["alpha"], zorder=2 + i,
+                    marker=style["marker"], markevery=(i * 0.03 % 0.09, 0.09), ms=5, mfc="white", mec=colour,
+                    label=label)
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel(r"$w = \det(JJ^T)$")
+        ax.grid(alpha=0.3)
+    panels[0].set_title("(a) the whole run" if zoom else "Manipulability of the compared schemes")
+    if zoom:
+        ax = panels[1]
+        ax.set_xlim(float(t_common[0]), t_end)
+        inside = t_common <= t_end
+        lo = min(float(np.nanmin(w[inside])) for _, w, _ in runs)
+        hi = max(float(np.nanmax(w[inside])) for _, w, _ in runs)
+        pad = 0.05 * max(hi - lo, 1e-12)
+        ax.set_ylim(lo - pad, hi + pad)
+        ax.set_title(f"(b) zoom on t $\\leq$ {t_end:.3g} s, where the schemes differ")
+        panels[0].axvspan(float(t_common[0]), t_end, color="0.85", zorder=0, label=None)
+        notes = [f"{runs[a][2]} and {runs[b][2]} coincide from t $\\approx$ {at:.2g} s" for a, b, at in joined]
+        ax.text(0.98, 0.03, "\n".join(notes), transform=ax.transAxes, ha="right", va="bottom", fontsize=8,
+                bbox=dict(boxstyle="round", fc="white", ec="0.7", alpha=0.9))
+    fig.suptitle("Manipulability of the compared schemes" if zoom else "")
+    bottom = shared_legend(fig, [panels[0]], ncol=min(len(runs), 3), fontsize=10)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     os.makedirs(out, exist_ok=True)
     save_output(os.path.join(out, "fig5_manipulability.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)

@@ -109,7 +109,7 @@ def main():
     image = ax.imshow(np.ma.masked_invalid(value), origin="lower", aspect="auto", cmap="viridis")
     fig.colorbar(image, ax=ax, label=args.value)
     bad_i, bad_j = np.nonzero((ran == 0) & (total > 0))
-    ax.scatter(bad_j, bad_i, marker="x", color="crimson", s=36, label="did not run through (failed steps or error)")
+    ax.scatter(bad_j, bad_i, marker="x", color="crimson", s=36)
     ax.set_xticks(range(len(xs)), tick_labels(xs), rotation=90 if len(xs) > 12 else 0,
                   fontsize=7 if len(xs) > 12 else 9)
     ax.set_yticks(range(len(ys)), tick_labels(ys), fontsize=7 if len(ys) > 20 else 9)
@@ -121,13 +121,11 @@ def main():
     if os.path.isfile(meta):
         with open(meta) as f:
             name = json.load(f).get("name", name)
-    # The title wrapped to the figure's width (a long sweep name would be cut otherwise).
-    fig.suptitle(wrapped(f"{name}: {args.value} ({len(rows)} variations, {failed} did not run through)", width, 10),
-                 fontsize=10)
-    if len(bad_i):
-        # Below the x axis' label (rotated tick labels are taller), outside the cells.
-        below = -0.32 if len(xs) > 12 else -0.2
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, below), fontsize=8, frameon=False)
+    # The title wrapped to the figure's width (a long sweep name would be cut otherwise); it also says what the
+    # crosses mean (a legend would cover cells or leave a gap).
+    marks = ", marked x (failed steps or error)" if len(bad_i) else ""
+    fig.suptitle(wrapped(f"{name}: {args.value}", width, 10) + "\n" +
+                 wrapped(f"{len(rows)} variations, {failed} did not run through{marks}", width, 9), fontsize=10)
     out = args.out or os.path.join(args.sweep_dir, "sweep_heatmap.png")
     try:
         save_output(out, lambda target: fig.savefig(target, dpi=120))

@@ -33,6 +33,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 
 from redres_output import OutputError, save_output  # noqa: E402  (beside this script)
 
@@ -783,18 +784,27 @@ class PlanarSection:
             self.artist.set_xy(poly)
 
 
-def write_animation(path, images, fps):
-    """The frames (h x w x 3 uint8 arrays) as an MP4 (ffmpeg on PATH: H.264 from raw RGB frames on its stdin) or a
-    GIF (Pillow), as the file name says."""
+def write_animation(path, images, fps, size):
+    """The frames (an iterable of h x w x 3 uint8 arrays, size = (w, h)) as an MP4 (ffmpeg on PATH: H.264 from raw
+    RGB frames streamed to its stdin) or a GIF (Pillow), as the file name says."""
     if path.endswith(".mp4"):
-        h, w = images[0].shape[:2]
+        w, h = size
         command = [shutil.which("ffmpeg"), "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s",
                    f"{w}x{h}", "-r", str(fps), "-i", "-", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-vcodec", "libx264",
                    "-pix_fmt", "yuv420p", "-b:v", "1800k", path]
-        with subprocess.Popen(command, stdin=subprocess.PIPE, stderr=subprocess.PIPE) as ffmpeg:
-            _, err = ffmpeg.communicate(b"".join(image.tobytes() for image in images))
-        if ffmpeg.returncode != 0:
-            raise RuntimeError(f"ffmpeg failed (exit code {ffmpeg.returncode}): {err.decode(errors='replace').strip()}")
+        with tempfile.TemporaryFile() as log:
+            with subprocess.Popen(command, stdin=subprocess.PIPE, stderr=log) as ffmpeg:
+                try:
+                    for image in images:
+                        ffmpeg.stdin.write(image.tobytes())
+                except BrokenPipeError:
+                    pass  # ffmpeg stopped: its exit code and message say why
+                finally:
+                    ffmpeg.stdin.close()
+            if ffmpeg.returncode != 0:
+                log.seek(0)
+                raise RuntimeError(f"ffmpeg failed (exit code {ffmpeg.returncode}): "
+                                   f"{log.read().decode(errors='replace').strip()}")
         return
     from PIL import Image  # Pillow comes with matplotlib
 
@@ -920,16 +930,21 @@ def animate_run(run_dir, quiet):
     canvas = fig.canvas
     canvas.draw()  # everything that is not animated: the background of every frame
     background = canvas.copy_from_bbox(fig.bbox)
-    images = []
-    for k in rows:
-        canvas.restore_region(background)
-        set_title(t_f[k])
-        for artist in update(k) + [ax.title]:
-            ax.draw_artist(artist)
-        images.append(np.asarray(canvas.buffer_rgba())[..., :3].copy())
-    plt.close(fig)
+    size = canvas.get_width_height()
+
+    def images():  # the frames, drawn as the writer takes them
+        for k in rows:
+            canvas.restore_region(background)
+            set_title(t_f[k])
+            for artist in update(k) + [ax.title]:
+                ax.draw_artist(artist)
+            yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
+
     path = os.path.join(run_dir, file_name)
-    save_output(path, lambda target: write_animation(target, images, fps))
+    try:
+        save_output(path, lambda target: write_animation(target, images(), fps, size))
+    finally:
+        plt.close(fig)
     if not quiet:
         print(f"{len(rows)} frames at {fps} frames/s, " + ("an MP4 (ffmpeg)" if file_name.endswith(".mp4") else
                                                            "a GIF (ffmpeg is not on PATH)"))
@@ -1049,6 +1064,6 @@ def main():
 if __name__ == "__main__":
     try:
         sys.exit(main())
-    except OutputError as e:
+    except (OutputError, RuntimeError) as e:  # RuntimeError: ffmpeg failed
         print(f"plot_run.py: {e}", file=sys.stderr)
         sys.exit(2)

@@ -591,7 +591,7 @@ def fig_accelerations(run_dir, data, n, name):
     t = data["t"]
 
     def draw(ax, j):
-        ax.plot(t, data[f"theta_ddot_{j}"], "b", lw=0.8, label=rf"$\ddot\theta_{j}$ commanded")
+        ax.plot(t, data[f"theta_ddot_{j}"], "b", lw=0.8, label=r"commanded joint acceleration $\ddot\theta_j$")
         ax.plot(t, data[f"acc_hi_{j}"], "r", lw=1, label="acceleration limits")
         ax.plot(t, data[f"acc_lo_{j}"], "r", lw=1)
         span = max(np.abs(data[f"acc_hi_{j}"]).max(), np.abs(data[f"acc_lo_{j}"]).max())

@@ -73,7 +73,8 @@ def check_figures(out, want):
     written = {p.name: png_size(p) for p in pathlib.Path(out).glob("*.png")}
     assert sorted(written) == sorted(want), f"figures in {out}"
     for name, size in want.items():
-        assert written[name] == size, f"{name}: {written[name][0]} x {written[name][1]} px, expected {size[0]} x {size[1]}"
+        (w, h), (want_w, want_h) = written[name], size
+        assert (w, h) == (want_w, want_h), f"{name}: {w} x {h} px, expected {want_w} x {want_h}"
 
 
 def test_a_planar_run_with_an_obstacle_writes_its_figures_at_their_sizes(tmp_path):

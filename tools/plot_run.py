@@ -16,9 +16,11 @@ Per run:
   fig9b_position_error.png  the position error over time (and the orientation error, for pose tasks)
   fig_collision_distances.png  (runs with obstacle_avoidance or self_collision) the smallest distances over time,
                             with each plugin's safety and influence distances
-With --animate: animation.mp4 (matplotlib's FFMpegWriter) when ffmpeg is on PATH, else animation.gif (PillowWriter),
-at most MAX_ANIMATION_FRAMES frames: the arm (and its collision shapes when there are obstacles), the obstacles where
-they are at each time, the end-effector trail and the desired path.
+With --animate: animation.mp4 (H.264 by ffmpeg) when ffmpeg is on PATH, else animation.gif (Pillow): the arm (and
+its collision shapes when there are obstacles), the obstacles where they are at each time, the end-effector trail and
+the desired path; about ANIMATION_FPS frames per second of the run, at least MIN_ANIMATION_FRAMES (or every row of
+frames.csv) and at most MAX_ANIMATION_FRAMES. The frames are drawn by blitting (the still parts once), so a short run
+takes a few seconds.
 
 The arm is drawn from frames.csv (joint frames computed by redres, so no kinematics here) and the obstacles and link
 shapes from summary.json (docs/output_formats.md). Uses matplotlib and numpy (Debian: python3-matplotlib,
@@ -29,7 +31,9 @@ import argparse
 import json
 import os
 import shutil
+import subprocess
 import sys
+import tempfile
 
 from redres_output import OutputError, save_output  # noqa: E402  (beside this script)
 
@@ -37,11 +41,12 @@ from redres_output import OutputError, save_output  # noqa: E402  (beside this s
 # failed plot; the check costs nothing, as the figures need these imports anyway.
 EXIT_MISSING_LIBRARY = 3
 MAX_ANIMATION_FRAMES = 240
+MIN_ANIMATION_FRAMES = 30
+ANIMATION_FPS = 12
 try:
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.animation  # noqa: E402
     import matplotlib.patches  # noqa: E402
     import matplotlib.pyplot as plt  # noqa: E402
     import numpy as np  # noqa: E402
@@ -92,6 +97,39 @@ def joints(summary):
     return len(summary["robot"]["joint_names"])
 
 
+def legend_outside(ax, where="right", ncol=None, fontsize=8):
+    """The axes' legend outside its data: to the right of the axes, or below them (under the x label); tight_layout
+    keeps room for it. None when nothing is labelled."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not handles:
+        return None
+    if where == "below":
+        return ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=fontsize,
+                         ncol=ncol or min(len(handles), 3), frameon=False)
+    return ax.legend(handles, labels, loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=fontsize,
+                     ncol=ncol or max(1, -(-len(handles) // 14)), frameon=False, handlelength=1.5)
+
+
+def shared_legend(fig, axes, ncol=None, fontsize=9):
+    """One legend for the whole figure, below every panel, of the distinct labels of `axes`; returns the figure
+    fraction it takes at the bottom (for tight_layout's rect)."""
+    entries = {}
+    for ax in axes:
+        for h, label in zip(*ax.get_legend_handles_labels()):
+            entries.setdefault(label, h)
+    if not entries:
+        return 0.0
+    legend = fig.legend(list(entries.values()), list(entries.keys()), loc="lower center", fontsize=fontsize,
+                        ncol=ncol or min(len(entries), 4), frameon=False, bbox_to_anchor=(0.5, 0.0))
+    fig.canvas.draw()
+    return float(legend.get_window_extent().height / fig.bbox.height) + 0.01
+
+
+def run_name(summary, run_dir):
+    """The run's name in titles and legends: summary.json's label (the scenario's `label`, default its name)."""
+    return summary.get("label") or summary.get("name") or os.path.basename(os.path.normpath(run_dir))
+
+
 def profiles(ax_v, ax_q, data, n):
     t = data["t"]
     for j in range(1, n + 1):
@@ -101,8 +139,8 @@ def profiles(ax_v, ax_q, data, n):
     ax_v.set_ylabel("rad/s")
     ax_q.set_xlabel("t (s)")
     ax_q.set_ylabel("rad")
-    ax_v.legend(fontsize=7, ncol=2)
-    ax_q.legend(fontsize=7, ncol=2)
+    legend_outside(ax_v)
+    legend_outside(ax_q)
     ax_v.grid(alpha=0.3)
     ax_q.grid(alpha=0.3)
 
@@ -349,7 +387,7 @@ def snapshot_planar(ax, data, summary, frames, duration):
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.legend(fontsize=6, loc="lower right")
+    legend_outside(ax, "below", ncol=2)
 
 
 def zoom_closest(ax, summary, frames, closest):
@@ -420,7 +458,7 @@ def snapshot_spatial(ax, data, summary, frames, duration):
                 label=f"closest approach: t = {t:.2f} s, d = {d * 1000:.1f} mm")
     equal_3d(ax, np.vstack([scene_points(summary, frames, duration),
                             np.column_stack([data["rd_x"], data["rd_y"], data["rd_z"]])]))
-    ax.legend(fontsize=7, loc="upper left")
+    legend_outside(ax, "below", ncol=2)
 
 
 def fig_task(run_dir, data, summary, frames, n, name):
@@ -466,7 +504,7 @@ def fig_task(run_dir, data, summary, frames, n, name):
         ax_b.set_xlabel("t (s)")
         ax_b.set_ylabel("desired displacement (m)")
     ax_b.set_title("(b) end-effector path and trajectory")
-    ax_b.legend(fontsize=8)
+    legend_outside(ax_b, "below", fontsize=8)
     ax_c, ax_d = fig.add_subplot(grid[1, 0:3]), fig.add_subplot(grid[1, 3:6])
     profiles(ax_c, ax_d, data, n)
     ax_c.set_title(r"(c) $\dot\theta$ profiles")
@@ -487,11 +525,12 @@ def joint_panels(run_dir, n, name, title, filename, ylabel, draw):
         ax.set_title(f"({chr(96 + j)}) " + draw(ax, j), fontsize=9)
         ax.set_xlabel("t (s)")
         ax.set_ylabel(ylabel)
-        ax.legend(fontsize=6)
     for k in range(n, rows * cols):
         axes[k // cols][k % cols].axis("off")
     fig.suptitle(f"{name}: {title}")
-    fig.tight_layout()
+    # One legend for every panel, below them (the panels' titles name the joint).
+    bottom = shared_legend(fig, [ax for row in axes for ax in row])
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     save_output(os.path.join(run_dir, filename), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
 
@@ -515,11 +554,11 @@ def fig_angles(run_dir, data, summary, n, name):
 
     def draw(ax, j):
         k = j - 1
-        ax.plot(t, data[f"theta_{j}"], "b", label=rf"$\theta_{j}$")
-        ax.axhline(hi[k], color="r", lw=1, label=r"$\theta^\pm$")
+        ax.plot(t, data[f"theta_{j}"], "b", label=r"joint angle $\theta_j$")
+        ax.axhline(hi[k], color="r", lw=1, label=r"joint limits $\theta_j^\pm$")
         ax.axhline(lo[k], color="r", lw=1)
         if margin[k] > 0:
-            ax.axhspan(hi[k] - margin[k], hi[k], color="r", alpha=0.15, label="safety region")
+            ax.axhspan(hi[k] - margin[k], hi[k], color="r", alpha=0.15, label="safety regions")
             ax.axhspan(lo[k], lo[k] + margin[k], color="r", alpha=0.15)
         return rf"$\theta_{j}$ and limits"
 
@@ -530,10 +569,10 @@ def fig_velocities(run_dir, data, n, name):
     t = data["t"]
 
     def draw(ax, j):
-        ax.plot(t, data[f"theta_dot_{j}"], "b", label=rf"$\dot\theta_{j}$")
+        ax.plot(t, data[f"theta_dot_{j}"], "b", label=r"joint velocity $\dot\theta_j$")
         ax.plot(t, data[f"vel_hi_{j}"], "r", lw=1, label="velocity limits")
         ax.plot(t, data[f"vel_lo_{j}"], "r", lw=1)
-        ax.plot(t, data[f"hi_{j}"], "g--", lw=1, label=r"bounds $\zeta^\pm$")
+        ax.plot(t, data[f"hi_{j}"], "g--", lw=1, label=r"merged bounds $\zeta^\pm$")
         ax.plot(t, data[f"lo_{j}"], "g--", lw=1)
         span = max(np.abs(data[f"vel_hi_{j}"]).max(), np.abs(data[f"vel_lo_{j}"]).max())
         ax.set_ylim(-1.1 * span, 1.1 * span)
@@ -552,7 +591,7 @@ def fig_accelerations(run_dir, data, n, name):
     t = data["t"]
 
     def draw(ax, j):
-        ax.plot(t, data[f"theta_ddot_{j}"], "b", lw=0.8, label=rf"$\ddot\theta_{j}$ commanded")
+        ax.plot(t, data[f"theta_ddot_{j}"], "b", lw=0.8, label=r"commanded joint acceleration $\ddot\theta_j$")
         ax.plot(t, data[f"acc_hi_{j}"], "r", lw=1, label="acceleration limits")
         ax.plot(t, data[f"acc_lo_{j}"], "r", lw=1)
         span = max(np.abs(data[f"acc_hi_{j}"]).max(), np.abs(data[f"acc_lo_{j}"]).max())
@@ -608,7 +647,7 @@ def fig_distances(run_dir, data, summary, name):
     ax.set_ylabel("distance (m)")
     ax.set_title(f"{name}: smallest collision distances")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+    legend_outside(ax)
     fig.tight_layout()
     save_output(os.path.join(run_dir, "fig_collision_distances.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
@@ -639,8 +678,6 @@ def fig_plant(run_dir, data, summary, n, name):
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel(r"$\dot\theta$ (rad/s)")
     axes[1][0].set_ylabel("torque (N m)")
-    axes[0][0].legend(fontsize=6)
-    axes[1][0].legend(fontsize=6)
     for ax in axes[2]:
         ax.remove()
     err = fig.add_subplot(3, 1, 3)
@@ -654,13 +691,14 @@ def fig_plant(run_dir, data, summary, n, name):
     err.set_ylabel("position error (m)")
     err.set_yscale("log" if data["position_error"].max() > 0 else "linear")
     err.grid(alpha=0.3)
-    err.legend(fontsize=7)
+    legend_outside(err)
     ratio = plant.get("max_torque_ratio", 0.0)
     torques = (f"torques (max {100 * ratio:.0f} % of the limit)" if any(x > 0.0 for x in limits)
                else "torques (the robot gives no effort limits)")
     fig.suptitle(f"{name} on MuJoCo ({plant.get('actuator', '')}): velocities, {torques}, "
-                 f"at most {plant.get('max_contacts', 0)} contact(s) at once")
-    fig.tight_layout()
+                 f"at most {plant.get('max_contacts', 0)} contact(s) at once", wrap=True)
+    bottom = shared_legend(fig, [axes[0][0], axes[1][0]], fontsize=8)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     save_output(os.path.join(run_dir, "fig_plant.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
 
@@ -679,7 +717,7 @@ def fig_profiles(run_dir, data, n, name):
 def plot_run(run_dir, quiet):
     data, summary = load(run_dir)
     n = joints(summary)
-    name = summary.get("name", os.path.basename(os.path.normpath(run_dir)))
+    name = run_name(summary, run_dir)
     fig_profiles(run_dir, data, n, name)
     fig_task(run_dir, data, summary, load_frames(run_dir, summary), n, name)
     fig_angles(run_dir, data, summary, n, name)
@@ -692,27 +730,103 @@ def plot_run(run_dir, quiet):
         print(f"figures written to {run_dir}")
 
 
-def animation_writer(fps):
-    """(writer, file name): FFMpegWriter to animation.mp4 when ffmpeg is on PATH, else PillowWriter to
-    animation.gif (Pillow is a dependency of matplotlib, so the GIF can always be made)."""
-    if shutil.which("ffmpeg"):
-        return matplotlib.animation.FFMpegWriter(fps=fps, bitrate=1800), "animation.mp4"
-    return matplotlib.animation.PillowWriter(fps=fps), "animation.gif"
+def animation_rows(t_f, duration):
+    """The rows of frames.csv that become frames, and the frame rate: about ANIMATION_FPS frames per second of the run
+    (real time), at least MIN_ANIMATION_FRAMES (or every row, when there are fewer) and at most MAX_ANIMATION_FRAMES
+    (longer runs play faster, never below 4 frames per second)."""
+    wanted = int(np.clip(round(ANIMATION_FPS * duration), MIN_ANIMATION_FRAMES, MAX_ANIMATION_FRAMES))
+    rows = np.unique(np.linspace(0, len(t_f) - 1, min(len(t_f), wanted)).round().astype(int))
+    fps = int(np.clip(round(len(rows) / max(duration, 1e-9)), 4, 25)) if duration > 0 else 10
+    return rows, fps
+
+
+class SectionCache:
+    """A shape's z = 0 section, computed once and moved rigidly while the shape only turns about z and moves in x and
+    y (a planar arm's links, an obstacle moving in the plane); computed anew otherwise."""
+
+    def __init__(self, shape):
+        self.shape = shape
+        self.reference = None  # (p, R, section) of the last computation
+
+    def polygon(self, p, R):
+        if self.reference is not None:
+            p0, R0, poly0 = self.reference
+            turn = R @ R0.T
+            if abs(p[2] - p0[2]) <= 1e-12 and abs(turn[2, 2] - 1.0) <= 1e-12:
+                return None if poly0 is None else (poly0 - p0[:2]) @ turn[:2, :2].T + p[:2]
+        poly = plane_section(self.shape, p, R)
+        self.reference = (np.array(p), np.array(R), poly)
+        return poly
+
+
+class PlanarSection:
+    """The artist of one shape's section on 2-D axes, updated in place each frame (hidden where the shape misses the
+    plane); clouds are a scatter of the cells near the plane."""
+
+    def __init__(self, ax, shape, **style):
+        self.shape, self.cache = shape, SectionCache(shape)
+        if is_cloud(shape):
+            self.artist = ax.scatter([], [], s=2, marker="s", color=style.get("facecolor", "grey"), animated=True)
+        else:
+            self.artist = matplotlib.patches.Polygon(np.zeros((3, 2)), closed=True, animated=True, **style)
+            ax.add_patch(self.artist)
+
+    def update(self, p, R):
+        if is_cloud(self.shape):
+            centres, edges = cloud_cells(self.shape, p, R)
+            near = np.abs(centres[:, 2]) <= 0.5 * edges + self.shape.get("radius", 0.0)
+            self.artist.set_offsets(centres[near, :2] if near.any() else np.zeros((0, 2)))
+            self.artist.set_visible(bool(near.any()))
+            return
+        poly = self.cache.polygon(p, R)
+        self.artist.set_visible(poly is not None)
+        if poly is not None:
+            self.artist.set_xy(poly)
+
+
+def write_animation(path, images, fps, size):
+    """The frames (an iterable of h x w x 3 uint8 arrays, size = (w, h)) as an MP4 (ffmpeg on PATH: H.264 from raw
+    RGB frames streamed to its stdin) or a GIF (Pillow), as the file name says."""
+    if path.endswith(".mp4"):
+        w, h = size
+        command = [shutil.which("ffmpeg"), "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s",
+                   f"{w}x{h}", "-r", str(fps), "-i", "-", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-vcodec", "libx264",
+                   "-pix_fmt", "yuv420p", "-b:v", "1800k", path]
+        with tempfile.TemporaryFile() as log:
+            with subprocess.Popen(command, stdin=subprocess.PIPE, stderr=log) as ffmpeg:
+                try:
+                    for image in images:
+                        ffmpeg.stdin.write(image.tobytes())
+                except BrokenPipeError:
+                    pass  # ffmpeg stopped: its exit code and message say why
+                finally:
+                    ffmpeg.stdin.close()
+            if ffmpeg.returncode != 0:
+                log.seek(0)
+                raise RuntimeError(f"ffmpeg failed (exit code {ffmpeg.returncode}): "
+                                   f"{log.read().decode(errors='replace').strip()}")
+        return
+    from PIL import Image  # Pillow comes with matplotlib
+
+    frames = [Image.fromarray(image) for image in images]
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=int(round(1000 / fps)), loop=0)
 
 
 def animate_run(run_dir, quiet):
     """The arm, its collision shapes (when there are obstacles), the obstacles where they are, the end-effector
-    trail and the desired path, over the run: animation.mp4 or animation.gif in run_dir."""
+    trail and the desired path, over the run: animation.mp4 or animation.gif in run_dir.
+
+    Fast: what does not move (axes, path, legend, fixed obstacles) is drawn once; each frame restores that background
+    and draws only the moving artists (arm, trail, sections or moving obstacles, title) into the canvas, whose pixels
+    are the frame (blitting); the frames are then written in one go."""
     data, summary = load(run_dir)
     frames = load_frames(run_dir, summary)
     if frames is None:
         raise SystemExit(f"plot_run.py: --animate: no frames.csv in {run_dir} (runs of redres before it wrote one)")
-    name = summary.get("name", os.path.basename(os.path.normpath(run_dir)))
+    name = run_name(summary, run_dir)
     t_f, pts, rots = frames
     duration = float(data["t"][-1])
-    rows = np.unique(np.linspace(0, len(t_f) - 1, min(len(t_f), MAX_ANIMATION_FRAMES)).round().astype(int))
-    # About real time for runs of 6 to 24 s, faster for longer ones, never below 4 frames per second.
-    fps = int(np.clip(round(len(rows) / max(duration, 1e-9)), 4, 25)) if duration > 0 else 10
+    rows, fps = animation_rows(t_f, duration)
     planar = summary["robot"]["kind"] == "planar"
     obs = obstacles(summary)
     shapes = bool(obs) and bool(summary["robot"].get("link_shapes"))
@@ -725,13 +839,13 @@ def animate_run(run_dir, quiet):
         k = int(np.argmin(np.abs(t_data - t)))
         return min(float(data[c][k]) for c in distance_columns)
 
-    writer, file_name = animation_writer(fps)
+    file_name = "animation.mp4" if shutil.which("ffmpeg") else "animation.gif"
     fig = plt.figure(figsize=(6.4, 6.0))
     if planar:
         ax = fig.add_subplot(1, 1, 1)
         ax.plot(data["rd_x"], data["rd_y"], "b-", lw=3, alpha=0.25, label="desired path")
-        (trail,) = ax.plot([], [], "r", lw=1.2, label="end-effector trajectory")
-        (arm,) = ax.plot([], [], "-o", color="k", lw=2, ms=4, label="arm")
+        (trail,) = ax.plot([], [], "r", lw=1.2, label="end-effector trajectory", animated=True)
+        (arm,) = ax.plot([], [], "-o", color="k", lw=2, ms=4, label="arm", animated=True, zorder=3)
         all_pts = [pts[:, :, :2].reshape(-1, 2), np.column_stack([data["rd_x"], data["rd_y"]])]
         for o in obs:
             r = bounding_radius(o)
@@ -755,47 +869,36 @@ def animate_run(run_dir, quiet):
         ax.grid(alpha=0.3)
         if obs:
             ax.plot([], [], "s", color=OBSTACLE_COLOUR, label="obstacles")
-        ax.legend(fontsize=7, loc="upper right")
-        dynamic = []  # patches redrawn every frame
+        obstacle_sections = [PlanarSection(ax, o, facecolor=OBSTACLE_COLOUR, edgecolor="k", lw=0.6, alpha=0.8)
+                             for o in obs]
+        link_sections = [PlanarSection(ax, shape, facecolor=CLOSEST_COLOUR, edgecolor=CLOSEST_COLOUR, lw=0.5,
+                                       alpha=0.25) for shape in summary["robot"]["link_shapes"]] if shapes else []
 
-        def update(i):
-            k = rows[i]
+        def update(k):
             t = t_f[k]
-            for artist in dynamic:
-                artist.remove()
-            dynamic.clear()
-            for o in obs:
-                patch = draw_section(ax, o, *obstacle_pose(o, t), facecolor=OBSTACLE_COLOUR, edgecolor="k", lw=0.6,
-                                     alpha=0.8)
-                if patch is not None:
-                    dynamic.append(patch)
-            if shapes:
-                for shape, p, R in link_shape_poses(summary, rots[k], pts[k]):
-                    patch = draw_section(ax, shape, p, R, facecolor=CLOSEST_COLOUR, edgecolor=CLOSEST_COLOUR,
-                                         lw=0.5, alpha=0.25)
-                    if patch is not None:
-                        dynamic.append(patch)
+            for section, o in zip(obstacle_sections, obs):
+                section.update(*obstacle_pose(o, t))
+            for section, (_, p, R) in zip(link_sections, link_shape_poses(summary, rots[k], pts[k])):
+                section.update(p, R)
             arm.set_data(pts[k, :, 0], pts[k, :, 1])
             shown = t_data <= t + 1e-12
             trail.set_data(data["r_x"][shown], data["r_y"][shown])
-            set_title(t)
+            return [s.artist for s in obstacle_sections + link_sections if s.artist.get_visible()] + [trail, arm]
     else:
         ax = fig.add_subplot(1, 1, 1, projection="3d")
         ax.plot(data["rd_x"], data["rd_y"], data["rd_z"], "b-", lw=3, alpha=0.25, label="desired path")
-        (trail,) = ax.plot([], [], [], "r", lw=1.2, label="end-effector trajectory")
-        (arm,) = ax.plot([], [], [], "-o", color="k", lw=3, ms=4, label="arm")
+        (trail,) = ax.plot([], [], [], "r", lw=1.2, label="end-effector trajectory", animated=True)
+        (arm,) = ax.plot([], [], [], "-o", color="k", lw=3, ms=4, label="arm", animated=True)
         equal_3d(ax, np.vstack([scene_points(summary, frames, duration),
                                 np.column_stack([data["rd_x"], data["rd_y"], data["rd_z"]])]))
         if obs:
             ax.plot([], [], "s", color=OBSTACLE_COLOUR, label="obstacles")
-        ax.legend(fontsize=7, loc="upper left")
-        static = [o for o in obs if not moving(o)]
-        for o in static:
-            draw_solid(ax, o, *obstacle_pose(o, 0.0), OBSTACLE_COLOUR, 0.5)
-        dynamic = []
+        for o in obs:
+            if not moving(o):
+                draw_solid(ax, o, *obstacle_pose(o, 0.0), OBSTACLE_COLOUR, 0.5)
+        dynamic = []  # moving obstacles: drawn anew each frame
 
-        def update(i):
-            k = rows[i]
+        def update(k):
             t = t_f[k]
             for artist in dynamic:
                 artist.remove()
@@ -803,10 +906,14 @@ def animate_run(run_dir, quiet):
             for o in obs:
                 if moving(o):
                     dynamic.extend(draw_solid(ax, o, *obstacle_pose(o, t), OBSTACLE_COLOUR, 0.5))
+            for artist in dynamic:
+                artist.set_animated(True)
+                if hasattr(artist, "do_3d_projection"):
+                    artist.do_3d_projection()  # what the 3-D axes' draw does for its collections
             arm.set_data_3d(pts[k, :, 0], pts[k, :, 1], pts[k, :, 2])
             shown = t_data <= t + 1e-12
             trail.set_data_3d(data["r_x"][shown], data["r_y"][shown], data["r_z"][shown])
-            set_title(t)
+            return dynamic + [trail, arm]
 
     def set_title(t):
         d = min_distance(t)
@@ -814,28 +921,115 @@ def animate_run(run_dir, quiet):
         ax.set_title(f"{name}: t = {t:.2f} s{extra}", fontsize=9)
 
     set_title(t_f[rows[0]])  # before the layout, so that it keeps room for the title
-    fig.tight_layout()
-    anim = matplotlib.animation.FuncAnimation(fig, update, frames=len(rows), blit=False)
+    # The legend below the axes, where the arm never goes.
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.1, 1, 1))
+    fig.set_dpi(90 if planar else 80)
+    ax.title.set_animated(True)
+    canvas = fig.canvas
+    canvas.draw()  # everything that is not animated: the background of every frame
+    background = canvas.copy_from_bbox(fig.bbox)
+    size = canvas.get_width_height()
+
+    def images():  # the frames, drawn as the writer takes them
+        for k in rows:
+            canvas.restore_region(background)
+            set_title(t_f[k])
+            for artist in update(k) + [ax.title]:
+                ax.draw_artist(artist)
+            yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
+
     path = os.path.join(run_dir, file_name)
-    save_output(path, lambda target: anim.save(target, writer=writer, dpi=90 if planar else 80))
-    plt.close(fig)
+    try:
+        save_output(path, lambda target: write_animation(target, images(), fps, size))
+    finally:
+        plt.close(fig)
     if not quiet:
-        print(f"{len(rows)} frames at {fps} frames/s with {type(writer).__name__}"
-              + ("" if file_name.endswith(".mp4") else " (ffmpeg is not on PATH: a GIF)"))
+        print(f"{len(rows)} frames at {fps} frames/s, " + ("an MP4 (ffmpeg)" if file_name.endswith(".mp4") else
+                                                           "a GIF (ffmpeg is not on PATH)"))
     return path
 
 
+# Line styles of the compared runs, the first drawn widest and lowest, so that a curve under another stays visible.
+COMPARE_STYLES = [
+    dict(ls="-", lw=4.0, alpha=0.45, marker=None),
+    dict(ls="--", lw=1.8, alpha=1.0, marker="o"),
+    dict(ls="-.", lw=1.6, alpha=1.0, marker="s"),
+    dict(ls=":", lw=2.0, alpha=1.0, marker="^"),
+    dict(ls=(0, (5, 1, 1, 1, 1, 1)), lw=1.4, alpha=1.0, marker="D"),
+]
+COINCIDE_FRACTION = 2e-3  # two curves coincide where they differ by less than this fraction of w's range
+
+
+def zoom_range(t, curves):
+    """The time range where the compared curves differ: from the start to a little after the last pair of them
+    comes within COINCIDE_FRACTION of w's range and stays there; the whole run when no pair coincides for good (or
+    all do from the start). (t_end, the pairs that coincide for good with the time each starts to)."""
+    values = np.vstack(curves)
+    span = max(float(np.nanmax(values) - np.nanmin(values)), 1e-300)
+    joined = []
+    for a in range(len(curves)):
+        for b in range(a + 1, len(curves)):
+            apart = np.abs(curves[a] - curves[b]) > COINCIDE_FRACTION * span
+            if not apart.any():
+                continue  # the same curve throughout: nothing to zoom on for this pair
+            last = int(np.nonzero(apart)[0][-1])
+            if last < len(t) - 1 and t[last] < 0.9 * t[-1]:
+                joined.append((a, b, float(t[last + 1])))
+    if not joined:
+        return float(t[-1]), []
+    end = float(t[0]) + 1.25 * (max(j[2] for j in joined) - float(t[0]))
+    return min(float(t[-1]), nice_ceiling(end)), joined
+
+
+def nice_ceiling(x):
+    """The smallest of 1, 2, 2.5, 5 times a power of ten that is >= x (x > 0): a round end for the zoom."""
+    if x <= 0:
+        return x
+    scale = 10.0 ** np.floor(np.log10(x))
+    return next(m * scale for m in (1.0, 2.0, 2.5, 5.0, 10.0) if m * scale >= x * (1 - 1e-12))
+
+
 def plot_compare(dirs, out, quiet):
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    """Fig. 5: w of every run over the whole time (a), and zoomed on the time where the curves differ (b)."""
+    runs = []
     for d in dirs:
         data, summary = load(d)
-        ax.plot(data["t"], data["manipulability"], label=summary.get("name", d))
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel(r"$w = \det(JJ^T)$")
-    ax.set_title("Manipulability of the compared schemes")
-    ax.legend()
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
+        runs.append((data["t"], data["manipulability"], run_name(summary, d)))
+    t_common = runs[0][0]
+    same_time = all(len(r[0]) == len(t_common) and np.allclose(r[0], t_common) for r in runs)
+    t_end, joined = zoom_range(t_common, [r[1] for r in runs]) if same_time and len(runs) > 1 else (None, [])
+    zoom = t_end is not None and t_end < 0.9 * float(t_common[-1])
+    fig, axes = plt.subplots(1, 2 if zoom else 1, figsize=(12, 4.8) if zoom else (8, 4.8), squeeze=False)
+    panels = axes[0]
+    for ax in panels:
+        for i, (t, w, label) in enumerate(runs):
+            style = COMPARE_STYLES[i % len(COMPARE_STYLES)]
+            colour = f"C{i % 10}"
+            ax.plot(t, w, color=colour, ls=style["ls"], lw=style["lw"], alpha=style["alpha"], zorder=2 + i,
+                    marker=style["marker"], markevery=(i * 0.03 % 0.09, 0.09), ms=5, mfc="white", mec=colour,
+                    label=label)
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel(r"$w = \det(JJ^T)$")
+        ax.grid(alpha=0.3)
+    panels[0].set_title("(a) the whole run" if zoom else "Manipulability of the compared schemes")
+    if zoom:
+        ax = panels[1]
+        ax.set_xlim(float(t_common[0]), t_end)
+        inside = t_common <= t_end
+        lo = min(float(np.nanmin(w[inside])) for _, w, _ in runs)
+        hi = max(float(np.nanmax(w[inside])) for _, w, _ in runs)
+        pad = 0.05 * max(hi - lo, 1e-12)
+        ax.set_ylim(lo - pad, hi + pad)
+        ax.set_title(f"(b) zoom on t $\\leq$ {t_end:.3g} s, where the schemes differ")
+        panels[0].axvspan(float(t_common[0]), t_end, color="0.85", zorder=0, label=None)
+        notes = [f"{runs[a][2]} and {runs[b][2]} coincide from t $\\approx$ {at:.2g} s" for a, b, at in joined]
+        ax.text(0.98, 0.03, "\n".join(notes), transform=ax.transAxes, ha="right", va="bottom", fontsize=8,
+                bbox=dict(boxstyle="round", fc="white", ec="0.7", alpha=0.9))
+    fig.suptitle("Manipulability of the compared schemes" if zoom else "")
+    bottom = shared_legend(fig, [panels[0]], ncol=min(len(runs), 3), fontsize=10)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     os.makedirs(out, exist_ok=True)
     save_output(os.path.join(out, "fig5_manipulability.png"), lambda target: fig.savefig(target, dpi=110))
     plt.close(fig)
@@ -870,6 +1064,6 @@ def main():
 if __name__ == "__main__":
     try:
         sys.exit(main())
-    except OutputError as e:
+    except (OutputError, RuntimeError) as e:  # RuntimeError: ffmpeg failed
         print(f"plot_run.py: {e}", file=sys.stderr)
         sys.exit(2)

@@ -11,6 +11,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
 if len(sys.argv) != 3:
     sys.exit(__doc__)
@@ -34,8 +35,21 @@ for ax, kind in zip(axes, ("planar", "spatial")):
     ax.set_title(f"{kind} chains")
     ax.set_xlabel("joints n")
     ax.grid(alpha=0.3, which="both")
-    ax.legend()
+    # The joint counts as plain numbers at the measured n (not 2 x 10^1).
+    ns = sorted({p[0] for (k, _), points in series.items() if k == kind for p in points})
+    if ns:
+        ax.set_xticks(ns)
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
 axes[0].set_ylabel("time per step (us)")
-fig.tight_layout()
+# One legend for both panels, below them (it covered measured points in a corner).
+handles = {}
+for ax in axes:
+    for h, label in zip(*ax.get_legend_handles_labels()):
+        handles.setdefault(label, h)
+legend = fig.legend(list(handles.values()), list(handles.keys()), loc="lower center", ncol=max(len(handles), 1),
+                    frameon=False)
+fig.canvas.draw()
+fig.tight_layout(rect=(0, legend.get_window_extent().height / fig.bbox.height + 0.01, 1, 1))
 fig.savefig(sys.argv[2], dpi=120)
 print(f"written: {sys.argv[2]}")

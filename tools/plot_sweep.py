@@ -16,6 +16,7 @@ import csv
 import json
 import os
 import sys
+import textwrap
 
 from redres_output import OutputError, save_output  # noqa: E402  (beside this script)
 
@@ -44,6 +45,25 @@ def axis_values(rows, key):
         return sorted(values, key=float)
     except ValueError:
         return values
+
+
+def tick_labels(values):
+    """Axis values as tick labels: numbers with 3 significant digits (more where 3 would make two alike), other
+    values as they are."""
+    try:
+        numbers = [float(v) for v in values]
+    except ValueError:
+        return list(values)
+    for digits in range(3, 18):
+        labels = [f"{v:.{digits}g}" for v in numbers]
+        if len(set(labels)) == len(set(numbers)):
+            return labels
+    return list(values)
+
+
+def wrapped(text, width_inches, fontsize):
+    """text broken into lines that fit width_inches at fontsize (an average glyph is about 0.55 em wide)."""
+    return "\n".join(textwrap.wrap(text, max(20, int(width_inches * 72 / (0.55 * fontsize)))))
 
 
 def main():
@@ -84,13 +104,15 @@ def main():
             sums[i, j] += float(r[args.value])
     value[ran > 0] = sums[ran > 0] / ran[ran > 0]
 
-    fig, ax = plt.subplots(figsize=(max(6.0, 0.28 * len(xs) + 2.5), max(3.0, 0.45 * len(ys) + 1.5)))
+    width = max(6.0, 0.28 * len(xs) + 2.5)
+    fig, ax = plt.subplots(figsize=(width, max(3.0, 0.45 * len(ys) + 1.5)), constrained_layout=True)
     image = ax.imshow(np.ma.masked_invalid(value), origin="lower", aspect="auto", cmap="viridis")
     fig.colorbar(image, ax=ax, label=args.value)
     bad_i, bad_j = np.nonzero((ran == 0) & (total > 0))
-    ax.scatter(bad_j, bad_i, marker="x", color="crimson", s=36, label="did not run through (failed steps or error)")
-    ax.set_xticks(range(len(xs)), xs, rotation=90 if len(xs) > 12 else 0, fontsize=7 if len(xs) > 12 else 9)
-    ax.set_yticks(range(len(ys)), ys)
+    ax.scatter(bad_j, bad_i, marker="x", color="crimson", s=36)
+    ax.set_xticks(range(len(xs)), tick_labels(xs), rotation=90 if len(xs) > 12 else 0,
+                  fontsize=7 if len(xs) > 12 else 9)
+    ax.set_yticks(range(len(ys)), tick_labels(ys), fontsize=7 if len(ys) > 20 else 9)
     ax.set_xlabel(x)
     ax.set_ylabel(y)
     failed = sum(1 for r in rows if r["status"] != "ok")
@@ -99,11 +121,11 @@ def main():
     if os.path.isfile(meta):
         with open(meta) as f:
             name = json.load(f).get("name", name)
-    ax.set_title(f"{name}: {args.value} "
-                 f"({len(rows)} variations, {failed} did not run through)", fontsize=10)
-    if len(bad_i):
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.25), fontsize=8, frameon=False)
-    fig.tight_layout()
+    # The title wrapped to the figure's width (a long sweep name would be cut otherwise); it also says what the
+    # crosses mean (a legend would cover cells or leave a gap).
+    marks = ", marked x (failed steps or error)" if len(bad_i) else ""
+    fig.suptitle(wrapped(f"{name}: {args.value}", width, 10) + "\n" +
+                 wrapped(f"{len(rows)} variations, {failed} did not run through{marks}", width, 9), fontsize=10)
     out = args.out or os.path.join(args.sweep_dir, "sweep_heatmap.png")
     try:
         save_output(out, lambda target: fig.savefig(target, dpi=120))

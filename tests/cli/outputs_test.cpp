@@ -156,8 +156,9 @@ TEST(CompareCli, SameStemsGetTheirOwnDirectoriesAndNamesAreQuotedInTheCsv) {
   EXPECT_EQ(nlohmann::json::parse(slurp(out / "x" / "summary.json"))["name"], "circle, newton");
   EXPECT_EQ(nlohmann::json::parse(slurp(out / "x-2" / "summary.json"))["name"], "circle \"b\"");
   const std::string csv = slurp(out / "comparison.csv");
-  EXPECT_NE(csv.find("\n\"circle, newton\",newton,"), std::string::npos) << csv;
-  EXPECT_NE(csv.find("\n\"circle \"\"b\"\"\",newton,"), std::string::npos) << csv;
+  // The name, then the label (no `label` in the files: the name), quoted the same way.
+  EXPECT_NE(csv.find("\n\"circle, newton\",\"circle, newton\",newton,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n\"circle \"\"b\"\"\",\"circle \"\"b\"\"\",newton,"), std::string::npos) << csv;
 }
 
 TEST(CompareCli, ABadLaterScenarioIsReportedBeforeAnyRun) {

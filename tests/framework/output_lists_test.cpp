@@ -80,19 +80,33 @@ TEST(OutputLists, SummaryJsonHasEveryListedFieldAndNothingElse) {
   EXPECT_EQ(json_leaves, leaves);
 }
 
+TEST(OutputLists, TheLabelNamesTheRunAndDefaultsToTheName) {
+  // No `label` in the file: the scenario's name; a `label`: that, in the summary and its JSON; an empty one: an error.
+  Scenario plain = load_scenario(source_path("configs/paper_r_fast.toml"), {"duration=0.1"});
+  EXPECT_EQ(plain.label, plain.name);
+  EXPECT_EQ(summarise(plain, simulate(plain)).label, "paper_r_fast");
+  Scenario named = load_scenario(source_path("configs/paper_r_fast.toml"), {"duration=0.1", "label=p = 2, fast"});
+  EXPECT_EQ(named.name, "paper_r_fast");
+  const RunSummary summary = summarise(named, simulate(named));
+  EXPECT_EQ(summary.label, "p = 2, fast");
+  EXPECT_EQ(nlohmann::json::parse(to_json(summary))["label"], "p = 2, fast");
+  EXPECT_THROW((void)load_scenario(source_path("configs/paper_r_fast.toml"), {"label="}), ConfigError);
+}
+
 TEST(OutputLists, TheComparisonShowsTheSummaryFieldsItNames) {
   Scenario s = load_scenario(source_path("configs/paper_r_fast.toml"), {"duration=0.5"});
   const RunSummary summary = summarise(s, simulate(s));
   const std::vector<std::string> cells = comparison_cells(summary);
   ASSERT_EQ(cells.size(), comparison_columns().size());
   EXPECT_EQ(cells[0], summary.name);
-  EXPECT_EQ(cells[1], summary.solver.engine);
+  EXPECT_EQ(cells[1], summary.label);
+  EXPECT_EQ(cells[2], summary.solver.engine);
   std::ostringstream error;
   error << std::setprecision(4) << summary.max_position_error;  // the column's 4 significant digits
-  EXPECT_EQ(cells[2], error.str());
-  EXPECT_EQ(comparison_markdown_heading().substr(0, 24), "| scenario | engine | ma");
+  EXPECT_EQ(cells[3], error.str());
+  EXPECT_EQ(comparison_markdown_heading().substr(0, 32), "| scenario | label | engine | ma");
   EXPECT_EQ(comparison_csv_heading(),
-            "scenario,engine,max_position_error,w_initial,w_final,w_min,w_mean,initial_joint_velocity_norm,"
+            "scenario,label,engine,max_position_error,w_initial,w_final,w_min,w_mean,initial_joint_velocity_norm,"
             "final_joint_velocity_norm,mean_iterations,failures,wall_time_s\n");
   EXPECT_THROW((void)summary_value(summary, "no_such_field"), std::invalid_argument);
 }

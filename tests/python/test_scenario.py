@@ -104,6 +104,9 @@ def test_compare_runs_every_scenario_and_tabulates_them():
     assert [r.name for r in cmp.results] == ["paper_r_tvcmm", "paper_r_constant_p", "paper_r_mvn"]
     table = cmp.table()
     assert [row["scenario"] for row in table] == ["paper_r_tvcmm", "paper_r_constant_p", "paper_r_mvn"]
+    # The configs' `label`s: the names the figures and the table's label column show.
+    assert [row["label"] for row in table] == ["TVCMM, p = 2 sin(pi t/T)", "p = 1", "MVN (p = 0)"]
+    assert [r.summary["label"] for r in cmp.results] == [row["label"] for row in table]
     assert tuple(table[0]) == redres.Comparison.columns
     # The paper's comparison: TVCMM ends with a higher w than MVN.
     assert cmp["paper_r_tvcmm"].summary["manipulability"]["final"] > cmp["paper_r_mvn"].summary["manipulability"]["final"]

@@ -11,6 +11,7 @@ namespace redres {
 const std::vector<ComparisonColumn>& comparison_columns() {
   static const std::vector<ComparisonColumn> columns{
       {"scenario", "scenario", "name", 0},
+      {"label", "label", "label", 0},
       {"engine", "engine", "solver.engine", 0},
       {"max position error (m)", "max_position_error", "max_position_error", 4},
       {"w(0)", "w_initial", "manipulability.initial", 6},

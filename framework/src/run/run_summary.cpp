@@ -93,6 +93,7 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
 
   RunSummary out;
   out.name = s.name;
+  out.label = s.label.empty() ? s.name : s.label;
   out.source = s.source;
   out.status = run.interrupted ? "interrupted" : run.stopped ? "stopped" : "complete";
   out.steps = s.steps();
@@ -237,6 +238,8 @@ SummaryValue count(long v) { return v; }
 const std::vector<SummaryField>& summary_fields() {
   static const std::vector<SummaryField> fields{
       {"name", "string", "scenario name", [](const S& s) { return text(s.name); }},
+      {"label", "string", "the run's name in legends and tables (the scenario's `label`; default: its `name`)",
+       [](const S& s) { return text(s.label); }},
       {"source", "string", "the scenario file as given on the command line", [](const S& s) { return text(s.source); }},
       {"status", "string",
        "`\"complete\"`; `\"stopped\"` (at its first failed step, `on_infeasible = \"stop\"`); or `\"interrupted\"` (by "

@@ -320,6 +320,14 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                  if (c.s.name.empty())
                    r.fail("name", "expected a non-empty name (or leave `name` out: the file's stem)");
                }),
+      entry<C>("label", "string", "", "the scenario's name",
+               "the run's name in legends and tables (summary.json's `label`, the comparison figure and table)",
+               [](const TableReader& r, C& c) {
+                 if (!r.has("label")) return;
+                 c.s.label = r.string("label");
+                 if (c.s.label.empty())
+                   r.fail("label", "expected a non-empty label (or leave `label` out: the scenario's name)");
+               }),
       entry<C>("robot", "path", "", "", "the robot file (TOML; docs/robot_format.md), relative to this file",
                [](const TableReader& r, C& c) {
                  try {
@@ -725,6 +733,7 @@ Scenario load_scenario(const std::filesystem::path& file, const std::vector<std:
   reading.s.name = file.stem().string();
   read_config(r, ScenarioReading::schema(), reading);
   r.finish();
+  if (reading.s.label.empty()) reading.s.label = reading.s.name;
   if (reading.ik) solve_start(reading.s, *reading.ik, reading.ik_where);
   Scenario s = std::move(reading.s);
   s.record = reading.output.record;

@@ -349,7 +349,7 @@ Cells run_variation(const SweepSpec& spec, const Variation& v, const std::filesy
     }
     nlohmann::json j = nlohmann::json::parse(to_json(summary));
     // (The run's own "status" is the sweep's status column and solver.stopped.)
-    for (const char* skip : {"wall_time_s", "source", "robot", "obstacles", "name", "status"}) j.erase(skip);
+    for (const char* skip : {"wall_time_s", "source", "robot", "obstacles", "name", "label", "status"}) j.erase(skip);
     flatten(j, "", figures);
   } catch (const std::bad_alloc&) {
     throw;  // not the variation's fault: run_sweep runs it again, alone

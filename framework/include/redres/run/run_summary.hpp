@@ -73,6 +73,7 @@ struct ObstacleFacts {
 /// The summary of one run.
 struct RunSummary {
   std::string name;                           //!< scenario name
+  std::string label;                          //!< the run's name in legends and tables (default: name)
   std::string source;                         //!< scenario file
   std::string status;                         //!< "complete", "stopped" (at a failed step) or "interrupted"
   int steps = 0;                              //!< control steps N (N + 1 rows)

@@ -53,6 +53,7 @@ enum class OnInfeasible { kHold, kStop, kRelax, kBrake };
 /// A loaded scenario. Owns everything a run needs.
 struct Scenario {
   std::string name;                   //!< scenario name
+  std::string label;                  //!< the run's name in legends and tables (default: name)
   std::string source;                 //!< file it came from
   std::unique_ptr<RobotModel> robot;  //!< the robot
   Eigen::VectorXd theta0;             //!< theta(0)

@@ -9,19 +9,6 @@
 
 namespace redres {
 
-void point_jacobian(const RobotModel& robot, const KinematicsData& kin, int link, const Eigen::Vector3d& p,
-                    Eigen::Ref<Eigen::Matrix3Xd> J) {
-  J.setZero();
-  for (int k = 0; k <= link; ++k) {
-    const Eigen::Vector3d z = kin.axes.col(k);
-    if (robot.joint(k).type == JointType::kRevolute) {
-      J.col(k) = z.cross(p - kin.origins.col(k));
-    } else {
-      J.col(k) = z;
-    }
-  }
-}
-
 PairDistances::PairDistances(int pairs, Damper damper)
     : distance_(static_cast<std::size_t>(pairs), std::numeric_limits<double>::infinity()), damper_(damper) {
   measured_.reserve(static_cast<std::size_t>(pairs));

@@ -194,6 +194,28 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
       link_shapes_.push_back({j, body, shape, shape.pose()});
     }
   }
+  // The named frames: each joint's link, the URDF links riding on it, and the end effector.
+  for (int j = 0; j < n; ++j) {
+    const std::string& link = joint(j).link_name.empty() ? joint(j).name : joint(j).link_name;
+    frames_.push_back({link, j, Isometry3d::Identity()});
+    for (const auto& [name, pose] : joint(j).frames) {
+      if (name == link) continue;
+      REDRES_REQUIRE(pose.matrix().allFinite(), "RobotModel",
+                     "joint " + std::to_string(j + 1) + "'s frame '" + name + "' has a finite pose");
+      frames_.push_back({name, j, pose});
+    }
+  }
+  {
+    std::unordered_map<std::string, int> seen;
+    for (std::size_t f = 0; f < frames_.size(); ++f) {
+      REDRES_REQUIRE(seen.emplace(frames_[f].name, static_cast<int>(f)).second, "RobotModel",
+                     "frame names are unique ('" + frames_[f].name + "' is named twice)");
+    }
+    // The task's frame, unless a link of the robot has taken its name.
+    if (seen.count("end_effector") == 0) {
+      frames_.push_back({"end_effector", n - 1, after_[static_cast<std::size_t>(n - 1)] * spec_.end_effector});
+    }
+  }
   for (const auto& [a, b] : spec_.collision_exclude_bodies) {
     const int ia = body_index(a), ib = body_index(b);
     REDRES_REQUIRE(ia >= 0 && ib >= 0 && ia != ib, "RobotModel",
@@ -331,6 +353,13 @@ void RobotModel::acceleration_limits(const Eigen::Ref<const Eigen::VectorXd>& th
 void RobotModel::jerk_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
                              Eigen::Ref<Eigen::VectorXd> upper) const {
   law_bounds(spec_.joints, &JointSpec::jerk_limit, theta, lower, upper, "RobotModel::jerk_limits");
+}
+
+int RobotModel::find_frame(const std::string& name) const {
+  for (std::size_t f = 0; f < frames_.size(); ++f) {
+    if (frames_[f].name == name) return static_cast<int>(f);
+  }
+  return -1;
 }
 
 int RobotModel::find_body(const std::string& name) const {

@@ -536,6 +536,7 @@ void read_urdf_links(const TableReader& r, RobotReading& c) {
     if (c.spec.joints.size() <= static_cast<std::size_t>(link.joint)) break;
     JointSpec& jt = c.spec.joints[static_cast<std::size_t>(link.joint)];
     if (jt.link_name.empty()) jt.link_name = link.name;  // the first link met on a joint is the one it moves
+    jt.frames.emplace_back(link.name, link.pose);        // every link: a frame tasks can name
     if (link.branch) jt.branch_links.push_back(link.name);
     const std::size_t first_shape = jt.collision.size();
     const auto e = link_entries.find(link.name);

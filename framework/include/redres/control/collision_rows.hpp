@@ -22,6 +22,7 @@
 #include "redres/common/error.hpp"
 #include "redres/control/plugin.hpp"
 #include "redres/model/collision.hpp"
+#include "redres/model/frames.hpp"  // point_jacobian
 #include "redres/model/kinematics.hpp"
 
 namespace redres {
@@ -133,11 +134,6 @@ inline void slack_row(Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> A_
 /// than d_i gets a slack row (A_row = 0, b = 1).
 void damper_row(const Damper& damper, double d, const Eigen::Vector3d& n, const Eigen::Matrix3Xd& D,
                 const Eigen::Vector3d& v_b, Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> A_row, double& b);
-
-/// Writes the 3 x n Jacobian of the world point `p` moving with link `link` (columns of later joints are zero):
-/// revolute joint k: z_k x (p - o_k); prismatic: z_k. `kin` must hold the configuration's joint axes and origins.
-void point_jacobian(const RobotModel& robot, const KinematicsData& kin, int link, const Eigen::Vector3d& p,
-                    Eigen::Ref<Eigen::Matrix3Xd> J);
 
 /// The unit normal from witness point `on_b` to `on_a` for signed distance d (FCL's points swap sides when the
 /// shapes overlap, so the direction is sign(d) (on_a - on_b)). For a planar robot the normal is projected into the

@@ -108,6 +108,9 @@ struct JointSpec {
   /// Links riding on this joint below a held joint of a side branch (a URDF's head or fingers): bodies of their own,
   /// which self-collision checks against the neighbouring joints' links (RobotModel::Body::branch).
   std::vector<std::string> branch_links;
+  /// Named frames riding on this joint's link: a URDF's links after the joint (the chain's, those fixed to them,
+  /// side branches), each with its pose in the joint's link frame. Frame tasks name them (RobotModel::frames()).
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> frames;
   /// Collision shapes of the link that joint j moves, in the link frame (the joint's frame after its motion, before
   /// the fixed transform to the next joint). A capsule with neither `length` nor `from`/`to` runs along the link:
   /// from the joint's origin to the next joint's origin (the end effector's, for the last joint).
@@ -247,6 +250,18 @@ class RobotModel {
   /// The body named `name`, or -1.
   [[nodiscard]] int find_body(const std::string& name) const;
 
+  /// A frame a task can name: a link's frame, or the end effector's, fixed in the frame of the joint it rides on.
+  struct Frame {
+    std::string name;  //!< the link's name (URDF), or the joint's; "end_effector"
+    int joint = 0;     //!< the joint whose link frame it rides in (0-based)
+    Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();  //!< its pose in that link frame
+  };
+  /// Every named frame: each joint's link (by its URDF link name, else the joint's name), the other URDF links
+  /// riding on the joints (JointSpec::frames), and "end_effector" (the task's frame, E).
+  [[nodiscard]] const std::vector<Frame>& frames() const noexcept { return frames_; }
+  /// The frame named `name`, or -1.
+  [[nodiscard]] int find_frame(const std::string& name) const;
+
   /// One collision shape of a link: the link (joint index), its body and the shape, with its pose in the link frame
   /// resolved (a capsule along the link gets its end points here).
   struct LinkShape {
@@ -289,6 +304,7 @@ class RobotModel {
   unsigned tracked_ = 0;  // bit r: reference row r is a task row
   Eigen::VectorXd lower_, upper_;
   std::vector<Eigen::Isometry3d> before_, after_;
+  std::vector<Frame> frames_;
   std::vector<Eigen::Vector3d> axes_;
   std::vector<FrameShape> shapes_;
   bool all_revolute_ = true;

@@ -505,7 +505,7 @@
       function seek(e) {
         var r = canvas.getBoundingClientRect();
         var x = (e.clientX - r.left) / r.width * canvas.width;
-        setTime(Math.max(0, Math.min(tEnd, (x - p.left) / (p.width) * tEnd)), true);
+        setTime(Math.max(0, Math.min(tEnd, (x - p.left) / (p.width) * tEnd)));
       }
       canvas.addEventListener('mousedown', function (e) { pause(); seek(e); p.dragging = true; });
       canvas.addEventListener('mousemove', function (e) { if (p.dragging && e.buttons) seek(e); });
@@ -605,11 +605,10 @@
   var current = 0, playing = false, last = 0, needRender = true, firstFrameMs = null;
 
   function requestRender() { needRender = true; }
-  function setTime(t, fromUser) {
+  function setTime(t) {
     current = Math.max(0, Math.min(tEnd, t));
     views.forEach(function (v) { pose(v, current); });
-    if (fromUser || !playing) slider.value = String(frameAt(timeline, current + 1e-12));
-    else slider.value = String(frameAt(timeline, current + 1e-12));
+    slider.value = String(frameAt(timeline, current + 1e-12));
     timeBox.textContent = 't = ' + current.toFixed(3) + ' s / ' + tEnd.toFixed(3) + ' s  (frame ' + slider.value +
                           ' of ' + (timeline.length - 1) + ')';
     var lines = views.map(function (v) {
@@ -624,12 +623,12 @@
   }
   function setFrame(k) {
     k = Math.max(0, Math.min(timeline.length - 1, k | 0));
-    setTime(timeline[k], true);
+    setTime(timeline[k]);
     slider.value = String(k);
   }
   function pause() { playing = false; playButton.textContent = 'Play'; }
   function play() {
-    if (current >= tEnd) setTime(0, true);
+    if (current >= tEnd) setTime(0);
     playing = true; playButton.textContent = 'Pause'; last = performance.now();
   }
   playButton.addEventListener('click', function () { if (playing) pause(); else play(); });
@@ -721,7 +720,7 @@
       last = now;
       var t = current + dt * Number(speedBox.value);
       if (t >= tEnd) { t = tEnd; pause(); }
-      setTime(t, false);
+      setTime(t);
     }
     if (needRender) render();
     requestAnimationFrame(loop);

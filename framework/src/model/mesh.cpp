@@ -137,26 +137,32 @@ Circle enclosing_circle(std::vector<Eigen::Vector2d> p) {
   return c;
 }
 
-}  // namespace
-
-MeshData read_mesh(const std::filesystem::path& file, const Eigen::Vector3d& scale) {
+// The scene of a mesh file, read by `importer` with Assimp's post-processing `flags`: the file is read within the
+// input bounds (a regular file of at most 16 MiB, common/input_file.hpp), then parsed from memory with the
+// extension as the format's hint, so that a device or a huge file named by a URDF is refused before Assimp sees it.
+const aiScene& import_scene(const std::filesystem::path& file, const Eigen::Vector3d& scale, unsigned flags,
+                            Assimp::Importer& importer) {
   if (!scale.allFinite() || (scale.array() <= 0.0).any()) {
     throw std::runtime_error("mesh '" + file.string() + "': expected a scale > 0 on every axis");
   }
-  // Read within the input bounds (a regular file of at most 16 MiB, common/input_file.hpp), then parsed from memory
-  // with the extension as the format's hint: a device or a huge file named by a URDF is refused before Assimp sees it.
   const std::string data = read_input_file(file, "mesh file");
   std::string hint = file.extension().string();
   if (!hint.empty()) hint.erase(0, 1);
-  Assimp::Importer importer;
-  const aiScene* scene =
-      importer.ReadFileFromMemory(data.data(), data.size(), aiProcess_JoinIdenticalVertices, hint.c_str());
+  const aiScene* scene = importer.ReadFileFromMemory(data.data(), data.size(), flags, hint.c_str());
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw std::runtime_error("mesh '" + file.string() + "': Assimp could not read it: " + importer.GetErrorString());
   }
+  return *scene;
+}
+
+}  // namespace
+
+MeshData read_mesh(const std::filesystem::path& file, const Eigen::Vector3d& scale) {
+  Assimp::Importer importer;
+  const aiScene& scene = import_scene(file, scale, aiProcess_JoinIdenticalVertices, importer);
   MeshData out;
   out.file = file;
-  collect(*scene, *scene->mRootNode, aiMatrix4x4(), scale, out, 0);
+  collect(scene, *scene.mRootNode, aiMatrix4x4(), scale, out, 0);
   if (out.pieces.empty()) throw std::runtime_error("mesh '" + file.string() + "' holds no vertex");
   return out;
 }
@@ -168,21 +174,13 @@ std::size_t DrawMesh::triangles() const {
 }
 
 DrawMesh read_draw_mesh(const std::filesystem::path& file, const Eigen::Vector3d& scale) {
-  if (!scale.allFinite() || (scale.array() <= 0.0).any()) {
-    throw std::runtime_error("mesh '" + file.string() + "': expected a scale > 0 on every axis");
-  }
-  const std::string data = read_input_file(file, "mesh file");
-  std::string hint = file.extension().string();
-  if (!hint.empty()) hint.erase(0, 1);
   Assimp::Importer importer;
   // The node transforms baked into the vertices, the meshes of one material merged: one part per colour.
-  const aiScene* scene = importer.ReadFileFromMemory(
-      data.data(), data.size(),
+  const aiScene& read = import_scene(
+      file, scale,
       aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices | aiProcess_SortByPType,
-      hint.c_str());
-  if (scene == nullptr || scene->mRootNode == nullptr) {
-    throw std::runtime_error("mesh '" + file.string() + "': Assimp could not read it: " + importer.GetErrorString());
-  }
+      importer);
+  const aiScene* scene = &read;
   DrawMesh out;
   std::vector<int> part_of_material(scene->mNumMaterials + 1, -1);
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {

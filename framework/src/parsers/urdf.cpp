@@ -205,6 +205,46 @@ void check_pose(const std::string& who, const char* what, const urdf::Pose& p) {
   }
 }
 
+// A <collision> or <visual> element's geometry (`element`: "" or "<visual> ", for messages), checked: lengths
+// positive and physical, a mesh's scale positive.
+UrdfVisual read_geometry(const std::string& who, const std::string& element, const urdf::Geometry& geometry) {
+  UrdfVisual g;
+  switch (geometry.type) {
+    case urdf::Geometry::SPHERE:
+      g.kind = UrdfVisual::Kind::kSphere;
+      g.radius = static_cast<const urdf::Sphere&>(geometry).radius;
+      check_length(who, (element + "<sphere> radius").c_str(), g.radius, true);
+      break;
+    case urdf::Geometry::BOX: {
+      const urdf::Vector3& d = static_cast<const urdf::Box&>(geometry).dim;
+      g.kind = UrdfVisual::Kind::kBox;
+      g.size = {d.x, d.y, d.z};
+      for (double v : g.size) check_length(who, (element + "<box> size").c_str(), v, true);
+      break;
+    }
+    case urdf::Geometry::CYLINDER: {
+      const auto& cyl = static_cast<const urdf::Cylinder&>(geometry);
+      g.kind = UrdfVisual::Kind::kCylinder;
+      g.radius = cyl.radius;
+      g.length = cyl.length;
+      check_length(who, (element + "<cylinder> radius").c_str(), cyl.radius, true);
+      check_length(who, (element + "<cylinder> length").c_str(), cyl.length, true);
+      break;
+    }
+    case urdf::Geometry::MESH: {
+      const auto& mesh = static_cast<const urdf::Mesh&>(geometry);
+      g.kind = UrdfVisual::Kind::kMesh;
+      g.filename = mesh.filename;
+      g.scale = Eigen::Vector3d(mesh.scale.x, mesh.scale.y, mesh.scale.z);
+      if (!g.scale.allFinite() || (g.scale.array() <= 0.0).any()) {
+        throw UrdfError(who + ": " + element + "<mesh> scale expected > 0 on every axis");
+      }
+      break;
+    }
+  }
+  return g;
+}
+
 // The collision elements of `link`, whose frame is `at` in the frame of the UrdfLink `out` gathers shapes for.
 void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometry3d& at, const std::string& messages,
                 UrdfLink& out) {
@@ -232,43 +272,28 @@ void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometr
     }
     check_pose(who, "<collision> <origin>", c->origin);
     const Eigen::Isometry3d pose = at * pose_of(c->origin);
+    const UrdfVisual g = read_geometry(who, "", *c->geometry);
+    if (g.kind == UrdfVisual::Kind::kMesh) {
+      out.meshes.push_back({g.filename, g.scale, pose});
+      continue;
+    }
     ShapeSpec s;
     s.xyz = {pose.translation().x(), pose.translation().y(), pose.translation().z()};
     s.rpy = rpy_of(pose.linear());
-    switch (c->geometry->type) {
-      case urdf::Geometry::SPHERE:
+    switch (g.kind) {
+      case UrdfVisual::Kind::kSphere:
         s.shape = ShapeSpec::Kind::kSphere;
-        s.radius = static_cast<const urdf::Sphere&>(*c->geometry).radius;
-        check_length(who, "<sphere> radius", *s.radius, true);
+        s.radius = g.radius;
         break;
-      case urdf::Geometry::BOX: {
-        const urdf::Vector3& d = static_cast<const urdf::Box&>(*c->geometry).dim;
+      case UrdfVisual::Kind::kBox:
         s.shape = ShapeSpec::Kind::kBox;
-        s.size = std::array<double, 3>{d.x, d.y, d.z};
-        for (double v : *s.size) check_length(who, "<box> size", v, true);
+        s.size = g.size;
         break;
-      }
-      case urdf::Geometry::CYLINDER: {
-        const auto& cyl = static_cast<const urdf::Cylinder&>(*c->geometry);
+      default:
         s.shape = ShapeSpec::Kind::kCylinder;
-        s.radius = cyl.radius;
-        s.length = cyl.length;
-        check_length(who, "<cylinder> radius", cyl.radius, true);
-        check_length(who, "<cylinder> length", cyl.length, true);
+        s.radius = g.radius;
+        s.length = g.length;
         break;
-      }
-      case urdf::Geometry::MESH: {
-        const auto& mesh = static_cast<const urdf::Mesh&>(*c->geometry);
-        UrdfMesh m;
-        m.filename = mesh.filename;
-        m.scale = Eigen::Vector3d(mesh.scale.x, mesh.scale.y, mesh.scale.z);
-        if (!m.scale.allFinite() || (m.scale.array() <= 0.0).any()) {
-          throw UrdfError(who + ": <mesh> scale expected > 0 on every axis");
-        }
-        m.pose = pose;
-        out.meshes.push_back(std::move(m));
-        continue;
-      }
     }
     out.shapes.push_back(s);
   }
@@ -285,39 +310,13 @@ void add_visuals(const Namer& names, const urdf::Link& link, const Eigen::Isomet
     UrdfVisual u;
     u.link = link.name;
     u.pose = at * pose_of(v->origin);
-    switch (v->geometry->type) {
-      case urdf::Geometry::SPHERE:
-        u.kind = UrdfVisual::Kind::kSphere;
-        u.radius = static_cast<const urdf::Sphere&>(*v->geometry).radius;
-        check_length(who, "<visual> <sphere> radius", u.radius, true);
-        break;
-      case urdf::Geometry::BOX: {
-        const urdf::Vector3& d = static_cast<const urdf::Box&>(*v->geometry).dim;
-        u.kind = UrdfVisual::Kind::kBox;
-        u.size = {d.x, d.y, d.z};
-        for (double x : u.size) check_length(who, "<visual> <box> size", x, true);
-        break;
-      }
-      case urdf::Geometry::CYLINDER: {
-        const auto& cyl = static_cast<const urdf::Cylinder&>(*v->geometry);
-        u.kind = UrdfVisual::Kind::kCylinder;
-        u.radius = cyl.radius;
-        u.length = cyl.length;
-        check_length(who, "<visual> <cylinder> radius", cyl.radius, true);
-        check_length(who, "<visual> <cylinder> length", cyl.length, true);
-        break;
-      }
-      case urdf::Geometry::MESH: {
-        const auto& mesh = static_cast<const urdf::Mesh&>(*v->geometry);
-        u.kind = UrdfVisual::Kind::kMesh;
-        u.filename = mesh.filename;
-        u.scale = Eigen::Vector3d(mesh.scale.x, mesh.scale.y, mesh.scale.z);
-        if (!u.scale.allFinite() || (u.scale.array() <= 0.0).any()) {
-          throw UrdfError(who + ": <visual> <mesh> scale expected > 0 on every axis");
-        }
-        break;
-      }
-    }
+    const UrdfVisual g = read_geometry(who, "<visual> ", *v->geometry);
+    u.kind = g.kind;
+    u.filename = g.filename;
+    u.scale = g.scale;
+    u.size = g.size;
+    u.radius = g.radius;
+    u.length = g.length;
     if (v->material) {
       const urdf::Color& c = v->material->color;
       const std::array<double, 4> rgba{c.r, c.g, c.b, c.a};

@@ -12,6 +12,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "common/xml_text.hpp"
 #include "redres/model/convex.hpp"
 #include "redres/plant/mujoco_model.hpp"
 #include "redres/plant/plant.hpp"
@@ -49,22 +50,6 @@ std::string quat(const Eigen::Matrix3d& R) {
 
 std::string pose_attributes(const Eigen::Isometry3d& T) {
   return "pos=\"" + vec3(T.translation()) + "\" quat=\"" + quat(T.linear()) + "\"";
-}
-
-// A name as an XML attribute value.
-std::string escaped(const std::string& s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 // Why the link has no mass properties MuJoCo could take ("" when it has): none given, or a mass or principal moment
@@ -180,7 +165,7 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
   std::vector<int> count(static_cast<std::size_t>(n), 0);
   for (const RobotModel::LinkShape& s : robot.link_shapes()) {
     const auto j = static_cast<std::size_t>(s.link);
-    const std::string name = escaped(mjcf_body_name(robot, s.link)) + "_shape" + std::to_string(count[j]++);
+    const std::string name = xml_escaped(mjcf_body_name(robot, s.link)) + "_shape" + std::to_string(count[j]++);
     std::string& g = geoms[j];
     g += "      <geom name=\"" + name + "\" ";
     g += shape_attributes(s.spec, s.pose, name, assets,
@@ -190,7 +175,7 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
 
   std::ostringstream out;
   const std::string model = options.model_name.empty() ? robot.name() : options.model_name;
-  out << "<mujoco model=\"" << escaped(model) << "\">\n"
+  out << "<mujoco model=\"" << xml_escaped(model) << "\">\n"
       << "  <!-- Written by redres (mjcf_from_robot). -->\n"
       << "  <compiler angle=\"radian\" inertiafromgeom=\"false\""
       << (options.balance_inertia ? " balanceinertia=\"true\"" : "") << "/>\n";
@@ -232,9 +217,10 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
     // Body j's frame is the link frame of joint j; at theta_j = 0 it sits at B_{j-1} A_j in its parent (P A_1 for the
     // first), and the joint moves it about/along u_j through its origin.
     const Eigen::Isometry3d place = (j == 0 ? robot.base() : robot.after(j - 1)) * robot.before(j);
-    out << indent << "<body name=\"" << escaped(mjcf_body_name(robot, j)) << "\" " << pose_attributes(place) << ">\n";
+    out << indent << "<body name=\"" << xml_escaped(mjcf_body_name(robot, j)) << "\" " << pose_attributes(place)
+        << ">\n";
     const std::string in = indent + "  ";
-    out << in << "<joint name=\"" << escaped(joint.name) << "\" type=\""
+    out << in << "<joint name=\"" << xml_escaped(joint.name) << "\" type=\""
         << (joint.type == JointType::kRevolute ? "hinge" : "slide") << "\" pos=\"0 0 0\" axis=\"" << vec3(robot.axis(j))
         << "\" limited=\"true\" range=\"" << nums({joint.lower, joint.upper}) << "\"";
     if (joint.damping) out << " damping=\"" << num(*joint.damping) << "\"";
@@ -257,7 +243,7 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
     std::istringstream lines(geoms[static_cast<std::size_t>(j)]);
     for (std::string line; std::getline(lines, line);) out << in << line.substr(6) << "\n";
     if (j == n - 1)
-      out << in << "<site name=\"" << escaped(options.end_effector_site) << "\" "
+      out << in << "<site name=\"" << xml_escaped(options.end_effector_site) << "\" "
           << pose_attributes(robot.after(j) * robot.end_effector()) << "/>\n";
     indent = in;
   }
@@ -276,8 +262,8 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
         for (const int b : bodies_of[static_cast<std::size_t>(k)])
           checked = checked || robot.self_collision_bodies(a, b);
       if (!checked)
-        excludes += "    <exclude body1=\"" + escaped(mjcf_body_name(robot, i)) + "\" body2=\"" +
-                    escaped(mjcf_body_name(robot, k)) + "\"/>\n";
+        excludes += "    <exclude body1=\"" + xml_escaped(mjcf_body_name(robot, i)) + "\" body2=\"" +
+                    xml_escaped(mjcf_body_name(robot, k)) + "\"/>\n";
     }
   if (!excludes.empty()) out << "  <contact>\n" << excludes << "  </contact>\n";
   if (options.plant && options.plant->actuator != PlantActuator::kIdealVelocity) {
@@ -288,7 +274,7 @@ std::string mjcf_from_robot(const RobotModel& robot, const MjcfOptions& options)
     out << "  <actuator>\n";
     for (int j = 0; j < n; ++j) {
       const JointSpec& joint = robot.joint(j);
-      out << "    <general name=\"" << escaped(joint.name) << "\" joint=\"" << escaped(joint.name)
+      out << "    <general name=\"" << xml_escaped(joint.name) << "\" joint=\"" << xml_escaped(joint.name)
           << "\" ctrllimited=\"false\" gaintype=\"fixed\" biastype=\"affine\" ";
       if (servo) {  // kv (ctrl - qdot): ctrl is the velocity command
         out << "gainprm=\"" << num(kv(j)) << "\" biasprm=\"0 0 " << num(-kv(j)) << "\"";

@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include "common/xml_text.hpp"
 #include "redres/common/output_file.hpp"
 #include "redres/model/convex.hpp"
 #include "redres/model/mesh.hpp"
@@ -482,6 +483,7 @@ std::string view_data(const std::vector<fs::path>& run_dirs, const ViewOptions& 
   if (title.empty()) {
     for (const auto& r : runs) title += (title.empty() ? "" : " vs ") + r["label"].get<std::string>();
   }
+  report.title = title;
   json data = {{"format", 1},
                {"title", title},
                {"runs", std::move(runs)},
@@ -507,17 +509,7 @@ std::string view_html(const std::vector<fs::path>& run_dirs, const ViewOptions& 
   replace_once(page, "/*REDRES_ORBIT*/", script_safe(read_file(orbit, "view")));
   replace_once(page, "/*REDRES_VIEWER*/", script_safe(view_assets::kScript));
   replace_once(page, "/*REDRES_DATA*/", script_safe(data));
-  std::string title = json::parse(data)["title"].get<std::string>();
-  std::string escaped;
-  for (const char c : title) {
-    switch (c) {
-      case '<': escaped += "&lt;"; break;
-      case '>': escaped += "&gt;"; break;
-      case '&': escaped += "&amp;"; break;
-      default: escaped += c;
-    }
-  }
-  replace_once(page, "REDRES_TITLE", escaped);
+  replace_once(page, "REDRES_TITLE", xml_escaped(report.title));
   return page;
 }
 

@@ -34,6 +34,7 @@ struct ViewReport {
   int bodies = 0;                    //!< robot shapes and obstacles drawn (all runs)
   int visuals = 0;                   //!< visual elements drawn (all runs)
   std::size_t visual_triangles = 0;  //!< triangles of the visual meshes (each mesh once)
+  std::string title;                 //!< the page's title
   std::vector<std::string> notes;    //!< what could not be drawn as recorded (e.g. a hull whose mesh is gone)
 };
 

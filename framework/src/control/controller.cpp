@@ -41,7 +41,13 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
                    "the path has one row per task position row (" + std::to_string(position_rows) + ")");
   }
   level_ = scheme.kinematics_level();
-  scheme.setup(qp_, *data_);
+  if (scheme.cascaded()) {
+    cascade_ = std::make_unique<Cascade>(scheme, *data_, engine);
+    cascade_->setup_first(qp_);
+    x_levels_ = Eigen::VectorXd::Zero(robot.dof());
+  } else {
+    scheme.setup(qp_, *data_);
+  }
   engine.setup(qp_.n(), qp_.m_eq(), qp_.m_in(), result_);
   ctx_.T = T;
   ctx_.tau = tau;
@@ -68,11 +74,19 @@ StepOutput Controller::make_output() const {
   out.theta_dot = Eigen::VectorXd::Zero(robot_->dof());
   out.theta_ddot = Eigen::VectorXd::Zero(robot_->dof());
   out.info.diagnosis.reserve(kDiagnosisCapacity);  // a failed step's text is written here without allocating
+  if (cascade_) {
+    out.levels.resize(static_cast<std::size_t>(cascade_->level_count()));
+    for (std::size_t l = 0; l < out.levels.size(); ++l) {
+      out.levels[l].priority = scheme_->levels()[l].priority;
+      out.levels[l].diagnosis.reserve(kDiagnosisCapacity);
+    }
+  }
   return out;
 }
 
 void Controller::reset() {
   engine_->reset();
+  if (cascade_) cascade_->reset();
   orientation_.forget_captured();
   prev_.setZero();
   prev2_.setZero();
@@ -196,7 +210,13 @@ void Controller::solve(double t, StepOutput& out) {
   out.task_row_error = 0.0;
   try {
     robot_->velocity_limits(kin_.theta, vlo_, vhi_);
-    scheme_->build(ctx_, qp_, *data_);
+    if (cascade_) {
+      REDRES_REQUIRE(out.levels.size() == static_cast<std::size_t>(cascade_->level_count()), "Controller::step",
+                     "out was made by make_output() (one LevelInfo per priority level)");
+      cascade_->build_first(ctx_, *data_, qp_);
+    } else {
+      scheme_->build(ctx_, qp_, *data_);
+    }
   } catch (const std::invalid_argument& e) {
     // A plugin or a law gave NaN or inf at this state (a user formula that is NaN in a narrow window): a failed step
     // that moves nothing, not the end of the run. The controller's own calls meet build()'s other conditions.
@@ -228,8 +248,25 @@ void Controller::solve(double t, StepOutput& out) {
   keep_diagnosis_capacity(out.info.diagnosis);  // a no-op unless the caller's output lost its reserve
   out.info = result_.info;
   if (result_.info.status == SolverStatus::kSolved) {
+    if (cascade_) {
+      solve_levels(out);
+      return;
+    }
     apply(result_.x, out);
     return;
+  }
+  if (cascade_) {
+    // Level 0 failed: the step's failure, for the policy; the levels below are not tried.
+    for (std::size_t l = 0; l < out.levels.size(); ++l) {
+      LevelInfo& level = out.levels[l];
+      level.status = l == 0 ? result_.info.status : SolverStatus::kNotRun;
+      level.iterations = l == 0 ? result_.info.iterations : 0;
+      level.residual = l == 0 ? result_.info.residual : 0.0;
+      level.task_error = 0.0;
+      keep_diagnosis_capacity(level.diagnosis);
+      level.diagnosis.clear();
+      TextSink(level.diagnosis) << (l == 0 ? "the step's QP (priority 0) failed" : "skipped: priority 0 failed");
+    }
   }
   // The step failed: the policy decides (never the unconverged iterate).
   bool relaxed = false;
@@ -241,6 +278,19 @@ void Controller::solve(double t, StepOutput& out) {
     if (error > recover_error_) relaxed = relax(out);  // behind the target: catch up within the limits
   }
   if (!relaxed) give_up(out);
+}
+
+void Controller::solve_levels(StepOutput& out) {
+  LevelInfo& first = out.levels.front();
+  first.status = result_.info.status;
+  first.iterations = result_.info.iterations;
+  first.residual = result_.info.residual;
+  keep_diagnosis_capacity(first.diagnosis);
+  first.diagnosis.clear();
+  cascade_->first_task_error(*data_, result_.x, first);
+  cascade_->solve_rest(ctx_, *data_, result_.x, out.levels, x_levels_);
+  for (std::size_t l = 1; l < out.levels.size(); ++l) out.info.iterations += out.levels[l].iterations;
+  apply(x_levels_, out);
 }
 
 void Controller::give_up(StepOutput& out) {

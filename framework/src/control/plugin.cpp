@@ -31,9 +31,15 @@ void Objective::set_weight(double weight) {
   weight_ = weight;
 }
 
+void Objective::set_priority(int priority) {
+  REDRES_REQUIRE(priority >= 0, "Objective::set_priority", "the priority of '" + name() + "' is >= 0");
+  priority_ = priority;
+}
+
 void Objective::write_common(toml::table& out) const {
   Plugin::write_common(out);
   out.insert("weight", weight_);
+  if (priority_ != 0) out.insert("priority", priority_);  // a one-level scheme's configuration as it always was
 }
 
 namespace {
@@ -128,11 +134,15 @@ namespace {
 struct ObjectiveCommon {
   std::optional<std::string> name;
   double weight = 1.0;
+  int priority = 0;
   bool active = true;
   static const Schema<ObjectiveCommon>& schema() {
     static const Schema<ObjectiveCommon> s{
         {field("name", &ObjectiveCommon::name, "", "instance name, used in diagnoses (default: the type)"),
          field("weight", &ObjectiveCommon::weight, "", "scales W and zeta", between(0.0, 1e6)),
+         field("priority", &ObjectiveCommon::priority, "",
+               "its level (0 the highest; docs/tasks.md): the levels below keep this level's optimum",
+               between<int>(0, 100)),
          field("active", &ObjectiveCommon::active, "", "false builds the plugin but leaves it out of the QP")}};
     return s;
   }
@@ -180,6 +190,7 @@ std::unique_ptr<Objective> make_objective(const TableReader& config, const Robot
   config.finish();
   apply_common(config, common, *p);
   p->set_weight(common.weight);
+  p->set_priority(common.priority);
   return p;
 }
 

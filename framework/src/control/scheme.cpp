@@ -1,6 +1,7 @@
 #include "redres/control/scheme.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <stdexcept>
 #include <string_view>
@@ -9,7 +10,16 @@ namespace redres {
 
 Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
                std::vector<std::unique_ptr<Constraint>> constraints, SchemeLevel level)
-    : robot_(&robot), objectives_(std::move(objectives)), constraints_(std::move(constraints)), scheme_level_(level) {
+    : Scheme(robot, std::move(objectives), std::move(constraints), {}, level) {}
+
+Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
+               std::vector<std::unique_ptr<Constraint>> constraints, std::vector<std::unique_ptr<Task>> tasks,
+               SchemeLevel level)
+    : robot_(&robot),
+      objectives_(std::move(objectives)),
+      constraints_(std::move(constraints)),
+      tasks_(std::move(tasks)),
+      scheme_level_(level) {
   std::set<std::string> names;
   const auto check_level = [level](const Plugin& p, const char* kind) {
     if (!p.active() || p.supports(level)) return;
@@ -41,6 +51,49 @@ Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> 
     m_eq_ += e;
     m_in_ += i;
   }
+  m_eq_c_ = m_eq_;
+  m_in_c_ = m_in_;
+  for (const auto& t : tasks_) {
+    REDRES_REQUIRE(t != nullptr, "Scheme", "every task is non-null");
+    REDRES_REQUIRE(names.insert(t->name()).second, "Scheme",
+                   "plugin names are unique (two are named '" + t->name() + "'; rename one with set_name())");
+    level_ = std::max(level_, t->kinematics_level());
+    check_level(*t, "task");
+    task_active_.push_back(t->active());
+  }
+  // The levels: the active objectives' and tasks' priorities, highest (0) first.
+  std::set<int> priorities;
+  for (const auto& o : objectives_) {
+    if (o->active()) priorities.insert(o->priority());
+  }
+  for (const auto& t : tasks_) {
+    if (t->active()) priorities.insert(t->priority());
+  }
+  if (priorities.empty()) priorities.insert(0);
+  for (int p : priorities) {
+    SchemeLevelSpec spec;
+    spec.priority = p;
+    for (std::size_t k = 0; k < objectives_.size(); ++k) {
+      if (objectives_[k]->active() && objectives_[k]->priority() == p) spec.objectives.push_back(static_cast<int>(k));
+    }
+    for (std::size_t k = 0; k < tasks_.size(); ++k) {
+      if (tasks_[k]->active() && tasks_[k]->priority() == p) spec.tasks.push_back(static_cast<int>(k));
+    }
+    levels_.push_back(std::move(spec));
+  }
+  // One level: the tasks' rows follow the constraints' in the one QP.
+  for (std::size_t k = 0; k < tasks_.size(); ++k) {
+    const Task& t = *tasks_[k];
+    const bool in_qp = !cascaded() && task_active_[k];
+    const int e = in_qp && t.mode() == TaskMode::kEquality ? t.rows() : 0;
+    const int i = in_qp && t.mode() == TaskMode::kInequality ? t.inequality_rows() : 0;
+    task_eq_offset_.push_back(m_eq_);
+    task_eq_rows_.push_back(e);
+    task_in_offset_.push_back(m_in_);
+    task_in_rows_.push_back(i);
+    m_eq_ += e;
+    m_in_ += i;
+  }
   // The acceleration level's task reads J_dot theta_dot = sum_i theta_dot_i dJ/dtheta_i theta_dot.
   if (level == SchemeLevel::kAcceleration) level_ = std::max(level_, KinematicsLevel::kManipulability);
 }
@@ -48,6 +101,7 @@ Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> 
 Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, double duration, double step) {
   std::vector<std::unique_ptr<Objective>> objectives;
   std::vector<std::unique_ptr<Constraint>> constraints;
+  std::vector<std::unique_ptr<Task>> tasks;
   std::set<std::string> names;
   const auto unique = [&](const TableReader& t, Plugin& p) {
     if (!names.insert(p.name()).second) {
@@ -74,6 +128,12 @@ Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, doubl
       unique(t, *constraints.back());
     }
   }
+  if (root.has("tasks")) {
+    for (const TableReader& t : root.tables("tasks")) {
+      tasks.push_back(make_task(t, robot));
+      unique(t, *tasks.back());
+    }
+  }
   if (objectives.empty()) root.fail("expected at least one [[objectives]] entry (e.g. type = \"min_velocity_norm\")");
   // The robot file's acceleration and jerk limits hold in every run: a scheme that lists no constraint for them gets
   // one (docs/motion.md).
@@ -96,39 +156,52 @@ Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, doubl
     const TableReader scheme(t.file_ptr(), t.raw(), "scheme");
     level = scheme.choice("level", {"velocity", "acceleration"}, "velocity") == "velocity" ? SchemeLevel::kVelocity
                                                                                            : SchemeLevel::kAcceleration;
+    const double eps = scheme.number("regularization", kDefaultRegularization);
+    if (!(eps > 0.0) || !(eps <= 1.0)) scheme.fail("regularization", "expected a number in (0, 1]");
     scheme.finish();
     try {
-      return Scheme(robot, std::move(objectives), std::move(constraints), level);
+      Scheme out(robot, std::move(objectives), std::move(constraints), std::move(tasks), level);
+      out.set_regularization(eps);
+      return out;
     } catch (const std::invalid_argument& e) {
       scheme.fail("level", e.what());
     }
   }
-  return Scheme(robot, std::move(objectives), std::move(constraints), level);
+  return Scheme(robot, std::move(objectives), std::move(constraints), std::move(tasks), level);
+}
+
+void Scheme::set_regularization(double eps) {
+  REDRES_REQUIRE(std::isfinite(eps) && eps > 0.0, "Scheme::set_regularization", "eps > 0 and finite");
+  regularization_ = eps;
 }
 
 SchemeData Scheme::make_data() const {
   SchemeData data;
   for (const auto& o : objectives_) data.objectives.push_back(o->make_data());
   for (const auto& c : constraints_) data.constraints.push_back(c->make_data());
+  for (const auto& t : tasks_) data.tasks.push_back(t->make_data());
   return data;
 }
 
 void Scheme::start(SchemeData& data) const {
-  REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size(),
+  REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size() &&
+                     data.tasks.size() == tasks_.size(),
                  "Scheme::start", "data was made by this scheme's make_data()");
   for (std::size_t k = 0; k < objectives_.size(); ++k) objectives_[k]->start(data.objectives[k].get());
   for (std::size_t k = 0; k < constraints_.size(); ++k) constraints_[k]->start(data.constraints[k].get());
+  for (std::size_t k = 0; k < tasks_.size(); ++k) tasks_[k]->start(data.tasks[k].get());
 }
 
-void Scheme::setup(QpProblem& qp, const SchemeData& data) const {
-  REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size(),
+void Scheme::name_sources(QpProblem& qp, const SchemeData& data) const {
+  REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size() &&
+                     data.tasks.size() == tasks_.size(),
                  "Scheme::setup", "data was made by this scheme's make_data()");
-  qp.resize(robot_->dof(), m_eq_, m_in_);
   qp.source_names.clear();
   qp.variable_names.clear();
   for (const auto& j : robot_->joints()) qp.variable_names.push_back(j.name);
   for (const auto& o : objectives_) qp.source_names.push_back(o->name());
   for (const auto& c : constraints_) qp.source_names.push_back(c->name());
+  for (const auto& t : tasks_) qp.source_names.push_back("task '" + t->name() + "'");
   const int base = static_cast<int>(objectives_.size());
   // The constraints' data, by the vector's storage: it stays where it is when the SchemeData itself is moved.
   const std::unique_ptr<PluginData>* own = data.constraints.data();
@@ -136,6 +209,12 @@ void Scheme::setup(QpProblem& qp, const SchemeData& data) const {
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
       if (row >= in_offset_[k] && row < in_offset_[k] + in_rows_[k]) {
         constraints_[k]->describe_inequality_row_to(own[k].get(), row - in_offset_[k], out);
+        return;
+      }
+    }
+    for (std::size_t k = 0; k < tasks_.size(); ++k) {
+      if (row >= task_in_offset_[k] && row < task_in_offset_[k] + task_in_rows_[k]) {
+        out << "task '" << tasks_[k]->name() << "' bound " << row - task_in_offset_[k] + 1;
         return;
       }
     }
@@ -148,16 +227,74 @@ void Scheme::setup(QpProblem& qp, const SchemeData& data) const {
   }
 }
 
+void Scheme::setup(QpProblem& qp, const SchemeData& data) const {
+  qp.resize(robot_->dof(), m_eq_, m_in_);
+  name_sources(qp, data);
+  for (std::size_t k = 0; k < tasks_.size(); ++k) {
+    for (int r = 0; r < task_eq_rows_[k]; ++r)
+      qp.eq_source[static_cast<std::size_t>(task_eq_offset_[k] + r)] = task_source(k);
+    for (int r = 0; r < task_in_rows_[k]; ++r)
+      qp.in_source[static_cast<std::size_t>(task_in_offset_[k] + r)] = task_source(k);
+  }
+}
+
+void Scheme::setup_constraints(QpProblem& qp, const SchemeData& data) const {
+  qp.resize(robot_->dof(), m_eq_c_, m_in_c_);
+  name_sources(qp, data);
+}
+
 void Scheme::build(const Context& ctx, QpProblem& qp, SchemeData& data) const {
+  REDRES_REQUIRE(!cascaded(), "Scheme::build",
+                 "the scheme has one priority level (with several, the Controller solves one QP per level)");
   REDRES_REQUIRE(qp.n() == robot_->dof() && qp.m_eq() == m_eq_ && qp.m_in() == m_in_, "Scheme::build",
                  "qp was sized by setup()");
+  check_inputs(ctx, data);
+  const bool full_w = contribute_all(ctx, qp, data, false);
+  check_built(ctx, qp, data, full_w, false);
+}
+
+void Scheme::build_constraints(const Context& ctx, QpProblem& qp, SchemeData& data) const {
+  REDRES_REQUIRE(qp.n() == robot_->dof() && qp.m_eq() == m_eq_c_ && qp.m_in() == m_in_c_, "Scheme::build_constraints",
+                 "qp was sized by setup_constraints()");
+  check_inputs(ctx, data);
+  const bool full_w = contribute_all(ctx, qp, data, false, true);
+  check_built(ctx, qp, data, full_w, true);
+}
+
+void Scheme::evaluate_tasks(const Context& ctx, SchemeData& data) const {
+  check_inputs(ctx, data);
+  for (std::size_t k = 0; k < tasks_.size(); ++k) {
+    if (task_active_[k]) tasks_[k]->evaluate(ctx, static_cast<TaskData&>(*data.tasks[k]));
+  }
+}
+
+QpBuilder::WrittenW Scheme::build_objectives(const Context& ctx, int level, QpProblem& qp, SchemeData& data) const {
+  REDRES_REQUIRE(level >= 0 && level < static_cast<int>(levels_.size()) && qp.n() == robot_->dof(),
+                 "Scheme::build_objectives", "0 <= level < levels().size() and qp has n variables");
+  qp.clear();
+  QpBuilder builder(qp);
+  QpBuilder::WrittenW written = QpBuilder::WrittenW::kNone;
+  for (int k : levels_[static_cast<std::size_t>(level)].objectives) {
+    const Objective& o = *objectives_[static_cast<std::size_t>(k)];
+    builder.begin(k, o.weight(), 0, 0, 0, 0);
+    o.contribute(ctx, builder, data.objectives[static_cast<std::size_t>(k)].get());
+    written = std::max(written, builder.written_w());
+  }
+  return written;
+}
+
+void Scheme::check_inputs(const Context& ctx, const SchemeData& data) const {
   REDRES_REQUIRE(ctx.kinematics != nullptr && ctx.robot == robot_, "Scheme::build",
                  "ctx.robot is the scheme's robot and ctx.kinematics is set");
   REDRES_REQUIRE(ctx.kinematics->level >= level_, "Scheme::build",
                  "ctx.kinematics was computed at kinematics_level() or deeper");
-  REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size(),
+  REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size() &&
+                     data.tasks.size() == tasks_.size(),
                  "Scheme::build", "data was made by this scheme's make_data()");
-  const bool full_w = contribute_all(ctx, qp, data, false);
+}
+
+void Scheme::check_built(const Context& ctx, QpProblem& qp, SchemeData& data, bool full_w,
+                         bool constraints_only) const {
   // One scan of everything the plugins can have written (bounds are checked as they are intersected; W off its
   // diagonal keeps clear()'s zeros unless a plugin wrote there).
   const Eigen::Index n = qp.W.rows();
@@ -173,19 +310,24 @@ void Scheme::build(const Context& ctx, QpProblem& qp, SchemeData& data) const {
          finite_probe(qp.b.data(), qp.b.size());
   if (acc == 0.0 && (!full_w || qp.W.isApprox(qp.W.transpose(), 1e-12))) return;
   // Build again with a check after each plugin, which names the plugin and the entry, and throws.
-  contribute_all(ctx, qp, data, true);
+  contribute_all(ctx, qp, data, true, constraints_only);
   qp.validate();  // the checked build found nothing (a plugin that gives different values when called again)
   throw_invalid_argument("Scheme::build",
                          "the QP had a non-finite or asymmetric entry that a second build did not "
                          "reproduce (a plugin whose output changes between two calls at one state)");
 }
 
-bool Scheme::contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked) const {
+bool Scheme::contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked,
+                            bool constraints_only) const {
   qp.clear();
   QpBuilder builder(qp);
   bool full_w = false;  // some plugin wrote off the diagonal of W
   int source = 0;
   for (std::size_t k = 0; k < objectives_.size(); ++k) {
+    if (constraints_only) {
+      ++source;
+      continue;
+    }
     const Objective& o = *objectives_[k];
     PluginData* own = data.objectives[k].get();
     builder.begin(source++, o.weight(), 0, 0, 0, 0);
@@ -205,6 +347,17 @@ bool Scheme::contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data,
     } else {
       constraints_[k]->contribute_unchecked(ctx, builder, own);
     }
+    full_w = full_w || builder.written_w() == QpBuilder::WrittenW::kFull;
+  }
+  if (constraints_only) return full_w;
+  // One level: the tasks (each checks its own rows as it computes them).
+  for (std::size_t k = 0; k < tasks_.size(); ++k) {
+    if (!task_active_[k]) continue;
+    const Task& t = *tasks_[k];
+    auto& own = static_cast<TaskData&>(*data.tasks[k]);
+    t.evaluate(ctx, own);
+    builder.begin(task_source(k), 1.0, task_eq_offset_[k], task_eq_rows_[k], task_in_offset_[k], task_in_rows_[k]);
+    write_task_terms(t, own.rows, builder);
     full_w = full_w || builder.written_w() == QpBuilder::WrittenW::kFull;
   }
   return full_w;

@@ -24,6 +24,27 @@ void QpBuilder::add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H) {
   }
 }
 
+void QpBuilder::add_least_squares(const Eigen::Ref<const Eigen::MatrixXd>& J,
+                                  const Eigen::Ref<const Eigen::VectorXd>& d, double w) {
+  const Eigen::Index n = qp_->n(), k = J.rows();
+  REDRES_REQUIRE(J.cols() == n && d.size() == k, "QpBuilder::add_least_squares", "J is k x n and d has k entries");
+  const double s = weight_ * w;
+  Eigen::MatrixXd& W = qp_->W;
+  for (Eigen::Index c = 0; c < n; ++c) {
+    for (Eigen::Index r = 0; r < n; ++r) {
+      double g = 0.0;
+      for (Eigen::Index i = 0; i < k; ++i) g += J(i, r) * J(i, c);
+      W(r, c) += s * g;
+      if (r != c && g != 0.0) qp_->w_diagonal = false;
+    }
+    double z = 0.0;
+    for (Eigen::Index i = 0; i < k; ++i) z += J(i, c) * d(i);
+    qp_->zeta(c) -= s * z;
+  }
+  wrote_w(WrittenW::kFull);
+  wrote_zeta_ = true;
+}
+
 void QpBuilder::bad_size(const char* function, const char* condition) { throw_invalid_argument(function, condition); }
 
 void QpBuilder::bad_bound(int joint, double lower, double upper) const {

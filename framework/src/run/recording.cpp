@@ -29,13 +29,14 @@ Eigen::Vector3d continuous_rotation_vector(const Eigen::Vector3d& w, const Eigen
 
 std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders) {
   std::vector<std::string> columns = standard_trajectory_columns(*s.robot);
-  const auto add_recorder = [&](const Plugin& p, std::size_t objective, std::size_t constraint) {
+  const auto add_recorder = [&](const Plugin& p, std::size_t objective, std::size_t constraint,
+                                std::size_t task = kNoPlugin) {
     if (!p.active()) return;
     const PluginOutput* output = output_of(p);
     if (output == nullptr) return;
     const std::vector<std::string> own = output->recorded_columns();
     if (own.empty()) return;
-    if (recorders != nullptr) recorders->push_back({output, nullptr, columns.size(), objective, constraint});
+    if (recorders != nullptr) recorders->push_back({output, nullptr, columns.size(), objective, constraint, task});
     for (const auto& c : own) {
       // Two plugins may record the same quantity (two obstacle sets): the second gets its name as a prefix.
       const bool taken = std::find(columns.begin(), columns.end(), c) != columns.end();
@@ -46,6 +47,14 @@ std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* r
   const auto& constraints = s.scheme->constraints();
   for (std::size_t k = 0; k < objectives.size(); ++k) add_recorder(*objectives[k], k, kNoPlugin);
   for (std::size_t k = 0; k < constraints.size(); ++k) add_recorder(*constraints[k], kNoPlugin, k);
+  const auto& tasks = s.scheme->tasks();
+  for (std::size_t k = 0; k < tasks.size(); ++k) add_recorder(*tasks[k], kNoPlugin, kNoPlugin, k);
+  if (s.scheme->cascaded()) {
+    for (const SchemeLevelSpec& level : s.scheme->levels()) {
+      columns.push_back("level_" + std::to_string(level.priority) + "_status");
+      columns.push_back("level_" + std::to_string(level.priority) + "_iterations");
+    }
+  }
   if (s.plant.kind == PlantKind::kMujoco) {
     for (auto& c : plant_columns(s.robot->dof())) columns.push_back(std::move(c));
   }
@@ -72,7 +81,14 @@ RowRecorder::RowRecorder(const Scenario& s, const Controller& ctrl, std::vector<
       position_rows_(s.robot->position_rows()) {
   const SchemeData& data = ctrl.plugin_data();
   for (Recorder& r : recorders_) {
-    r.data = r.objective != kNoPlugin ? data.objectives[r.objective].get() : data.constraints[r.constraint].get();
+    r.data = r.objective != kNoPlugin    ? data.objectives[r.objective].get()
+             : r.constraint != kNoPlugin ? data.constraints[r.constraint].get()
+                                         : data.tasks[r.task].get();
+  }
+  if (s.scheme->cascaded()) {
+    const std::vector<std::string> columns = run_columns(s, nullptr);
+    const std::string first = "level_" + std::to_string(s.scheme->levels().front().priority) + "_status";
+    levels_first_ = static_cast<std::size_t>(std::find(columns.begin(), columns.end(), first) - columns.begin());
   }
   standard_columns_ = recorders_.empty() ? width : recorders_.front().first;
   orientation_rows_ = robot_->has_orientation_rows();
@@ -164,6 +180,10 @@ double* RowRecorder::write(int k, double t, const Eigen::VectorXd& theta, const 
     }
   }
   for (const Recorder& r : recorders_) r.output->record(r.data, row + r.first);
+  for (std::size_t l = 0; l < out.levels.size(); ++l) {
+    row[levels_first_ + 2 * l] = static_cast<double>(static_cast<int>(out.levels[l].status));
+    row[levels_first_ + 2 * l + 1] = out.levels[l].iterations;
+  }
   return row;
 }
 

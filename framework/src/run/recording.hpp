@@ -25,11 +25,13 @@ struct Recorder {
   const PluginData* data = nullptr;
   std::size_t first = 0;
   std::size_t objective = 0, constraint = 0;  //!< which plugin: objective k (constraint = kNoPlugin) or constraint k
+  std::size_t task = static_cast<std::size_t>(-1);  //!< or task k (objective = constraint = kNoPlugin)
 };
 inline constexpr std::size_t kNoPlugin = static_cast<std::size_t>(-1);
 
 /// The columns a run of `s` records: the standard ones, then the plugins' own (a name that an earlier plugin took
-/// is "<plugin>.<column>"), with each recording plugin (its data not yet known) when `recorders` is given, then the
+/// is "<plugin>.<column>"), with each recording plugin (its data not yet known) when `recorders` is given, then, for a
+/// scheme with several priority levels, level_<p>_status and level_<p>_iterations per level (priority p), then the
 /// MuJoCo plant's (plant_columns()) when the scenario runs on it.
 [[nodiscard]] std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders);
 
@@ -69,6 +71,7 @@ class RowRecorder {
   Eigen::Vector3d wd_prev_ = Eigen::Vector3d::Zero(), w_prev_ = Eigen::Vector3d::Zero();
   Eigen::VectorXd acc_lo_, acc_hi_;  // the acceleration laws at theta (robots with acceleration limits)
   bool acc_limits_ = false;          // the robot has them: the acc_lo_/acc_hi_ columns are recorded
+  std::size_t levels_first_ = 0;     // the first level_<p>_status column (a cascaded scheme)
 };
 
 /// The run's log of step outcomes, kept in its RunResult.

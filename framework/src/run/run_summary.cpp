@@ -166,6 +166,8 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   const auto& constraints = s.scheme->constraints();
   for (std::size_t k = 0; k < objectives.size(); ++k) collect(*objectives[k], data ? &data->objectives : nullptr, k);
   for (std::size_t k = 0; k < constraints.size(); ++k) collect(*constraints[k], data ? &data->constraints : nullptr, k);
+  const auto& tasks = s.scheme->tasks();
+  for (std::size_t k = 0; k < tasks.size(); ++k) collect(*tasks[k], data ? &data->tasks : nullptr, k);
   return out;
 }
 

@@ -453,10 +453,13 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
       entry<C>("constraints", "array of tables [[constraints]]", "", "none",
                "the hard constraints; their keys are their type's (redres plugins)",
                [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
-      entry<C>(
-          "scheme", "table [scheme]", "", "level = \"velocity\"",
-          "`level`: \"velocity\" (x = theta_dot, the paper's) or \"acceleration\" (x = theta_ddot; docs/motion.md)",
-          [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
+      entry<C>("tasks", "array of tables [[tasks]]", "", "none",
+               "tasks on frames and joints, each hard, soft or an inequality, at a priority (docs/tasks.md)",
+               [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
+      entry<C>("scheme", "table [scheme]", "", "level = \"velocity\"",
+               "`level`: \"velocity\" (x = theta_dot, the paper's) or \"acceleration\" (x = theta_ddot; "
+               "docs/motion.md); `regularization`: the eps |x|^2 / 2 of every priority level (docs/tasks.md)",
+               [](const TableReader&, C&) {}),  // read with `objectives`, into the same scheme
       entry<C>("solver", "table", "", "engine = \"projection\"",
                "the LVI engine and its settings (redres plugins), and what a step that is not solved does",
                [](const TableReader& r, C& c) {

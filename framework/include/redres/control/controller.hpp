@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "redres/control/cascade.hpp"
 #include "redres/control/orientation_reference.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/scheme.hpp"
@@ -32,6 +33,9 @@ struct StepOutput {
   SolverInfo info;              //!< status, iterations, residual, engine, diagnosis
   double task_row_error = 0.0;  //!< for a `relaxed` step, max_r |J_r theta_dot - d_r|: how far the equality rows
                                 //!< are missed (0 for every other status)
+  /// With several priority levels (Scheme::cascaded()): each level's outcome, highest first (info is level 0's, with
+  /// the iterations of every level); empty otherwise.
+  std::vector<LevelInfo> levels;
 };
 
 struct Scenario;
@@ -147,6 +151,7 @@ class Controller {
 
  private:
   void solve(double t, StepOutput& out);
+  void solve_levels(StepOutput& out);  // a cascaded scheme's levels below the first
   void begin_step();                     // the previous step's command becomes theta_dot_prev
   void end_step(const StepOutput& out);  // this step's command and status, for the next
   bool relax(StepOutput& out);           // the elastic QP; false when it fails too
@@ -185,6 +190,8 @@ class Controller {
   std::unique_ptr<LviEngine> relax_engine_;  // an engine like *engine_ for the elastic QP
   ElasticQp relaxed_;                        // the elastic QP (no equality rows)
   SolverResult relaxed_result_;
+  std::unique_ptr<Cascade> cascade_;  // a cascaded scheme's levels (null with one level)
+  Eigen::VectorXd x_levels_;          // the answer of the lowest level solved
 };
 
 }  // namespace redres

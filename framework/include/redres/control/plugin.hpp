@@ -123,6 +123,11 @@ class Objective : public Plugin {
   [[nodiscard]] double weight() const noexcept { return weight_; }
   /// Sets the weight; std::invalid_argument unless finite and >= 0.
   void set_weight(double weight);
+  /// Its priority level (0, the default, is the highest; docs/tasks.md): with tasks or objectives at several
+  /// priorities the controller solves one QP per level.
+  [[nodiscard]] int priority() const noexcept { return priority_; }
+  /// Sets the priority; std::invalid_argument unless >= 0.
+  void set_priority(int priority);
   /// Adds this objective's terms and validates them. `data` is what make_data() made for the calling controller.
   void contribute(const Context& ctx, QpBuilder& builder, PluginData* data) const;
   /// Framework use (Scheme::build): adds the terms without validating them; the caller checks the whole QP after
@@ -146,6 +151,7 @@ class Objective : public Plugin {
   virtual void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const = 0;
 
   double weight_ = 1.0;
+  int priority_ = 0;
 };
 
 /// A constraint adds equality rows, inequality rows or bounds.
@@ -198,7 +204,7 @@ ObjectiveRegistry& objective_registry();
 /// The process-wide constraint registry.
 ConstraintRegistry& constraint_registry();
 
-/// The keys every objective takes besides its own (`name`, `weight`, `active`).
+/// The keys every objective takes besides its own (`name`, `weight`, `priority`, `active`).
 [[nodiscard]] const std::vector<KeyInfo>& objective_common_keys();
 /// The keys every constraint takes besides its own (`name`, `active`).
 [[nodiscard]] const std::vector<KeyInfo>& constraint_common_keys();

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "redres/control/plugin.hpp"
+#include "redres/control/task.hpp"
 
 namespace redres {
 
@@ -14,18 +15,34 @@ namespace redres {
 struct SchemeData {
   std::vector<std::unique_ptr<PluginData>> objectives;   //!< one per objective
   std::vector<std::unique_ptr<PluginData>> constraints;  //!< one per constraint
+  std::vector<std::unique_ptr<PluginData>> tasks;        //!< one per task (a TaskData)
+};
+
+/// One priority level of a scheme: its active objectives and tasks (indices into the scheme's lists).
+struct SchemeLevelSpec {
+  int priority = 0;
+  std::vector<int> objectives;
+  std::vector<int> tasks;
 };
 
 /// Objectives and constraints assembled into one QP. Immutable after construction, so one scheme can serve several
 /// controllers at once (each with its own SchemeData, in its own thread); build() allocates nothing.
 class Scheme {
  public:
+  /// The default of regularization().
+  static constexpr double kDefaultRegularization = 1e-8;
   /// Takes ownership of the plugins; sizes follow from the robot and the constraints' row counts.
   /// Throws std::invalid_argument when an active plugin does not work at `level` (Plugin::supports).
   Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
          std::vector<std::unique_ptr<Constraint>> constraints, SchemeLevel level = SchemeLevel::kVelocity);
+  /// The same with tasks (control/task.hpp). Active objectives and tasks are grouped by priority into levels(); with
+  /// one level, build() writes the tasks into the one QP (after the constraints' rows); with several, the Controller
+  /// solves the levels in turn (control/cascade.hpp) and build() is not used.
+  Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
+         std::vector<std::unique_ptr<Constraint>> constraints, std::vector<std::unique_ptr<Task>> tasks,
+         SchemeLevel level = SchemeLevel::kVelocity);
 
-  /// Reads `[[objectives]]` and `[[constraints]]` arrays of tables from `root`, and the `[scheme]` table's `level`.
+  /// Reads `[[objectives]]`, `[[constraints]]` and `[[tasks]]` arrays of tables from `root`, and the `[scheme]` table's `level`.
   /// When the robot file gives every joint an acceleration (jerk) limit and no constraint of type
   /// `joint_acceleration_limits` (`joint_jerk_limits`) is listed, one is added with its defaults, so that the robot's
   /// limits hold in every run (list one with `active = false` to run without). Each plugin's source() is its
@@ -47,11 +64,43 @@ class Scheme {
   /// the entry. The QP it leaves is therefore valid (QpProblem::validate() would pass).
   void build(const Context& ctx, QpProblem& qp, SchemeData& data) const;
 
+  /// Cascade use: writes only the constraints' rows and bounds into `qp` (sized n, constraint_equality_rows(),
+  /// constraint_inequality_rows(); set up by setup_constraints()), with build()'s checks.
+  void build_constraints(const Context& ctx, QpProblem& qp, SchemeData& data) const;
+  /// Cascade use: sizes `qp` for the constraints alone and names every source (objectives, constraints, tasks).
+  void setup_constraints(QpProblem& qp, const SchemeData& data) const;
+  /// Cascade use: computes every active task's rows into its TaskData (checked: a non-finite entry throws
+  /// std::invalid_argument naming the task).
+  void evaluate_tasks(const Context& ctx, SchemeData& data) const;
+  /// Cascade use: clears `qp` (sized n, 0, 0) and adds the objectives of levels()[level], checked; returns what they
+  /// wrote to W.
+  QpBuilder::WrittenW build_objectives(const Context& ctx, int level, QpProblem& qp, SchemeData& data) const;
+
+  /// The priority levels of the active objectives and tasks, highest first (at least one).
+  [[nodiscard]] const std::vector<SchemeLevelSpec>& levels() const noexcept { return levels_; }
+  /// Whether there are several levels (the Controller then solves one QP per level).
+  [[nodiscard]] bool cascaded() const noexcept { return levels_.size() > 1; }
+  /// The tasks.
+  [[nodiscard]] const std::vector<std::unique_ptr<Task>>& tasks() const noexcept { return tasks_; }
+  /// The constraints' equality and inequality rows (without the tasks').
+  [[nodiscard]] int constraint_equality_rows() const noexcept { return m_eq_c_; }
+  [[nodiscard]] int constraint_inequality_rows() const noexcept { return m_in_c_; }
+  /// The QP source index of task k (objectives, then constraints, then tasks).
+  [[nodiscard]] int task_source(std::size_t k) const noexcept {
+    return static_cast<int>(objectives_.size() + constraints_.size() + k);
+  }
+
+  /// With several levels: the eps of the eps |x|^2 / 2 that every level adds to make its answer unique (not held;
+  /// control/cascade.hpp). `[scheme] regularization`.
+  [[nodiscard]] double regularization() const noexcept { return regularization_; }
+  /// Sets it (> 0, finite).
+  void set_regularization(double eps);
+
   /// The deepest kinematics any plugin reads.
   [[nodiscard]] KinematicsLevel kinematics_level() const noexcept { return level_; }
   /// What the QP's x is: theta_dot or theta_ddot.
   [[nodiscard]] SchemeLevel level() const noexcept { return scheme_level_; }
-  /// Total equality and inequality rows.
+  /// Total equality and inequality rows of build()'s QP (the constraints' and, with one level, the tasks').
   [[nodiscard]] int equality_rows() const noexcept { return m_eq_; }
   [[nodiscard]] int inequality_rows() const noexcept { return m_in_; }
   /// The plugins.
@@ -64,13 +113,22 @@ class Scheme {
   const RobotModel* robot_;
   std::vector<std::unique_ptr<Objective>> objectives_;
   std::vector<std::unique_ptr<Constraint>> constraints_;
+  std::vector<std::unique_ptr<Task>> tasks_;
+  std::vector<SchemeLevelSpec> levels_;
   std::vector<int> eq_offset_, eq_rows_, in_offset_, in_rows_;
-  int m_eq_ = 0, m_in_ = 0;
+  std::vector<int> task_eq_offset_, task_eq_rows_, task_in_offset_, task_in_rows_;  // one level: the tasks' rows
+  std::vector<bool> task_active_;  // active when the scheme was built (only those are in levels_ and the QP)
+  int m_eq_ = 0, m_in_ = 0, m_eq_c_ = 0, m_in_c_ = 0;
+  double regularization_ = kDefaultRegularization;
   KinematicsLevel level_ = KinematicsLevel::kPosition;
   SchemeLevel scheme_level_ = SchemeLevel::kVelocity;
   // Clears qp and lets every plugin write (checked: through contribute(), which throws naming a culprit); returns
   // whether a plugin wrote off W's diagonal.
-  bool contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked) const;
+  bool contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked,
+                      bool constraints_only = false) const;
+  void check_built(const Context& ctx, QpProblem& qp, SchemeData& data, bool full_w, bool constraints_only) const;
+  void name_sources(QpProblem& qp, const SchemeData& data) const;
+  void check_inputs(const Context& ctx, const SchemeData& data) const;
 };
 
 }  // namespace redres

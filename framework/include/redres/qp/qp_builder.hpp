@@ -30,6 +30,9 @@ class QpBuilder {
   void add_diagonal(const Eigen::Ref<const Eigen::VectorXd>& diagonal);
   /// W += weight * H (H symmetric); marks W as non-diagonal when H has off-diagonal entries.
   void add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H);
+  /// A least squares (w / 2) |J x - d|^2 (J: k x n): W += weight * w * J'J, zeta -= weight * w * J'd. Allocation-free.
+  void add_least_squares(const Eigen::Ref<const Eigen::MatrixXd>& J, const Eigen::Ref<const Eigen::VectorXd>& d,
+                         double w);
   /// zeta += weight * z.
   void add_linear(const Eigen::Ref<const Eigen::VectorXd>& z) {
     const Eigen::Index n = qp_->zeta.size();

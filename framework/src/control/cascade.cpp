@@ -1,0 +1,420 @@
+#include "redres/control/cascade.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "redres/control/engine_registry.hpp"
+
+namespace redres {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// A held row whose part outside the rows held before it is below this (relative to its norm) adds nothing.
+constexpr double kDependent = 1e-9;
+}  // namespace
+
+/// What an inequality row of a level's QP past the constraints' stands for.
+struct Cascade::RowTag {
+  int task = -1;  // the task (index in the scheme), or -1: a higher level's objectives held
+  int row = 0;    // the task's row
+  bool upper = true;
+  bool held = false;
+  int priority = 0;  // the level it comes from
+};
+
+struct Cascade::Level {
+  int priority = 0;
+  std::vector<int> tasks, objectives;
+  int eq_tasks = 0;       // the rows of its equality tasks
+  int in_tasks = 0;       // the inequality rows of its inequality tasks (and, in least squares, its slacks)
+  int held_eq = 0;        // rows held from the levels above (an orthonormal basis, padded with 0 x = 0)
+  int held_in = 0;        // inequality rows held from the levels above
+  std::vector<RowTag> in_tags;  // its QP's inequality rows past the constraints'
+  bool has_ls = false;          // below the first, with equality or inequality tasks: a least-squares retry
+  QpProblem qp, ls;
+  std::unique_ptr<LviEngine> engine, ls_engine;
+  SolverResult result, ls_result;
+};
+
+Cascade::~Cascade() = default;
+
+Cascade::Cascade(const Scheme& scheme, const SchemeData& data, const LviEngine& engine)
+    : scheme_(&scheme), n_(scheme.robot().dof()), eps_(scheme.regularization()) {
+  REDRES_REQUIRE(scheme.cascaded(), "Cascade", "the scheme has several priority levels");
+  scheme.setup_constraints(base_, data);
+  obj_.resize(n_, 0, 0);
+  const auto& tasks = scheme.tasks();
+  for (const auto& t : tasks) {
+    std::vector<std::string> names;
+    for (int r = 0; r < t->rows(); ++r) names.push_back(t->row_name(r));
+    row_names_.push_back(std::move(names));
+  }
+  int held_eq = 0, held_in = 0;
+  std::vector<RowTag> held_tags;
+  for (const SchemeLevelSpec& spec : scheme.levels()) {
+    auto level = std::make_unique<Level>();
+    level->priority = spec.priority;
+    level->tasks = spec.tasks;
+    level->objectives = spec.objectives;
+    level->held_eq = std::min(held_eq, n_);
+    level->held_in = held_in;
+    for (int k : spec.tasks) {
+      const Task& t = *tasks[static_cast<std::size_t>(k)];
+      if (t.mode() == TaskMode::kEquality) level->eq_tasks += t.rows();
+      if (t.mode() == TaskMode::kInequality) {
+        level->in_tasks += t.inequality_rows();
+        for (int r = 0; r < t.rows(); ++r) {
+          if (t.has_upper(r)) level->in_tags.push_back({k, r, true, false, spec.priority});
+          if (t.has_lower(r)) level->in_tags.push_back({k, r, false, false, spec.priority});
+        }
+      }
+    }
+    level->in_tags.insert(level->in_tags.end(), held_tags.begin(), held_tags.end());
+    // What this level leaves held for those below it.
+    for (int k : spec.tasks) {
+      const Task& t = *tasks[static_cast<std::size_t>(k)];
+      if (t.mode() == TaskMode::kInequality) {
+        held_in += t.inequality_rows();
+        for (int r = 0; r < t.rows(); ++r) {
+          if (t.has_upper(r)) held_tags.push_back({k, r, true, true, spec.priority});
+          if (t.has_lower(r)) held_tags.push_back({k, r, false, true, spec.priority});
+        }
+      } else {
+        held_eq += t.rows();
+      }
+    }
+    if (!spec.objectives.empty()) {
+      ++held_in;
+      held_tags.push_back({-1, 0, true, true, spec.priority});
+    }
+    level->has_ls = !levels_.empty() && level->eq_tasks + level->in_tasks > 0;
+    levels_.push_back(std::move(level));
+  }
+  held_J_ = Eigen::MatrixXd::Zero(std::min(held_eq, n_), n_);
+  held_d_ = Eigen::VectorXd::Zero(held_J_.rows());
+  held_A_ = Eigen::MatrixXd::Zero(held_in, n_);
+  held_b_ = Eigen::VectorXd::Zero(held_in);
+  for (std::size_t l = 1; l < levels_.size(); ++l) {
+    Level& L = *levels_[l];
+    size_level(static_cast<int>(l), L.qp, false);
+    L.engine = make_engine(std::string(engine.name()), engine.settings());
+    L.engine->setup(L.qp.n(), L.qp.m_eq(), L.qp.m_in(), L.result);
+    if (L.has_ls) {
+      size_level(static_cast<int>(l), L.ls, true);
+      L.ls_engine = make_engine(std::string(engine.name()), engine.settings());
+      L.ls_engine->setup(L.ls.n(), L.ls.m_eq(), L.ls.m_in(), L.ls_result);
+    }
+  }
+  note_.reserve(kDiagnosisCapacity);
+}
+
+void Cascade::size_level(int l, QpProblem& qp, bool least_squares) const {
+  const Level& L = *levels_[static_cast<std::size_t>(l)];
+  const int slack = least_squares ? L.in_tasks : 0;
+  const int m_eq = base_.m_eq() + (least_squares ? 0 : L.eq_tasks) + L.held_eq;
+  const int m_in = base_.m_in() + L.in_tasks + L.held_in;
+  qp.resize(n_ + slack, m_eq, m_in);
+  qp.source_names = base_.source_names;
+  qp.variable_names = base_.variable_names;
+  for (int s = 0; s < slack; ++s) qp.variable_names.push_back("slack " + std::to_string(s + 1));
+  const int held_source = static_cast<int>(qp.source_names.size());
+  qp.source_names.push_back("the higher levels' optima, held");
+  std::copy(base_.eq_source.begin(), base_.eq_source.end(), qp.eq_source.begin());
+  std::copy(base_.in_source.begin(), base_.in_source.end(), qp.in_source.begin());
+  int row = base_.m_eq();
+  if (!least_squares) {
+    for (int k : L.tasks) {
+      const Task& t = *scheme_->tasks()[static_cast<std::size_t>(k)];
+      if (t.mode() != TaskMode::kEquality) continue;
+      for (int r = 0; r < t.rows(); ++r) qp.eq_source[static_cast<std::size_t>(row++)] = scheme_->task_source(k);
+    }
+  }
+  for (int r = 0; r < L.held_eq; ++r) qp.eq_source[static_cast<std::size_t>(row++)] = held_source;
+  for (std::size_t r = 0; r < L.in_tags.size(); ++r) {
+    const RowTag& tag = L.in_tags[r];
+    qp.in_source[static_cast<std::size_t>(base_.m_in()) + r] =
+        tag.held ? held_source : scheme_->task_source(static_cast<std::size_t>(tag.task));
+  }
+  const std::function<void(int, TextSink&)>& constraints = base_.in_row_description;
+  const int m_in_c = base_.m_in();
+  qp.in_row_description = [this, l, m_in_c, &constraints](int r, TextSink& out) {
+    if (r < m_in_c) {
+      if (constraints) constraints(r, out);
+      return;
+    }
+    const RowTag& tag = levels_[static_cast<std::size_t>(l)]->in_tags[static_cast<std::size_t>(r - m_in_c)];
+    if (tag.task < 0) {
+      out << "the value of priority " << tag.priority << "'s objectives, held";
+      return;
+    }
+    out << "task '" << scheme_->tasks()[static_cast<std::size_t>(tag.task)]->name() << "' row '"
+        << row_names_[static_cast<std::size_t>(tag.task)][static_cast<std::size_t>(tag.row)] << "' "
+        << (tag.upper ? "upper" : "lower") << " bound";
+    if (tag.held) out << " (priority " << tag.priority << ", held where it ended)";
+  };
+}
+
+void Cascade::setup_first(QpProblem& qp) const { size_level(0, qp, false); }
+
+void Cascade::reset() {
+  for (std::size_t l = 1; l < levels_.size(); ++l) {
+    levels_[l]->engine->reset();
+    if (levels_[l]->ls_engine) levels_[l]->ls_engine->reset();
+  }
+}
+
+namespace {
+// W(0:n, 0:n) += w J'J, zeta(0:n) -= w J'd.
+void add_least_squares(QpProblem& qp, const Eigen::MatrixXd& J, const Eigen::VectorXd& d, double w) {
+  const Eigen::Index n = J.cols(), k = J.rows();
+  for (Eigen::Index c = 0; c < n; ++c) {
+    for (Eigen::Index r = 0; r < n; ++r) {
+      double g = 0.0;
+      for (Eigen::Index i = 0; i < k; ++i) g += J(i, r) * J(i, c);
+      qp.W(r, c) += w * g;
+    }
+    double z = 0.0;
+    for (Eigen::Index i = 0; i < k; ++i) z += J(i, c) * d(i);
+    qp.zeta(c) -= w * z;
+  }
+  qp.w_diagonal = false;
+}
+}  // namespace
+
+void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_squares) {
+  const Level& L = *levels_[static_cast<std::size_t>(l)];
+  const int n = n_;
+  qp.clear();
+  // The objective: the level's objectives, its soft tasks, eps (and the damping of its soft tasks).
+  qp.W.topLeftCorner(n, n) = obj_.W;
+  qp.zeta.head(n) = obj_.zeta;
+  qp.w_diagonal = obj_.w_diagonal;
+  for (int i = 0; i < n; ++i) qp.W(i, i) += eps_;
+  // The constraints: rows and bounds.
+  const int me = base_.m_eq(), mi = base_.m_in();
+  qp.J.topLeftCorner(me, n) = base_.J;
+  qp.d.head(me) = base_.d;
+  qp.A.topLeftCorner(mi, n) = base_.A;
+  qp.b.head(mi) = base_.b;
+  qp.lo.head(n) = base_.lo;
+  qp.hi.head(n) = base_.hi;
+  std::copy_n(base_.lo_source.begin(), n, qp.lo_source.begin());
+  std::copy_n(base_.hi_source.begin(), n, qp.hi_source.begin());
+  // The level's tasks.
+  int eq = me, in = mi, slack = n;
+  for (int k : L.tasks) {
+    const Task& t = *scheme_->tasks()[static_cast<std::size_t>(k)];
+    const TaskTerms& terms = static_cast<const TaskData&>(*data.tasks[static_cast<std::size_t>(k)]).rows;
+    const int rows = t.rows();
+    switch (t.mode()) {
+      case TaskMode::kEquality:
+        if (least_squares) {
+          add_least_squares(qp, terms.J, terms.d, t.weight());
+        } else {
+          qp.J.block(eq, 0, rows, n) = terms.J;
+          qp.d.segment(eq, rows) = terms.d;
+          eq += rows;
+        }
+        break;
+      case TaskMode::kSoft:
+        add_least_squares(qp, terms.J, terms.d, t.weight());
+        for (int i = 0; i < n; ++i) qp.W(i, i) += t.weight() * terms.damping;
+        break;
+      case TaskMode::kInequality:
+        for (int r = 0; r < rows; ++r) {
+          for (int side = 0; side < 2; ++side) {
+            const bool upper = side == 0;
+            if (upper ? !t.has_upper(r) : !t.has_lower(r)) continue;
+            const double sign = upper ? 1.0 : -1.0;
+            qp.A.row(in).head(n) = sign * terms.J.row(r);
+            qp.b(in) = upper ? terms.hi(r) : -terms.lo(r);
+            if (least_squares) {
+              qp.A(in, slack) = -1.0;
+              qp.W(slack, slack) = t.weight();
+              ++slack;
+            }
+            ++in;
+          }
+        }
+        break;
+    }
+  }
+  // The higher levels' optima.
+  qp.J.block(eq, 0, L.held_eq, n) = held_J_.topRows(L.held_eq);
+  qp.d.segment(eq, L.held_eq) = held_d_.head(L.held_eq);
+  qp.A.block(in, 0, L.held_in, n) = held_A_.topRows(L.held_in);
+  qp.b.segment(in, L.held_in) = held_b_.head(L.held_in);
+}
+
+void Cascade::hold(int l, const SchemeData& data, const Eigen::VectorXd& x) {
+  const Level& L = *levels_[static_cast<std::size_t>(l)];
+  const int n = n_;
+  for (int k : L.tasks) {
+    const Task& t = *scheme_->tasks()[static_cast<std::size_t>(k)];
+    const TaskTerms& terms = static_cast<const TaskData&>(*data.tasks[static_cast<std::size_t>(k)]).rows;
+    if (t.mode() == TaskMode::kInequality) {
+      for (int r = 0; r < t.rows(); ++r) {
+        const double v = terms.J.row(r).dot(x);
+        if (t.has_upper(r)) {
+          held_A_.row(held_in_) = terms.J.row(r);
+          held_b_(held_in_++) = std::max(terms.hi(r), v);
+        }
+        if (t.has_lower(r)) {
+          held_A_.row(held_in_) = -terms.J.row(r);
+          held_b_(held_in_++) = std::max(-terms.lo(r), -v);
+        }
+      }
+      continue;
+    }
+    // Equality and soft rows: J x = J x*, kept as an orthonormal basis (modified Gram-Schmidt) of the rows held so
+    // far, so that the held rows are independent (a row in their span adds nothing and is left out).
+    for (int r = 0; r < t.rows(); ++r) {
+      if (held_eq_ >= held_J_.rows()) break;  // n independent rows: x is decided
+      auto q = held_J_.row(held_eq_);
+      q = terms.J.row(r);
+      const double norm0 = q.norm();
+      if (!(norm0 > 0.0)) continue;
+      for (int i = 0; i < held_eq_; ++i) q -= q.dot(held_J_.row(i)) * held_J_.row(i);
+      for (int i = 0; i < held_eq_; ++i) q -= q.dot(held_J_.row(i)) * held_J_.row(i);  // twice is enough
+      const double norm = q.norm();
+      if (!(norm > kDependent * norm0)) continue;
+      q /= norm;
+      ++held_eq_;
+    }
+  }
+  // Every held row's value at this level's answer (the rows held before keep theirs, up to the solve's tolerance).
+  for (int i = 0; i < held_eq_; ++i) held_d_(i) = held_J_.row(i).dot(x);
+  for (int i = held_eq_; i < held_J_.rows(); ++i) {
+    held_J_.row(i).setZero();  // padding: 0 x = 0
+    held_d_(i) = 0.0;
+  }
+  if (!L.objectives.empty()) {
+    // The value of the level's objectives, linear in x once its other terms are held: zeta' x <= zeta' x*.
+    const double v = obj_.zeta.dot(x);
+    held_A_.row(held_in_) = obj_.zeta.transpose();
+    held_b_(held_in_++) = v + 1e-9 * (1.0 + std::abs(v));
+  }
+  (void)n;
+}
+
+double Cascade::task_error(int l, const SchemeData& data, const Eigen::VectorXd& x) const {
+  const Level& L = *levels_[static_cast<std::size_t>(l)];
+  double worst = 0.0;
+  for (int k : L.tasks) {
+    const Task& t = *scheme_->tasks()[static_cast<std::size_t>(k)];
+    const TaskTerms& terms = static_cast<const TaskData&>(*data.tasks[static_cast<std::size_t>(k)]).rows;
+    for (int r = 0; r < t.rows(); ++r) {
+      const double v = terms.J.row(r).dot(x);
+      if (t.mode() == TaskMode::kInequality) {
+        if (t.has_upper(r)) worst = std::max(worst, v - terms.hi(r));
+        if (t.has_lower(r)) worst = std::max(worst, terms.lo(r) - v);
+      } else {
+        worst = std::max(worst, std::abs(v - terms.d(r)));
+      }
+    }
+  }
+  return worst;
+}
+
+void Cascade::first_task_error(const SchemeData& data, const Eigen::VectorXd& x, LevelInfo& info) const {
+  info.task_error = task_error(0, data, x);
+}
+
+void Cascade::describe_level(int l, TextSink& out) const {
+  const Level& L = *levels_[static_cast<std::size_t>(l)];
+  out << "priority " << L.priority << " (";
+  const char* sep = "";
+  for (int k : L.tasks) {
+    out << sep << "task '" << scheme_->tasks()[static_cast<std::size_t>(k)]->name() << "'";
+    sep = ", ";
+  }
+  for (int k : L.objectives) {
+    out << sep << "objective '" << scheme_->objectives()[static_cast<std::size_t>(k)]->name() << "'";
+    sep = ", ";
+  }
+  out << ")";
+}
+
+void Cascade::build_first(const Context& ctx, SchemeData& data, QpProblem& qp) {
+  scheme_->build_constraints(ctx, base_, data);
+  scheme_->evaluate_tasks(ctx, data);
+  held_eq_ = held_in_ = 0;
+  obj_w_ = scheme_->build_objectives(ctx, 0, obj_, data);
+  assemble(0, data, qp, false);
+}
+
+void Cascade::solve_rest(const Context& ctx, SchemeData& data, const Eigen::VectorXd& x0,
+                         std::vector<LevelInfo>& levels, Eigen::VectorXd& x) {
+  REDRES_REQUIRE(levels.size() == levels_.size() && x.size() == n_ && x0.size() == n_, "Cascade::solve_rest",
+                 "levels has one entry per level and x, x0 have n entries");
+  x = x0;
+  hold(0, data, x);
+  // Why the levels below are skipped, once one is: -1 none, 0 nothing left to decide, 1 a level failed.
+  int skip = obj_w_ != QpBuilder::WrittenW::kNone || held_eq_ >= n_ ? 0 : -1;
+  int decided_by = 0;
+  for (std::size_t l = 1; l < levels_.size(); ++l) {
+    Level& L = *levels_[l];
+    LevelInfo& info = levels[l];
+    info.priority = L.priority;
+    info.status = SolverStatus::kNotRun;
+    info.iterations = 0;
+    info.residual = 0.0;
+    info.task_error = 0.0;
+    keep_diagnosis_capacity(info.diagnosis);
+    info.diagnosis.clear();
+    TextSink text(info.diagnosis);
+    text.precision(6);
+    if (skip >= 0) {
+      text << "skipped: ";
+      if (skip == 0) {
+        text << "nothing left to decide (";
+        describe_level(decided_by, text);
+        text << " decided every joint velocity)";
+      } else {
+        text << "a higher level failed";
+      }
+      continue;
+    }
+    obj_w_ = scheme_->build_objectives(ctx, static_cast<int>(l), obj_, data);
+    assemble(static_cast<int>(l), data, L.qp, false);
+    L.engine->solve_valid(L.qp, L.result);
+    info.iterations = L.result.info.iterations;
+    info.residual = L.result.info.residual;
+    info.status = L.result.info.status;
+    const Eigen::VectorXd* answer = nullptr;
+    if (L.result.info.status == SolverStatus::kSolved) {
+      answer = &L.result.x;
+    } else if (L.has_ls) {
+      assemble(static_cast<int>(l), data, L.ls, true);
+      L.ls_engine->solve_valid(L.ls, L.ls_result);
+      info.iterations += L.ls_result.info.iterations;
+      if (L.ls_result.info.status == SolverStatus::kSolved) {
+        answer = &L.ls_result.x;
+        info.residual = L.ls_result.info.residual;
+        text << "its tasks cannot all be met below the higher levels (" << to_string(L.result.info.status)
+             << "): solved in least squares";
+        info.status = SolverStatus::kRelaxed;
+      } else {
+        note_.assign(L.ls_result.info.diagnosis);
+      }
+    }
+    if (answer == nullptr) {
+      describe_level(static_cast<int>(l), text);
+      text << " not solved: " << to_string(L.result.info.status) << ": " << L.result.info.diagnosis;
+      if (L.has_ls) text << "; in least squares too: " << to_string(L.ls_result.info.status) << ": " << note_;
+      text << "; the step keeps the answer of the levels above";
+      skip = 1;
+      continue;
+    }
+    x = answer->head(n_);
+    info.task_error = task_error(static_cast<int>(l), data, x);
+    hold(static_cast<int>(l), data, x);
+    if (obj_w_ != QpBuilder::WrittenW::kNone || held_eq_ >= n_) {
+      skip = 0;
+      decided_by = static_cast<int>(l);
+    }
+  }
+}
+
+}  // namespace redres

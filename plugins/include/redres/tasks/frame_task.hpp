@@ -1,0 +1,86 @@
+#pragma once
+/// @file
+/// `frame`: a task on any named frame of the chain (RobotModel::frames(): a link by its name, or "end_effector"),
+/// at a point fixed in that frame (`point`), with the rows the user picks:
+/// - "x", "y", "z": the point's world position; J = the rows of its velocity Jacobian, d = p_d_dot + K (p_d - p);
+/// - "wx", "wy", "wz": the frame's orientation; J = the rows of its angular velocity Jacobian, d = K e with e the
+///   rotation vector of R_d R';
+/// - "axis": a direction fixed in the frame (`axis`) turned towards a world direction (`axis_target`, default the
+///   direction at the start); two rows: u' omega = K u' (a x a_d) and v' omega = K v' (a x a_d), with u, v an
+///   orthonormal basis of the plane normal to a.
+/// The reference (`reference`): "start" (the frame's pose at the first step of a run), "fixed" (`position`, `rpy`)
+/// or "path" (the position rows follow the scenario's path and its velocity; orientation rows and the axis hold their
+/// start). In mode "inequality" the position rows are kept within `lower` <= p <= `upper` (world coordinates, m; one
+/// entry per row, +-inf where open): K (lower - p) <= J x <= K (upper - p).
+/// `damping` (soft mode): the Levenberg-Marquardt term lambda^2 = damping^2 (1 - (sigma / damping_threshold)^2) that
+/// the task's level adds to W while the rows' smallest singular value sigma is below the threshold.
+/// Records `<name>_error` (m: the norm of the position rows' error; inequality: how far outside its bounds) and, with
+/// orientation rows, `<name>_orientation_error` (rad); the summary has their maxima.
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "redres/control/task.hpp"
+#include "redres/run/plugin_output.hpp"
+
+namespace redres {
+
+/// The configuration of `frame`.
+struct FrameTaskConfig {
+  std::string frame = "end_effector";                 //!< a name of RobotModel::frames()
+  std::array<double, 3> point{0.0, 0.0, 0.0};         //!< the point in the frame (m)
+  std::vector<std::string> rows{};                    //!< subset of x, y, z, wx, wy, wz, axis (default: position)
+  std::optional<std::array<double, 3>> axis{};        //!< for "axis": the direction in the frame
+  std::optional<std::array<double, 3>> axis_target{}; //!< for "axis": the world direction (default: at the start)
+  std::string reference = "start";                    //!< "start", "fixed" or "path"
+  std::optional<std::array<double, 3>> position{};    //!< reference = "fixed": the world position (m)
+  std::optional<std::array<double, 3>> rpy{};         //!< reference = "fixed": roll, pitch, yaw (rad)
+  PerJoint gain = 1.0;                                //!< K (1/s): one number or one per row
+  std::optional<std::vector<double>> lower{};         //!< inequality: per row (m)
+  std::optional<std::vector<double>> upper{};         //!< inequality: per row (m)
+  double damping = 0.0;                               //!< lambda_max (soft mode); 0: none
+  double damping_threshold = 0.05;                    //!< sigma below which damping grows
+
+  static const Schema<FrameTaskConfig>& schema();
+};
+
+/// A task on a frame.
+class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginOutput {
+ public:
+  static constexpr const char* kType = "frame";
+  FrameTask(const Config& config, const RobotModel& robot);
+
+  [[nodiscard]] int rows() const override { return static_cast<int>(kinds_.size()); }
+  [[nodiscard]] std::string row_name(int r) const override;
+  [[nodiscard]] std::string row_unit(int r) const override;
+  [[nodiscard]] bool has_lower(int r) const override;
+  [[nodiscard]] bool has_upper(int r) const override;
+  void check_mode() const override;
+  [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
+  void start(PluginData* data) const override;
+  /// The frame's index in RobotModel::frames().
+  [[nodiscard]] int frame() const noexcept { return frame_; }
+
+  [[nodiscard]] std::vector<std::string> recorded_columns() const override;
+  void record(const PluginData* data, double* values) const override;
+  void summarise(const RobotModel& robot, const Trajectory& run, const PluginData* data,
+                 std::vector<Metric>& out) const override;
+
+ private:
+  enum class Row { kX, kY, kZ, kWx, kWy, kWz, kAxisU, kAxisV };
+  void compute(const Context& ctx, TaskData& data) const override;
+  [[nodiscard]] bool has_position_rows() const;
+  [[nodiscard]] bool has_orientation_rows() const;
+
+  int frame_ = -1;
+  std::vector<Row> kinds_;
+  Eigen::VectorXd gain_;
+  Eigen::Vector3d point_, axis_;
+  std::optional<Eigen::Vector3d> axis_target_;
+  Eigen::Vector3d position_;
+  Eigen::Matrix3d rotation_;
+};
+
+}  // namespace redres

@@ -1,0 +1,320 @@
+#include "redres/tasks/frame_task.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Geometry>
+
+#include "redres/model/frames.hpp"
+#include "redres/run/trajectory.hpp"
+
+namespace redres {
+
+namespace {
+
+constexpr const char* kRowNames[] = {"x", "y", "z", "wx", "wy", "wz", "axis_u", "axis_v"};
+
+class FrameTaskData final : public TaskData {
+ public:
+  Eigen::Matrix<double, 6, Eigen::Dynamic> J6;  // the frame's [v; omega] Jacobian
+  bool captured = false;                         // the start pose is known
+  Eigen::Vector3d p0 = Eigen::Vector3d::Zero();  // the start position
+  Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d a0 = Eigen::Vector3d::UnitZ();  // the axis's world direction at the start
+  double position_error = 0.0, orientation_error = 0.0;
+};
+
+Eigen::Vector3d vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+
+}  // namespace
+
+const Schema<FrameTaskConfig>& FrameTaskConfig::schema() {
+  using C = FrameTaskConfig;
+  static const Schema<C> s{
+      {field("frame", &C::frame, "", "the frame: a link's name or \"end_effector\" (redres robot lists them)"),
+       field("point", &C::point, "m", "a point fixed in the frame, in its axes (default its origin)"),
+       field("rows", &C::rows, "",
+             "the rows: a subset of \"x\", \"y\", \"z\" (position), \"wx\", \"wy\", \"wz\" (orientation), \"axis\" "
+             "(default: the position rows)"),
+       field("axis", &C::axis, "", "for the \"axis\" rows: a direction fixed in the frame"),
+       field("axis_target", &C::axis_target, "", "for the \"axis\" rows: the world direction (default: at the start)"),
+       field("reference", &C::reference, "",
+             "\"start\" (the pose at the first step), \"fixed\" (position, rpy) or \"path\" (the position rows follow "
+             "the scenario's path)",
+             rule<std::string>("one of 'start', 'fixed', 'path'",
+                               [](const std::string& r) { return r == "start" || r == "fixed" || r == "path"; })),
+       field("position", &C::position, "m", "reference = \"fixed\": the world position"),
+       field("rpy", &C::rpy, "rad", "reference = \"fixed\": roll, pitch, yaw of the orientation (default 0)"),
+       field("gain", &C::gain, "1/s", "feedback gain K: one number or one per row", at_least<PerJoint>(0.0)),
+       field("lower", &C::lower, "m", "mode = \"inequality\": a lower bound per row (-inf: none)"),
+       field("upper", &C::upper, "m", "mode = \"inequality\": an upper bound per row (inf: none)"),
+       field("damping", &C::damping, "1/s",
+             "soft mode: the largest Levenberg-Marquardt damping lambda, reached as the rows lose rank",
+             between(0.0, 1e3)),
+       field("damping_threshold", &C::damping_threshold, "",
+             "the smallest singular value of the rows below which the damping grows", greater(0.0))}};
+  return s;
+}
+
+FrameTask::FrameTask(const Config& config, const RobotModel& robot)
+    : Configured(kType, config), point_(vec(config_.point)), axis_(Eigen::Vector3d::UnitZ()) {
+  set_dof(robot.dof());
+  frame_ = robot.find_frame(config_.frame);
+  if (frame_ < 0) {
+    std::string names;
+    for (const auto& f : robot.frames()) names += (names.empty() ? "'" : ", '") + f.name + "'";
+    throw FieldError("frame", "no frame '" + config_.frame + "' on robot '" + robot.name() + "'; its frames are " +
+                                  names);
+  }
+  std::vector<std::string> names = config_.rows;
+  if (names.empty()) {
+    names = robot.kind() == ChainKind::kPlanar ? std::vector<std::string>{"x", "y"}
+                                               : std::vector<std::string>{"x", "y", "z"};
+  }
+  for (const std::string& r : names) {
+    if (r == "axis") {
+      if (!config_.axis) throw FieldError("rows", "the \"axis\" rows need `axis` (a direction in the frame)");
+      kinds_.push_back(Row::kAxisU);
+      kinds_.push_back(Row::kAxisV);
+      continue;
+    }
+    const auto* it = std::find_if(std::begin(kRowNames), std::begin(kRowNames) + 6,
+                                  [&r](const char* name) { return r == name; });
+    if (it == std::begin(kRowNames) + 6) {
+      throw FieldError("rows", "unknown row '" + r + "'; expected \"x\", \"y\", \"z\", \"wx\", \"wy\", \"wz\" or \"axis\"");
+    }
+    const Row kind = static_cast<Row>(it - std::begin(kRowNames));
+    if (std::find(kinds_.begin(), kinds_.end(), kind) != kinds_.end()) {
+      throw FieldError("rows", "row '" + r + "' is listed twice");
+    }
+    kinds_.push_back(kind);
+  }
+  const bool axis = std::find(kinds_.begin(), kinds_.end(), Row::kAxisU) != kinds_.end();
+  const bool rotation = std::any_of(kinds_.begin(), kinds_.end(),
+                                    [](Row k) { return k == Row::kWx || k == Row::kWy || k == Row::kWz; });
+  if (axis && rotation) throw FieldError("rows", "\"axis\" and the orientation rows \"wx\", \"wy\", \"wz\" exclude each other");
+  if (config_.axis) {
+    axis_ = vec(*config_.axis);
+    if (!(axis_.norm() > 1e-9) || !axis_.allFinite()) throw FieldError("axis", "expected a non-zero direction");
+    axis_.normalize();
+  }
+  if (config_.axis_target) {
+    Eigen::Vector3d a = vec(*config_.axis_target);
+    if (!(a.norm() > 1e-9) || !a.allFinite()) throw FieldError("axis_target", "expected a non-zero direction");
+    axis_target_ = a.normalized();
+  }
+  gain_ = config_.gain.resolve(rows(), "gain", "row");
+  if (config_.reference == "fixed") {
+    if (has_position_rows() && !config_.position) {
+      throw FieldError("position", "reference = \"fixed\" with position rows needs `position` (m, world)");
+    }
+    position_ = config_.position ? vec(*config_.position) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d rpy = config_.rpy ? vec(*config_.rpy) : Eigen::Vector3d::Zero();
+    rotation_ = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+                 Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+                 Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+                    .toRotationMatrix();
+  } else {
+    if (config_.position) throw FieldError("position", "is read only with reference = \"fixed\"");
+    if (config_.rpy) throw FieldError("rpy", "is read only with reference = \"fixed\"");
+    position_.setZero();
+    rotation_.setIdentity();
+  }
+  if (config_.reference == "path" && robot.kind() == ChainKind::kPlanar) {
+    for (Row k : kinds_) {
+      if (k == Row::kZ) throw FieldError("rows", "a planar robot's path has no z row");
+    }
+  }
+  for (const auto* bounds : {&config_.lower, &config_.upper}) {
+    if (*bounds && static_cast<int>((*bounds)->size()) != rows()) {
+      throw FieldError(bounds == &config_.lower ? "lower" : "upper",
+                       "expected one bound per row (" + std::to_string(rows()) + "), got " +
+                           std::to_string((*bounds)->size()));
+    }
+  }
+}
+
+void FrameTask::check_mode() const {
+  if (mode() == TaskMode::kInequality) {
+    if (!config_.lower && !config_.upper) {
+      throw FieldError("mode", "mode = \"inequality\" needs `lower` or `upper` (one bound per row, m)");
+    }
+    if (has_orientation_rows()) {
+      throw FieldError("rows", "mode = \"inequality\" bounds position rows only (\"x\", \"y\", \"z\")");
+    }
+    bool any = false;
+    for (int r = 0; r < rows(); ++r) any = any || has_lower(r) || has_upper(r);
+    if (!any) throw FieldError("lower", "every bound is infinite: the task would bound nothing");
+    for (int r = 0; r < rows(); ++r) {
+      if (has_lower(r) && has_upper(r) && (*config_.lower)[static_cast<std::size_t>(r)] >
+                                              (*config_.upper)[static_cast<std::size_t>(r)]) {
+        throw FieldError("lower", "row '" + row_name(r) + "': lower > upper");
+      }
+    }
+  } else {
+    if (config_.lower) throw FieldError("lower", "is read only with mode = \"inequality\"");
+    if (config_.upper) throw FieldError("upper", "is read only with mode = \"inequality\"");
+  }
+  if (config_.damping > 0.0 && mode() != TaskMode::kSoft) {
+    throw FieldError("damping", "damping softens the rows into a damped least squares: use mode = \"soft\"");
+  }
+}
+
+std::string FrameTask::row_name(int r) const { return kRowNames[static_cast<int>(kinds_[static_cast<std::size_t>(r)])]; }
+
+std::string FrameTask::row_unit(int r) const { return static_cast<int>(kinds_[static_cast<std::size_t>(r)]) < 3 ? "m" : "rad"; }
+
+bool FrameTask::has_lower(int r) const {
+  return config_.lower && std::isfinite((*config_.lower)[static_cast<std::size_t>(r)]);
+}
+
+bool FrameTask::has_upper(int r) const {
+  return config_.upper && std::isfinite((*config_.upper)[static_cast<std::size_t>(r)]);
+}
+
+bool FrameTask::has_position_rows() const {
+  return std::any_of(kinds_.begin(), kinds_.end(), [](Row k) { return static_cast<int>(k) < 3; });
+}
+
+bool FrameTask::has_orientation_rows() const {
+  return std::any_of(kinds_.begin(), kinds_.end(), [](Row k) { return static_cast<int>(k) >= 3; });
+}
+
+std::unique_ptr<PluginData> FrameTask::make_data() const {
+  auto data = std::make_unique<FrameTaskData>();
+  size_rows(data->rows, dof());
+  data->J6 = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, dof());
+  return data;
+}
+
+void FrameTask::start(PluginData* data) const {
+  auto& own = static_cast<FrameTaskData&>(*data);
+  own.captured = false;
+  own.position_error = own.orientation_error = 0.0;
+}
+
+void FrameTask::compute(const Context& ctx, TaskData& data) const {
+  auto& own = static_cast<FrameTaskData&>(data);
+  TaskTerms& t = own.rows;
+  const RobotModel& robot = *ctx.robot;
+  const KinematicsData& kin = *ctx.kinematics;
+  const Eigen::Isometry3d pose = frame_pose(robot, kin, frame_);
+  const Eigen::Vector3d p = pose * point_;
+  const Eigen::Matrix3d R = pose.linear();
+  frame_jacobian(robot, kin, frame_, point_, own.J6);
+  if (!own.captured) {
+    own.p0 = p;
+    own.R0 = R;
+    own.a0 = R * axis_;
+    own.captured = true;
+  }
+  // The reference position and velocity, orientation and axis.
+  Eigen::Vector3d p_d = position_, v_d = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_d = rotation_;
+  if (config_.reference == "start") {
+    p_d = own.p0;
+    R_d = own.R0;
+  } else if (config_.reference == "path") {
+    REDRES_REQUIRE(ctx.r_d != nullptr && ctx.r_d_dot != nullptr, "frame task",
+                   "the context carries the path's r_d and r_d_dot (reference = \"path\")");
+    const int rows_p = robot.position_rows();
+    p_d.setZero();
+    for (int i = 0; i < rows_p; ++i) {
+      p_d(i) = (*ctx.r_d)(i);
+      v_d(i) = (*ctx.r_d_dot)(i);
+    }
+    if (rows_p == 2) p_d.z() = p.z();
+    R_d = own.R0;
+  }
+  const Eigen::Vector3d a = R * axis_;
+  const Eigen::Vector3d a_d = axis_target_ ? *axis_target_ : own.a0;
+  Eigen::Vector3d e_rot = Eigen::Vector3d::Zero();
+  if (has_orientation_rows()) {
+    const Eigen::AngleAxisd err(R_d * R.transpose());
+    e_rot = err.angle() * err.axis();
+  }
+  // u, v: an orthonormal basis of the plane normal to a.
+  Eigen::Vector3d u = a.unitOrthogonal();
+  Eigen::Vector3d v = a.cross(u);
+  const Eigen::Vector3d e_axis = a.cross(a_d);
+  double pos2 = 0.0, rot2 = 0.0, violation = 0.0;
+  for (int r = 0; r < rows(); ++r) {
+    const Row kind = kinds_[static_cast<std::size_t>(r)];
+    const double k = gain_(r);
+    const int i = static_cast<int>(kind);
+    double e = 0.0, feedforward = 0.0;
+    if (i < 3) {
+      t.J.row(r) = own.J6.row(i);
+      e = p_d(i) - p(i);
+      feedforward = v_d(i);
+      if (mode() == TaskMode::kInequality) {
+        constexpr double kInf = std::numeric_limits<double>::infinity();
+        const double lo = has_lower(r) ? (*config_.lower)[static_cast<std::size_t>(r)] : -kInf;
+        const double hi = has_upper(r) ? (*config_.upper)[static_cast<std::size_t>(r)] : kInf;
+        t.lo(r) = has_lower(r) ? k * (lo - p(i)) : -kInf;
+        t.hi(r) = has_upper(r) ? k * (hi - p(i)) : kInf;
+        e = std::max({0.0, lo - p(i), p(i) - hi});
+        violation = std::max(violation, e);
+      } else {
+        pos2 += e * e;
+      }
+    } else if (i < 6) {
+      t.J.row(r) = own.J6.row(i);
+      e = e_rot(i - 3);
+      rot2 += e * e;
+    } else {
+      const Eigen::Vector3d& n = kind == Row::kAxisU ? u : v;
+      t.J.row(r) = n.transpose() * own.J6.bottomRows<3>();
+      e = n.dot(e_axis);
+      rot2 += e * e;
+    }
+    t.error(r) = e;
+    if (mode() != TaskMode::kInequality) t.d(r) = feedforward + k * e;
+  }
+  own.position_error = mode() == TaskMode::kInequality ? violation : std::sqrt(pos2);
+  own.orientation_error = std::sqrt(rot2);
+  if (std::find(kinds_.begin(), kinds_.end(), Row::kAxisU) != kinds_.end()) {
+    // The axis's error is the angle between a and a_d.
+    own.orientation_error = std::atan2(e_axis.norm(), a.dot(a_d));
+  }
+  if (config_.damping > 0.0) {
+    t.sigma_min = smallest_singular_value(t.J);
+    t.damping = damping_term(t.sigma_min, config_.damping, config_.damping_threshold);
+  }
+}
+
+std::vector<std::string> FrameTask::recorded_columns() const {
+  std::vector<std::string> out;
+  if (has_position_rows()) out.push_back(name() + "_error");
+  if (has_orientation_rows()) out.push_back(name() + "_orientation_error");
+  return out;
+}
+
+void FrameTask::record(const PluginData* data, double* values) const {
+  const auto& own = static_cast<const FrameTaskData&>(*data);
+  int c = 0;
+  if (has_position_rows()) values[c++] = own.position_error;
+  if (has_orientation_rows()) values[c++] = own.orientation_error;
+}
+
+void FrameTask::summarise(const RobotModel& /*robot*/, const Trajectory& run, const PluginData* /*data*/,
+                          std::vector<Metric>& out) const {
+  const auto worst = [&run, this](const std::string& column) {
+    const std::size_t c = own_column(run, name(), column);
+    double w = 0.0;
+    for (std::size_t row = 0; row < run.size(); ++row) w = std::max(w, run(row, c));
+    return w;
+  };
+  if (has_position_rows()) {
+    out.push_back({mode() == TaskMode::kInequality ? "max_violation" : "max_error", {worst(name() + "_error")}, "m"});
+  }
+  if (has_orientation_rows()) out.push_back({"max_orientation_error", {worst(name() + "_orientation_error")}, "rad"});
+}
+
+namespace {
+const bool kRegistered = task_registry().add_plugin<FrameTask>(
+    "rows of a frame's position, orientation or axis towards a reference (start, fixed, the path)");
+}  // namespace
+
+}  // namespace redres

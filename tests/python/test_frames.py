@@ -167,7 +167,8 @@ def test_an_unknown_frame_or_a_wrong_point_raises_naming_it():
             (lambda ctx: ctx.frame_pose("panda_link99"), "StepContext.frame_pose: robot 'franka_panda' has no frame "
                                                          "'panda_link99'; its frames are 'panda_joint1', .*"
                                                          "'panda_joint7', 'end_effector'"),
-            (lambda ctx: ctx.frame_jacobian("elbow"), "StepContext.frame_jacobian: .* no frame 'elbow'; .*'end_effector'"),
+            (lambda ctx: ctx.frame_jacobian("elbow"),
+             "StepContext.frame_jacobian: .* no frame 'elbow'; .*'end_effector'"),
             (lambda ctx: ctx.frame_jacobian("end_effector", np.zeros(2)), "point has 2 entries, expected 3"),
             (lambda ctx: ctx.frame_jacobian("end_effector", np.zeros(4)), "point has 4 entries, expected 3")):
         ctrl = redres.Controller(robot, objectives=[Asks(call, name="asks")],

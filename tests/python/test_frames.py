@@ -200,3 +200,33 @@ def test_the_frames_are_not_readable_after_the_call():
                  lambda c: c.frame_names, lambda c: c.link_frames):
         with pytest.raises(RuntimeError, match="outside contribute"):
             read(kept[0])
+
+
+def test_a_kinematics_of_the_contexts_robot_keeps_its_frames_after_the_controller():
+    """ctx.robot is borrowed from the controller; a redres.Kinematics computed from it inside the step gives the
+    context's frames, and keeps its own copy of the robot, so that its frames stay readable once the controller and
+    the robot are gone. (A read of a freed robot may return stale values, so the second half is a guard rather than a
+    proof: only the first half is sure to fail when it is wrong.)"""
+    import gc
+
+    kept = []
+
+    class Computes(redres.Objective):
+        def contribute(self, ctx, qp):
+            kept.append((ctx.robot.kinematics(ctx.theta), ctx.frame_pose("panda_joint4"),
+                         ctx.frame_jacobian("end_effector", np.array([0.0, 0.0, 0.1]))))
+            qp.add_identity()
+
+    robot = redres.Robot.load(source("robots/franka_panda.toml"))
+    theta = random_theta(robot, np.random.default_rng(7))
+    ctrl = redres.Controller(robot, objectives=[Computes()], constraints=[redres.constraints.TaskTracking()],
+                             theta0=theta)
+    f = robot.kinematics(theta).f
+    ctrl.step(theta, 0.0, f, np.zeros_like(f))
+    del ctrl, robot
+    gc.collect()
+    k, pose, J = kept[0]
+    assert k.frame_names[-1] == "end_effector"
+    np.testing.assert_allclose(k.frame_pose("panda_joint4"), pose, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(k.frame_jacobian("end_effector", [0.0, 0.0, 0.1]), J, rtol=0, atol=1e-12)
+    assert k.frame_names == [f"panda_joint{j}" for j in range(1, 8)] + ["end_effector"]

@@ -74,7 +74,8 @@ KinematicsResult kinematics_of(const std::shared_ptr<const RobotModel>& model, c
   KinematicsData& k = *data;
   compute_kinematics(robot, checked_theta(robot, theta, "Robot.kinematics"), k, KinematicsLevel::kAll);
   KinematicsResult out;
-  out.robot = model;
+  // A robot borrowed from a step's context (ctx.robot, no owner) may be gone before the result: it keeps a copy.
+  out.robot = model.use_count() > 0 ? model : std::make_shared<const RobotModel>(robot);
   out.data = data;
   out.theta = k.theta;
   out.f = k.f;

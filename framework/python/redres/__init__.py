@@ -236,11 +236,12 @@ class Objective(_PythonPlugin):
     """Base of an objective written in Python: subclass it and define contribute(self, ctx, qp).
 
     contribute is called from the C++ step with the step's redres.StepContext (ctx.t, ctx.theta, ctx.J, ctx.w,
-    ctx.grad_w, ctx.r_d, ... as read-only numpy views, valid during the call) and the objective's share of the QP,
-    a redres.StepQp: qp.add_identity(scale), qp.add_diagonal(v), qp.add_hessian(H), qp.add_linear(z); the
-    objective's weight scales what it adds. Optionally define potential(self, ctx) -> float, a P(theta) whose
-    gradient is the linear term per unit weight: the conformance checks (redres.check_plugins) then compare the two
-    by central differences.
+    ctx.grad_w, ctx.r_d, ..., and the robot's named frames: ctx.frame_names, ctx.frame_pose(name),
+    ctx.frame_jacobian(name, point), ctx.link_frames; numpy copies, readable during the call) and the objective's
+    share of the QP, a redres.StepQp: qp.add_identity(scale), qp.add_diagonal(v), qp.add_hessian(H),
+    qp.add_linear(z); the objective's weight scales what it adds. Optionally define potential(self, ctx) -> float, a
+    P(theta) whose gradient is the linear term per unit weight: the conformance checks (redres.check_plugins) then
+    compare the two by central differences.
 
     Class attributes: keys (key -> default), help, summary, kinematics, type; instance attributes name, weight
     and active. Use an instance in redres.Controller(objectives=[...]), or redres.register(MyObjective) to name it

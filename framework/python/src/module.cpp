@@ -18,6 +18,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include "frame_access.hpp"
 #include "python_plugins.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
@@ -48,6 +49,9 @@ struct KinematicsResult {
   double w = 0.0, mu = 0.0;
   Eigen::Matrix4d ee_pose = Eigen::Matrix4d::Identity();
   std::vector<Eigen::Matrix4d> link_frames;
+  // For the named frames: the robot (shared with its redres.Robot) and the kinematics it was computed into.
+  std::shared_ptr<const RobotModel> robot;
+  std::shared_ptr<const KinematicsData> data;
 };
 
 Eigen::VectorXd checked_theta(const RobotModel& robot, const Eigen::VectorXd& theta, const char* who) {
@@ -64,10 +68,15 @@ Eigen::VectorXd checked_theta(const RobotModel& robot, const Eigen::VectorXd& th
   return theta;
 }
 
-KinematicsResult kinematics_of(const RobotModel& robot, const Eigen::VectorXd& theta) {
-  KinematicsData k(robot);
+KinematicsResult kinematics_of(const std::shared_ptr<const RobotModel>& model, const Eigen::VectorXd& theta) {
+  const RobotModel& robot = *model;
+  auto data = std::make_shared<KinematicsData>(robot);
+  KinematicsData& k = *data;
   compute_kinematics(robot, checked_theta(robot, theta, "Robot.kinematics"), k, KinematicsLevel::kAll);
   KinematicsResult out;
+  // A robot borrowed from a step's context (ctx.robot, no owner) may be gone before the result: it keeps a copy.
+  out.robot = model.use_count() > 0 ? model : std::make_shared<const RobotModel>(robot);
+  out.data = data;
   out.theta = k.theta;
   out.f = k.f;
   out.J = k.J;
@@ -76,7 +85,7 @@ KinematicsResult kinematics_of(const RobotModel& robot, const Eigen::VectorXd& t
   out.mu = k.mu;
   out.grad_mu = k.grad_mu;
   out.ee_pose = k.ee_pose.matrix();
-  for (const auto& frame : k.link_frames) out.link_frames.push_back(frame.matrix());
+  out.link_frames = link_frames_of(k);
   return out;
 }
 
@@ -423,6 +432,23 @@ PYBIND11_MODULE(_redres, m) {
       .def_readonly("grad_mu", &KinematicsResult::grad_mu, "d mu / d theta (n,)")
       .def_readonly("ee_pose", &KinematicsResult::ee_pose, "end-effector pose in the world frame (4, 4)")
       .def_readonly("link_frames", &KinematicsResult::link_frames, "each joint's frame after its motion (4, 4)")
+      .def_property_readonly(
+          "frame_names", [](const KinematicsResult& k) { return frame_names(*k.robot); },
+          "the robot's named frames (each joint's link, a URDF's other links, 'end_effector'), in order")
+      .def(
+          "frame_pose",
+          [](const KinematicsResult& k, const std::string& name) {
+            return frame_pose_of(*k.robot, *k.data, name, "Kinematics.frame_pose");
+          },
+          py::arg("name"), "world pose (4, 4) of the named frame; an unknown name raises ValueError")
+      .def(
+          "frame_jacobian",
+          [](const KinematicsResult& k, const std::string& name, const std::optional<Eigen::VectorXd>& point) {
+            return frame_jacobian_of(*k.robot, *k.data, name, point, "Kinematics.frame_jacobian");
+          },
+          py::arg("name"), py::arg("point") = py::none(),
+          "Jacobian (6, n) [v; omega] of the named frame, its origin moved by `point` (3,) in the frame's own axes "
+          "(default: the origin)")
       .def("__repr__", [](const KinematicsResult& k) { return "<redres.Kinematics w=" + std::to_string(k.w) + ">"; });
 
   py::class_<PyRobot>(m, "Robot", "A robot model (redres.Robot.load(path) reads a robot TOML file, DH or URDF).")
@@ -454,8 +480,10 @@ PYBIND11_MODULE(_redres, m) {
       .def_property_readonly("home", [](const PyRobot& r) { return Eigen::VectorXd(r.model->home()); })
       .def_property_readonly("source", [](const PyRobot& r) { return r.model->source(); })
       .def(
-          "kinematics", [](const PyRobot& r, const Eigen::VectorXd& theta) { return kinematics_of(*r.model, theta); },
-          py::arg("theta"), "f, J, w, grad w, mu, grad mu and the end-effector pose at theta (numpy arrays).")
+          "kinematics", [](const PyRobot& r, const Eigen::VectorXd& theta) { return kinematics_of(r.model, theta); },
+          py::arg("theta"),
+          "f, J, w, grad w, mu, grad mu, the end-effector pose and the link frames at theta (numpy arrays); the named "
+          "frames' poses and Jacobians through frame_pose(name) and frame_jacobian(name, point).")
       .def(
           "velocity_limits",
           [](const PyRobot& r, const Eigen::VectorXd& theta) {

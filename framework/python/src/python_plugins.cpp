@@ -1,6 +1,7 @@
 #include "python_plugins.hpp"
 
 #include <any>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -8,6 +9,7 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include "frame_access.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
 #include "redres/extend/conformance.hpp"
@@ -550,7 +552,27 @@ void bind_python_plugins(py::module_& m) {
           "r_d_dot", [](const StepContext& c) { return copy_of(*c.get().r_d_dot); }, "desired task velocity")
       .def_property_readonly(
           "ee_pose", [](const StepContext& c) { return Eigen::Matrix4d(c.get().kinematics->ee_pose.matrix()); },
-          "end-effector pose in the world (4, 4), a copy");
+          "end-effector pose in the world (4, 4), a copy")
+      .def_property_readonly(
+          "frame_names", [](const StepContext& c) { return frame_names(*c.get().robot); },
+          "the robot's named frames (each joint's link, a URDF's other links, 'end_effector'), in order")
+      .def(
+          "frame_pose",
+          [](const StepContext& c, const std::string& name) {
+            return frame_pose_of(*c.get().robot, *c.get().kinematics, name, "StepContext.frame_pose");
+          },
+          py::arg("name"), "world pose (4, 4) of the named frame at theta, a copy; an unknown name raises ValueError")
+      .def(
+          "frame_jacobian",
+          [](const StepContext& c, const std::string& name, const std::optional<Eigen::VectorXd>& point) {
+            return frame_jacobian_of(*c.get().robot, *c.get().kinematics, name, point, "StepContext.frame_jacobian");
+          },
+          py::arg("name"), py::arg("point") = py::none(),
+          "Jacobian (6, n) [v; omega] of the named frame, its origin moved by `point` (3,) in the frame's own axes "
+          "(default: the origin)")
+      .def_property_readonly(
+          "link_frames", [](const StepContext& c) { return link_frames_of(*c.get().kinematics); },
+          "each joint's link frame after its motion, in the world (list of (4, 4)), copies");
 
   py::class_<StepQp>(m, "StepQp",
                      "A plugin's share of the step's QP  min x'Wx/2 + zeta'x  s.t.  J x = d,  A x <= b,  lo <= x <= hi "

@@ -11,7 +11,7 @@ namespace redres {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // A held row whose part outside the rows held before it is below this (relative to its norm) adds nothing.
-constexpr double kDependent = 1e-9;
+constexpr double kDependent = 1e-6;
 }  // namespace
 
 /// What an inequality row of a level's QP past the constraints' stands for.
@@ -28,13 +28,18 @@ struct Cascade::Level {
   std::vector<int> tasks, objectives;
   int eq_tasks = 0;       // the rows of its equality tasks
   int in_tasks = 0;       // the inequality rows of its inequality tasks (and, in least squares, its slacks)
-  int held_eq = 0;        // rows held from the levels above (an orthonormal basis, padded with 0 x = 0)
+  int held_eq = 0;        // at most this many rows held from the levels above (an orthonormal basis of their span)
   int held_in = 0;        // inequality rows held from the levels above
   std::vector<RowTag> in_tags;  // its QP's inequality rows past the constraints'
   bool has_ls = false;          // below the first, with equality or inequality tasks: a least-squares retry
-  QpProblem qp, ls;
-  std::unique_ptr<LviEngine> engine, ls_engine;
-  SolverResult result, ls_result;
+  // One QP (and its least-squares retry) per number of held rows, 0 to held_eq, each with its engine: the held rows'
+  // rank is known only at the step, and a QP with fewer independent rows than rows would be degenerate.
+  struct Slot {
+    QpProblem qp, ls;
+    std::unique_ptr<LviEngine> engine, ls_engine;
+    SolverResult result, ls_result;
+  };
+  std::vector<std::unique_ptr<Slot>> slots;
 };
 
 Cascade::~Cascade() = default;
@@ -95,24 +100,30 @@ Cascade::Cascade(const Scheme& scheme, const SchemeData& data, const LviEngine& 
   held_d_ = Eigen::VectorXd::Zero(held_J_.rows());
   held_A_ = Eigen::MatrixXd::Zero(held_in, n_);
   held_b_ = Eigen::VectorXd::Zero(held_in);
+  const SolverSettings& lower = engine.settings();
   for (std::size_t l = 1; l < levels_.size(); ++l) {
     Level& L = *levels_[l];
-    size_level(static_cast<int>(l), L.qp, false);
-    L.engine = make_engine(std::string(engine.name()), engine.settings());
-    L.engine->setup(L.qp.n(), L.qp.m_eq(), L.qp.m_in(), L.result);
-    if (L.has_ls) {
-      size_level(static_cast<int>(l), L.ls, true);
-      L.ls_engine = make_engine(std::string(engine.name()), engine.settings());
-      L.ls_engine->setup(L.ls.n(), L.ls.m_eq(), L.ls.m_in(), L.ls_result);
+    for (int rank = 0; rank <= L.held_eq; ++rank) {
+      auto slot = std::make_unique<Level::Slot>();
+      size_level(static_cast<int>(l), slot->qp, false, rank);
+      slot->engine = make_engine(std::string(engine.name()), lower);
+      slot->engine->setup(slot->qp.n(), slot->qp.m_eq(), slot->qp.m_in(), slot->result);
+      if (L.has_ls) {
+        size_level(static_cast<int>(l), slot->ls, true, rank);
+        slot->ls_engine = make_engine(std::string(engine.name()), lower);
+        slot->ls_engine->setup(slot->ls.n(), slot->ls.m_eq(), slot->ls.m_in(), slot->ls_result);
+      }
+      L.slots.push_back(std::move(slot));
     }
   }
   note_.reserve(kDiagnosisCapacity);
+  prox_ = Eigen::VectorXd::Zero(n_);
 }
 
-void Cascade::size_level(int l, QpProblem& qp, bool least_squares) const {
+void Cascade::size_level(int l, QpProblem& qp, bool least_squares, int held_rows) const {
   const Level& L = *levels_[static_cast<std::size_t>(l)];
   const int slack = least_squares ? L.in_tasks : 0;
-  const int m_eq = base_.m_eq() + (least_squares ? 0 : L.eq_tasks) + L.held_eq;
+  const int m_eq = base_.m_eq() + (least_squares ? 0 : L.eq_tasks) + held_rows;
   const int m_in = base_.m_in() + L.in_tasks + L.held_in;
   qp.resize(n_ + slack, m_eq, m_in);
   qp.source_names = base_.source_names;
@@ -130,7 +141,7 @@ void Cascade::size_level(int l, QpProblem& qp, bool least_squares) const {
       for (int r = 0; r < t.rows(); ++r) qp.eq_source[static_cast<std::size_t>(row++)] = scheme_->task_source(k);
     }
   }
-  for (int r = 0; r < L.held_eq; ++r) qp.eq_source[static_cast<std::size_t>(row++)] = held_source;
+  for (int r = 0; r < held_rows; ++r) qp.eq_source[static_cast<std::size_t>(row++)] = held_source;
   for (std::size_t r = 0; r < L.in_tags.size(); ++r) {
     const RowTag& tag = L.in_tags[r];
     qp.in_source[static_cast<std::size_t>(base_.m_in()) + r] =
@@ -155,12 +166,14 @@ void Cascade::size_level(int l, QpProblem& qp, bool least_squares) const {
   };
 }
 
-void Cascade::setup_first(QpProblem& qp) const { size_level(0, qp, false); }
+void Cascade::setup_first(QpProblem& qp) const { size_level(0, qp, false, 0); }
 
 void Cascade::reset() {
   for (std::size_t l = 1; l < levels_.size(); ++l) {
-    levels_[l]->engine->reset();
-    if (levels_[l]->ls_engine) levels_[l]->ls_engine->reset();
+    for (auto& slot : levels_[l]->slots) {
+      slot->engine->reset();
+      if (slot->ls_engine) slot->ls_engine->reset();
+    }
   }
 }
 
@@ -186,11 +199,10 @@ void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_
   const Level& L = *levels_[static_cast<std::size_t>(l)];
   const int n = n_;
   qp.clear();
-  // The objective: the level's objectives, its soft tasks, eps (and the damping of its soft tasks).
+  // The objective: the level's objectives, its soft tasks (and their damping).
   qp.W.topLeftCorner(n, n) = obj_.W;
   qp.zeta.head(n) = obj_.zeta;
   qp.w_diagonal = obj_.w_diagonal;
-  for (int i = 0; i < n; ++i) qp.W(i, i) += eps_;
   // The constraints: rows and bounds.
   const int me = base_.m_eq(), mi = base_.m_in();
   qp.J.topLeftCorner(me, n) = base_.J;
@@ -240,9 +252,20 @@ void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_
         break;
     }
   }
+  // Scaled so that its largest diagonal entry is 1 (the same minimiser; a level of equality rows alone, W = 0, gets
+  // W = I), plus eps I: the regularization is relative to the level's own terms.
+  double scale = 0.0;
+  for (int i = 0; i < qp.n(); ++i) scale = std::max(scale, qp.W(i, i));  // the slacks' weights too
+  if (scale > 0.0) {
+    qp.W.topLeftCorner(n, n) /= scale;
+    qp.zeta.head(n) /= scale;
+    for (int i = n; i < qp.n(); ++i) qp.W(i, i) /= scale;
+  }
+  for (int i = 0; i < n; ++i) qp.W(i, i) += scale > 0.0 ? eps_ : 1.0;
+  least_squares_terms_ = scale > 0.0;
   // The higher levels' optima.
-  qp.J.block(eq, 0, L.held_eq, n) = held_J_.topRows(L.held_eq);
-  qp.d.segment(eq, L.held_eq) = held_d_.head(L.held_eq);
+  qp.J.block(eq, 0, held_eq_, n) = held_J_.topRows(held_eq_);
+  qp.d.segment(eq, held_eq_) = held_d_.head(held_eq_);
   qp.A.block(in, 0, L.held_in, n) = held_A_.topRows(L.held_in);
   qp.b.segment(in, L.held_in) = held_b_.head(L.held_in);
 }
@@ -285,10 +308,6 @@ void Cascade::hold(int l, const SchemeData& data, const Eigen::VectorXd& x) {
   }
   // Every held row's value at this level's answer (the rows held before keep theirs, up to the solve's tolerance).
   for (int i = 0; i < held_eq_; ++i) held_d_(i) = held_J_.row(i).dot(x);
-  for (int i = held_eq_; i < held_J_.rows(); ++i) {
-    held_J_.row(i).setZero();  // padding: 0 x = 0
-    held_d_(i) = 0.0;
-  }
   if (!L.objectives.empty()) {
     // The value of the level's objectives, linear in x once its other terms are held: zeta' x <= zeta' x*.
     const double v = obj_.zeta.dot(x);
@@ -377,32 +396,50 @@ void Cascade::solve_rest(const Context& ctx, SchemeData& data, const Eigen::Vect
       continue;
     }
     obj_w_ = scheme_->build_objectives(ctx, static_cast<int>(l), obj_, data);
-    assemble(static_cast<int>(l), data, L.qp, false);
-    L.engine->solve_valid(L.qp, L.result);
-    info.iterations = L.result.info.iterations;
-    info.residual = L.result.info.residual;
-    info.status = L.result.info.status;
+    Level::Slot& S = *L.slots[static_cast<std::size_t>(held_eq_)];
+    assemble(static_cast<int>(l), data, S.qp, false);
+    S.engine->solve_valid(S.qp, S.result);
+    info.iterations = S.result.info.iterations;
+    info.residual = S.result.info.residual;
+    info.status = S.result.info.status;
     const Eigen::VectorXd* answer = nullptr;
-    if (L.result.info.status == SolverStatus::kSolved) {
-      answer = &L.result.x;
+    if (S.result.info.status == SolverStatus::kSolved) {
+      answer = &S.result.x;
     } else if (L.has_ls) {
-      assemble(static_cast<int>(l), data, L.ls, true);
-      L.ls_engine->solve_valid(L.ls, L.ls_result);
-      info.iterations += L.ls_result.info.iterations;
-      if (L.ls_result.info.status == SolverStatus::kSolved) {
-        answer = &L.ls_result.x;
-        info.residual = L.ls_result.info.residual;
-        text << "its tasks cannot all be met below the higher levels (" << to_string(L.result.info.status)
+      assemble(static_cast<int>(l), data, S.ls, true);
+      S.ls_engine->solve_valid(S.ls, S.ls_result);
+      info.iterations += S.ls_result.info.iterations;
+      if (S.ls_result.info.status == SolverStatus::kSolved) {
+        answer = &S.ls_result.x;
+        info.residual = S.ls_result.info.residual;
+        text << "its tasks cannot all be met below the higher levels (" << to_string(S.result.info.status)
              << "): solved in least squares";
         info.status = SolverStatus::kRelaxed;
       } else {
-        note_.assign(L.ls_result.info.diagnosis);
+        note_.assign(S.ls_result.info.diagnosis);
+      }
+    }
+    if (answer != nullptr && least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone) {
+      // A least squares whose rows leave directions free: eps |x|^2 / 2 biases its optimum by O(eps / sigma^2) along
+      // its weak directions. Two proximal steps, eps |x - x_k|^2 / 2 about the last answer, take that bias to
+      // O((eps / sigma^2)^3) (the same matrix: the engine starts warm).
+      QpProblem& qp = answer == &S.result.x ? S.qp : S.ls;
+      SolverResult& r = answer == &S.result.x ? S.result : S.ls_result;
+      LviEngine& e = answer == &S.result.x ? *S.engine : *S.ls_engine;
+      prox_.setZero();
+      for (int step = 0; step < 2 && answer != nullptr; ++step) {
+        qp.zeta.head(n_) += eps_ * prox_;  // the previous step's centre out, this one's in
+        prox_ = answer->head(n_);
+        qp.zeta.head(n_) -= eps_ * prox_;
+        e.solve_valid(qp, r);
+        info.iterations += r.info.iterations;
+        if (r.info.status != SolverStatus::kSolved) answer = nullptr;
       }
     }
     if (answer == nullptr) {
       describe_level(static_cast<int>(l), text);
-      text << " not solved: " << to_string(L.result.info.status) << ": " << L.result.info.diagnosis;
-      if (L.has_ls) text << "; in least squares too: " << to_string(L.ls_result.info.status) << ": " << note_;
+      text << " not solved: " << to_string(S.result.info.status) << ": " << S.result.info.diagnosis;
+      if (L.has_ls) text << "; in least squares too: " << to_string(S.ls_result.info.status) << ": " << note_;
       text << "; the step keeps the answer of the levels above";
       skip = 1;
       continue;

@@ -3,15 +3,19 @@
 /// Strict priorities (docs/tasks.md): a scheme whose objectives and tasks sit at several priority levels is solved
 /// one QP per level, highest first, by the scenario's LVI engine. Level l's QP is
 ///
-///   minimise   x'(W_l + eps I)x / 2 + zeta_l'x    (its objectives, its soft tasks' least squares, damping)
+///   minimise   x'(W_l + eps c I)x / 2 + zeta_l'x  (its objectives, its soft tasks' least squares, damping; c is
+///                                                  W_l's largest diagonal entry, and W_l = 0 becomes I)
 ///   subject to the constraints' rows and bounds   (hard at every level)
 ///              its equality and inequality tasks' rows
 ///              every higher level's optimum held: its equality and soft tasks' rows J x = J x*, its inequality
 ///              tasks' rows at what they reached (J_r x <= max(hi_r, J_r x*)), and the value of its linear
 ///              objectives (zeta' x <= zeta' x*).
 ///
-/// eps (the scheme's `regularization`) makes every level's answer unique; it is not held, so it decides nothing
-/// that a lower level wants. A level below the first whose tasks cannot all be met (its QP fails) is solved again in
+/// eps (the scheme's `regularization`, relative to the level's own terms) makes every level's answer unique; it is not
+/// held, so it decides nothing that a lower level wants. Each level's QP is scaled so that its W's largest diagonal
+/// entry is 1 (the same minimiser, a better conditioned problem for the engine). A least-squares level (soft tasks,
+/// or a retry) is solved twice more with eps |x - x_k|^2 / 2 about its last answer x_k (proximal steps), which takes
+/// eps's bias along the rows' weak directions from O(eps / sigma^2) to its cube. A level below the first whose tasks cannot all be met (its QP fails) is solved again in
 /// least squares: its equality tasks' rows become (weight / 2) |J x - d|^2 and its inequality rows get slack
 /// variables s with (weight / 2) |s|^2 (J_r x - s <= hi_r), so they are met as well as the higher levels allow; the
 /// level's status is then `relaxed`. A level that fails even so keeps the higher levels' answer: the step does not
@@ -73,7 +77,7 @@ class Cascade {
  private:
   struct Level;
   struct RowTag;
-  void size_level(int l, QpProblem& qp, bool least_squares) const;
+  void size_level(int l, QpProblem& qp, bool least_squares, int held_rows) const;
   void assemble(int l, const SchemeData& data, QpProblem& qp, bool least_squares);
   void hold(int l, const SchemeData& data, const Eigen::VectorXd& x);
   [[nodiscard]] double task_error(int l, const SchemeData& data, const Eigen::VectorXd& x) const;
@@ -91,6 +95,8 @@ class Cascade {
   int held_eq_ = 0, held_in_ = 0;  // rows held so far this step
   std::vector<std::vector<std::string>> row_names_;  // each task's row names (for diagnoses)
   std::string note_;                                 // a failed try's text while the next writes
+  bool least_squares_terms_ = false;                 // the last assembled level has terms in W (scaled)
+  Eigen::VectorXd prox_;                             // the centre of the last proximal step
 };
 
 }  // namespace redres

@@ -30,7 +30,7 @@ struct SchemeLevelSpec {
 class Scheme {
  public:
   /// The default of regularization().
-  static constexpr double kDefaultRegularization = 1e-8;
+  static constexpr double kDefaultRegularization = 1e-9;
   /// Takes ownership of the plugins; sizes follow from the robot and the constraints' row counts.
   /// Throws std::invalid_argument when an active plugin does not work at `level` (Plugin::supports).
   Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,

@@ -11,6 +11,7 @@
 #include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/plugin.hpp"
+#include "redres/control/task.hpp"
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
 #include "redres/qp/lvi.hpp"
@@ -115,6 +116,8 @@ void print_plugins(bool json) {
                                 {"objective_common_keys", keys_json(objective_common_keys())},
                                 {"constraints", registry_json(constraint_registry())},
                                 {"constraint_common_keys", keys_json(constraint_common_keys())},
+                                {"tasks", registry_json(task_registry())},
+                                {"task_common_keys", keys_json(task_common_keys())},
                                 {"velocity_limits", registry_json(velocity_limit_registry())},
                                 {"paths", registry_json(path_registry())},
                                 {"path_common_keys", keys_json(describe_keys(PathPlacement::schema()))},
@@ -128,6 +131,8 @@ void print_plugins(bool json) {
                  "keys of every objective:");
   print_registry(constraint_registry(), "constraints ([[constraints]] tables in a scenario; hard, no weight)",
                  constraint_common_keys(), "keys of every constraint:");
+  print_registry(task_registry(), "tasks ([[tasks]] tables in a scenario; docs/tasks.md)", task_common_keys(),
+                 "keys of every task:");
   print_registry(velocity_limit_registry(), "velocity-limit laws ([joints.velocity_limit] in a robot file)", {}, "");
   print_registry(path_registry(), "paths (the [path] table of a scenario)", describe_keys(PathPlacement::schema()),
                  "keys of every path (placement and timing):");

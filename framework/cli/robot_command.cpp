@@ -17,6 +17,7 @@
 #include "redres/common/formula.hpp"
 #include "redres/model/collision.hpp"
 #include "redres/model/convex.hpp"
+#include "redres/model/frames.hpp"
 #include "redres/model/kinematics.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/run/ik.hpp"
@@ -172,6 +173,14 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
       if (!v.problem.empty()) visuals.back()["problem"] = v.problem;
     }
   }
+  nlohmann::json task_frames = nlohmann::json::array();  // the frames a frame task can name (docs/tasks.md)
+  for (std::size_t f = 0; f < model.frames().size(); ++f) {
+    const Eigen::Isometry3d at = frame_pose(model, k, static_cast<int>(f));
+    task_frames.push_back({{"name", model.frames()[f].name},
+                           {"joint", model.frames()[f].joint + 1},
+                           {"position", to_vector(at.translation())},
+                           {"rpy", rpy_of(at.linear())}});
+  }
   nlohmann::json J = nlohmann::json::array();
   for (Eigen::Index r = 0; r < k.J.rows(); ++r) J.push_back(to_vector(k.J.row(r).transpose()));
   return {{"name", model.name()},
@@ -189,6 +198,7 @@ nlohmann::json to_json(const RobotModel& model, const KinematicsData& k, const E
           {"base_pose", pose(model.base())},
           {"end_effector_pose", pose(k.ee_pose)},
           {"link_frames", frames},
+          {"frames", task_frames},
           {"theta", to_vector(k.theta)},
           {"f", to_vector(k.f)},
           {"J", J},
@@ -233,6 +243,12 @@ void print_text(const RobotModel& model, const KinematicsData& k, const Eigen::V
   for (int j = 0; j < model.dof(); ++j) {
     o << std::setw(5) << j + 1 << "  " << std::left << std::setw(width) << model.joint(j).name << std::right << "  "
       << pose(k.link_frames[static_cast<std::size_t>(j)]) << "\n";
+  }
+  o << "frames a task can name (frame = \"...\"; docs/tasks.md), riding on joint j\n";
+  for (std::size_t f = 0; f < model.frames().size(); ++f) {
+    const RobotModel::Frame& frame = model.frames()[f];
+    o << std::setw(5) << frame.joint + 1 << "  " << std::left << std::setw(width) << frame.name << std::right << "  "
+      << pose(frame_pose(model, k, static_cast<int>(f))) << "\n";
   }
   o << "f        " << row(k.f) << "\n";
   o << "J\n";

@@ -79,6 +79,24 @@ TEST(RobotCommand, TheJsonGivesPosesAndTheSelfDistancesNearestFirst) {
   for (int a = 0; a < 3; ++a) {
     EXPECT_NEAR(j["end_effector_pose"]["xyz"][a].get<double>(), k.ee_pose.translation()(a), 1e-12);
   }
+  // The frames a task can name: every link by its URDF name (the hand and fingers too) and the end effector, each at
+  // its pose; the end effector's is the end-effector pose.
+  ASSERT_EQ(j["frames"].size(), robot.frames().size());
+  bool hand = false, end_effector = false;
+  for (const auto& f : j["frames"]) {
+    if (f["name"] == "panda_hand") hand = true;
+    if (f["name"] == "end_effector") {
+      end_effector = true;
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_NEAR(f["position"][a].get<double>(), k.ee_pose.translation()(a), 1e-12);
+      }
+    }
+  }
+  EXPECT_TRUE(hand);
+  EXPECT_TRUE(end_effector);
+  const Cli text = redres("robot robots/franka_panda_meshes.toml");
+  EXPECT_NE(text.out.find("frames a task can name"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("panda_leftfinger"), std::string::npos);
 }
 
 }  // namespace

@@ -105,6 +105,45 @@ BENCHMARK_CAPTURE(BM_MotionStep, helix_acceleration, "panda_helix", true, false)
 BENCHMARK_CAPTURE(BM_MotionStep, helix_jerk, "panda_helix", false, true)->Iterations(5)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_MotionStep, helix_both, "panda_helix", true, true)->Iterations(5)->Unit(benchmark::kMillisecond);
 
+// BM_LevelsStep/<variant> (issue 29): the Panda's hand on configs/panda_tool_elbow_posture.toml's vertical circle,
+// with the joint margins and velocity limits, solved as
+//   single      the paper's single QP: task_tracking rows and the velocity norm (the baseline),
+//   one_level   the same as tasks: a frame task (equality) and the velocity norm, both at priority 0 (one QP),
+//   two_levels  the hand at priority 0, the velocity norm at 1,
+//   three_levels the shipped scenario: the hand at 0, the elbow above 0.5 m (inequality) at 1, the posture (soft)
+//               and a small velocity norm at 2.
+std::filesystem::path levels_variant(const std::string& variant) {
+  std::string text = read_text(source_path("configs/panda_tool_elbow_posture.toml"));
+  const std::string robot = "\"../robots/franka_panda.toml\"";
+  text.replace(text.find(robot), robot.size(), "\"" + source_path("robots/franka_panda.toml").string() + "\"");
+  if (variant != "three_levels") {
+    // The path and the limits stay; the tasks and objectives are replaced.
+    const std::size_t tasks = text.find("[[tasks]]");
+    const std::size_t constraints = text.find("[[constraints]]");
+    text = text.substr(0, tasks) + text.substr(constraints);
+    if (variant == "single") {
+      text += "\n[[constraints]]\ntype = \"task_tracking\"\ngain = 8.0\n\n[[objectives]]\ntype = \"min_velocity_norm\"\n";
+    } else {
+      text += "\n[[tasks]]\nname = \"tool\"\ntype = \"frame\"\nreference = \"path\"\ngain = 8.0\n\n"
+              "[[objectives]]\ntype = \"min_velocity_norm\"\npriority = " +
+              std::string(variant == "one_level" ? "0" : "1") + "\n";
+    }
+  }
+  const std::filesystem::path dir = scratch("levels_" + variant);
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path file = dir / "panda_levels.toml";
+  std::ofstream(file) << text;
+  return file;
+}
+
+void BM_LevelsStep(benchmark::State& state, const std::string& variant) {
+  BM_ScenarioFileStep(state, levels_variant(variant));
+}
+BENCHMARK_CAPTURE(BM_LevelsStep, single, "single")->Iterations(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LevelsStep, one_level, "one_level")->Iterations(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LevelsStep, two_levels, "two_levels")->Iterations(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LevelsStep, three_levels, "three_levels")->Iterations(5)->Unit(benchmark::kMillisecond);
+
 // Every scenario of configs/ (sorted by name), registered before main() runs.
 const bool registered = [] {
   std::vector<std::string> names;

@@ -108,6 +108,52 @@ TEST(ControllerRealTime, ThousandStepsWithEveryPerStepPluginAllocateNothing) {
   }
 }
 
+// A cascade of priority levels (docs/tasks.md) allocates nothing either: the shipped three-level scenario, the same
+// with the elbow's bound above where the elbow starts (its level cannot be met at first: the least-squares retry with
+// slack variables), and the conflicting tasks (a soft level below the hand's), with each engine.
+TEST(ControllerRealTime, ACascadeOfPriorityLevelsAllocatesNothing) {
+  if (!testing::allocation_counting_available()) {
+    GTEST_SKIP() << "AddressSanitizer owns malloc here; the release build runs this check";
+  }
+  struct Run {
+    const char* config;
+    std::vector<std::string> overrides;
+  };
+  const std::vector<Run> runs = {
+      {"configs/panda_tool_elbow_posture.toml", {}},
+      {"configs/panda_tool_elbow_posture.toml", {"tasks.1.lower=[0.7]"}},
+      {"configs/panda_conflict_tool_first.toml", {}},
+      {"configs/panda_tool_elbow_posture.toml", {"solver.engine=\"projection\""}},
+  };
+  int relaxed = 0;
+  for (const Run& r : runs) {
+    SCOPED_TRACE(std::string(r.config) + (r.overrides.empty() ? "" : " " + r.overrides.front()));
+    Scenario s = load_scenario(source_path(r.config), r.overrides);
+    const auto ctrl = Controller::from_scenario(s);
+    StepOutput out = ctrl->make_output();
+    ASSERT_EQ(out.levels.size(), s.scheme->levels().size());
+    ASSERT_GE(out.levels.size(), 2U);
+    Eigen::VectorXd theta = s.theta0;
+    ctrl->step(theta, 0.0, out);
+    theta += s.tau * out.theta_dot;
+    long allocations = 0;
+    int usable_steps = 0;
+    {
+      const testing::AllocationCounter counter;
+      for (int k = 1; k <= 600; ++k) {
+        ctrl->step(theta, k * s.tau, out);
+        usable_steps += usable(out.info.status) ? 1 : 0;
+        for (const LevelInfo& level : out.levels) relaxed += level.status == SolverStatus::kRelaxed ? 1 : 0;
+        theta += s.tau * out.theta_dot;
+      }
+      allocations = counter.count();
+    }
+    EXPECT_EQ(allocations, 0);
+    EXPECT_EQ(usable_steps, 600) << to_string(out.info.status) << ": " << out.info.diagnosis;
+  }
+  EXPECT_GT(relaxed, 0) << "the least-squares retry ran";
+}
+
 // Steps that fail allocate nothing either, diagnosis included: for each engine with a real-time path and each policy
 // (hold: theta_dot = 0; relax: the elastic QP), on scenes whose steps fail for different reasons: a sphere on the
 // Panda's hand path (the task rows against collision rows), the same sphere beside the point-cloud scenario's cloud,

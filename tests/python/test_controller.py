@@ -144,3 +144,21 @@ def test_a_measured_velocity_steps_within_the_pandas_acceleration_limits():
     with pytest.raises(ValueError, match="velocity jump"):
         ctrl.set_failure_policy("hold")
     ctrl.set_failure_policy("brake", recover_error=0.002)
+
+
+def test_a_scheme_with_priority_levels_reports_each_level_and_keeps_the_hand_on_its_path():
+    # configs/panda_tool_elbow_posture.toml: the hand (priority 0), the elbow above 0.5 m (1), the posture (2).
+    s = redres.Scenario.load(source("configs/panda_tool_elbow_posture.toml"))
+    ctrl = redres.Controller.from_scenario(s)
+    theta = s.theta0.copy()
+    for k in range(300):
+        theta_dot, info = ctrl.step(theta, k * s.step)
+        assert info.ok, info.diagnosis
+        assert [level.priority for level in info.levels] == [0, 1, 2]
+        assert all(level.status in ("solved", "relaxed") for level in info.levels), [l.diagnosis for l in info.levels]
+        assert info.levels[0].task_error < 1e-6  # the hand's rows are met
+        theta = theta + s.step * theta_dot
+    # A one-level scheme has no levels to report.
+    _, info = redres.Controller.from_scenario(redres.Scenario.load(source("configs/paper_r_tvcmm.toml"))).step(
+        redres.Scenario.load(source("configs/paper_r_tvcmm.toml")).theta0, 0.0)
+    assert info.levels == []

@@ -241,15 +241,28 @@ py::list typed_rows(const SweepTable& table, const SweepSpec& spec) {
 // --- controllers -------------------------------------------------------------------------------------------------
 
 // One step's SolverInfo, with the engine's name owned.
+struct LevelStepInfo {
+  int priority = 0;
+  std::string status, diagnosis;
+  int iterations = 0;
+  double residual = 0.0, task_error = 0.0;
+};
+
 struct StepInfo {
   std::string status, engine, diagnosis;
   int iterations = 0;
   double residual = 0.0;
+  std::vector<LevelStepInfo> levels;  // a scheme with several priority levels: each level's outcome
   [[nodiscard]] bool ok() const { return status == "solved"; }
 };
 
-StepInfo info_of(const SolverInfo& i) {
-  return StepInfo{to_string(i.status), std::string(i.engine), i.diagnosis, i.iterations, i.residual};
+StepInfo info_of(const StepOutput& out) {
+  const SolverInfo& i = out.info;
+  StepInfo info{to_string(i.status), std::string(i.engine), i.diagnosis, i.iterations, i.residual, {}};
+  for (const LevelInfo& l : out.levels) {
+    info.levels.push_back({l.priority, to_string(l.status), l.diagnosis, l.iterations, l.residual, l.task_error});
+  }
+  return info;
 }
 
 // redres.Controller: the per-step API for a caller's own loop, owning (or sharing) what the C++ Controller needs.
@@ -358,7 +371,7 @@ template <class Step>
 py::tuple step_in_turn(PyController& c, Step&& step) {
   auto [theta_dot, info] = in_turn(c, "Controller.step", [&](Controller& k) {
     step(k);
-    return std::make_pair(Eigen::VectorXd(c.out.theta_dot), info_of(c.out.info));
+    return std::make_pair(Eigen::VectorXd(c.out.theta_dot), info_of(c.out));
   });
   return py::make_tuple(std::move(theta_dot), std::move(info));
 }
@@ -587,6 +600,17 @@ PYBIND11_MODULE(_redres, m) {
         return "<redres.Scenario '" + s.scenario->name + "' " + std::to_string(s.scenario->steps()) + " steps>";
       });
 
+  py::class_<LevelStepInfo>(m, "LevelInfo", "one priority level's outcome at a step (docs/tasks.md)")
+      .def_readonly("priority", &LevelStepInfo::priority)
+      .def_readonly("status", &LevelStepInfo::status,
+                    "'solved', 'relaxed' (its tasks in least squares), 'not_run' (skipped) or why it failed")
+      .def_readonly("iterations", &LevelStepInfo::iterations)
+      .def_readonly("residual", &LevelStepInfo::residual)
+      .def_readonly("task_error", &LevelStepInfo::task_error, "the largest miss of its tasks' rows at the answer")
+      .def_readonly("diagnosis", &LevelStepInfo::diagnosis, "why it was relaxed, skipped or failed")
+      .def("__repr__", [](const LevelStepInfo& l) {
+        return "LevelInfo(priority=" + std::to_string(l.priority) + ", status='" + l.status + "')";
+      });
   py::class_<StepInfo>(m, "StepInfo", "One step's solver outcome.")
       .def_readonly("status", &StepInfo::status, "'solved', 'max_iterations', 'infeasible' or 'numerical_error'")
       .def_property_readonly("ok", &StepInfo::ok, "status == 'solved'")
@@ -594,6 +618,9 @@ PYBIND11_MODULE(_redres, m) {
       .def_readonly("residual", &StepInfo::residual, "||e(u)||_2 of the LVI at the answer")
       .def_readonly("engine", &StepInfo::engine, "the engine that ran (a fallback names itself)")
       .def_readonly("diagnosis", &StepInfo::diagnosis, "empty when solved; else which joint, bound, row and plugin")
+      .def_readonly("levels", &StepInfo::levels,
+                    "with tasks or objectives at several priorities (docs/tasks.md): each level's LevelInfo, highest "
+                    "first; empty otherwise")
       .def("__repr__", [](const StepInfo& i) {
         return "<redres.StepInfo " + i.status + ", " + std::to_string(i.iterations) + " iterations>";
       });

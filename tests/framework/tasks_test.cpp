@@ -474,6 +474,52 @@ TEST(Tasks, ASoftTaskWithAVeryLargeWeightApproachesTheHardOne) {
   }
 }
 
+TEST(Tasks, DampingBoundsTheVelocityNearASingularityAndVanishesAwayFromIt) {
+  const RobotModel robot = load_robot(source_path("robots/planar_4link.toml"));
+  const auto solve = [&](const Eigen::VectorXd& theta, double damping, const Eigen::Vector2d& target) {
+    FrameTaskConfig c;
+    c.reference = "fixed";
+    c.position = {target.x(), target.y(), 0.0};
+    c.damping = damping;
+    c.damping_threshold = 0.05;
+    std::vector<std::unique_ptr<Task>> tasks;
+    tasks.push_back(frame_task(robot, "tool", c, TaskMode::kSoft, 0));
+    std::vector<std::unique_ptr<Objective>> objectives;
+    objectives.push_back(min_norm(robot, 0));
+    objectives.back()->set_weight(1e-8);
+    Rig rig(robot, std::move(objectives), {}, std::move(tasks), Scheme::kDefaultRegularization, 1e-10);
+    const Eigen::VectorXd x = rig.step(theta);
+    EXPECT_EQ(rig.out.info.status, SolverStatus::kSolved) << rig.out.info.diagnosis;
+    return std::make_pair(x, rig.terms(0));
+  };
+  // Nearly stretched: the rows lose rank along the arm. The target lies 5 cm along the weak direction.
+  Eigen::VectorXd theta(4);
+  theta << 0.3, 0.004, 0.002, 0.001;
+  KinematicsData k(robot);
+  compute_kinematics(robot, theta, k, KinematicsLevel::kJacobian);
+  const Eigen::MatrixXd J = k.J.topRows(2);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullU);
+  ASSERT_LT(svd.singularValues()(1), 0.01);
+  const Eigen::Vector2d weak = svd.matrixU().col(1);
+  const Eigen::Vector2d target = k.f.head(2) + 0.05 * weak;
+  const auto [plain, plain_terms] = solve(theta, 0.0, target);
+  const auto [damped, damped_terms] = solve(theta, 0.1, target);
+  EXPECT_EQ(plain_terms.damping, 0.0);
+  EXPECT_GT(damped_terms.damping, 0.9 * 0.01);  // lambda^2 near its largest, 0.1^2
+  EXPECT_NEAR(damped_terms.sigma_min, svd.singularValues()(1), 1e-9);
+  // Undamped, the joints race to make up the lost rank; damped, |x| <= |d| / (2 lambda) (damped least squares).
+  EXPECT_GT(plain.norm(), 10.0 * damped.norm());
+  EXPECT_LE(damped.norm(), damped_terms.d.norm() / (2.0 * std::sqrt(damped_terms.damping)) * 1.001);
+  // Away from the singularity the damping is 0 and the answer is the undamped one, bit for bit.
+  Eigen::VectorXd bent(4);
+  bent << 0.3, 0.8, -0.6, 0.4;
+  const Eigen::Vector2d near = target;
+  const auto [a, a_terms] = solve(bent, 0.0, near);
+  const auto [b, b_terms] = solve(bent, 0.1, near);
+  EXPECT_EQ(b_terms.damping, 0.0);
+  EXPECT_EQ((a - b).norm(), 0.0);
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // One level; a failed lower level.
 

@@ -118,6 +118,9 @@ Cascade::Cascade(const Scheme& scheme, const SchemeData& data, const LviEngine& 
   }
   note_.reserve(kDiagnosisCapacity);
   prox_ = Eigen::VectorXd::Zero(n_);
+  Eigen::Index widest = n_;
+  for (const auto& level : levels_) widest = std::max<Eigen::Index>(widest, n_ + level->in_tasks);
+  keep_ = Eigen::VectorXd::Zero(widest);
 }
 
 void Cascade::size_level(int l, QpProblem& qp, bool least_squares, int held_rows) const {
@@ -355,6 +358,33 @@ void Cascade::describe_level(int l, TextSink& out) const {
   out << ")";
 }
 
+void Cascade::refine(QpProblem& qp, LviEngine& engine, SolverResult& r, int& iterations) {
+  // A least squares whose rows leave directions free: eps |x|^2 / 2 biases its optimum by O(eps / sigma^2) along its
+  // weak directions. Two proximal steps, eps |x - x_k|^2 / 2 about the last answer, take that bias to
+  // O((eps / sigma^2)^3) (the same matrix: the engine starts warm). Should a step fail, the answer before it stays.
+  const Eigen::Index m = r.x.size();
+  keep_.head(m) = r.x;
+  prox_.setZero();
+  for (int step = 0; step < 2; ++step) {
+    qp.zeta.head(n_) += eps_ * prox_;  // the previous step's centre out, this one's in
+    prox_ = r.x.head(n_);
+    qp.zeta.head(n_) -= eps_ * prox_;
+    engine.solve_valid(qp, r);
+    iterations += r.info.iterations;
+    if (r.info.status != SolverStatus::kSolved) {
+      r.x = keep_.head(m);
+      r.info.status = SolverStatus::kSolved;  // the answer before the step, which was solved
+      break;
+    }
+    keep_.head(m) = r.x;
+  }
+}
+
+void Cascade::refine_first(QpProblem& qp, LviEngine& engine, SolverResult& r, int& iterations) {
+  // build_first() assembled level 0 last: the flags are its own.
+  if (least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone) refine(qp, engine, r, iterations);
+}
+
 void Cascade::build_first(const Context& ctx, SchemeData& data, QpProblem& qp) {
   scheme_->build_constraints(ctx, base_, data);
   scheme_->evaluate_tasks(ctx, data);
@@ -420,21 +450,9 @@ void Cascade::solve_rest(const Context& ctx, SchemeData& data, const Eigen::Vect
       }
     }
     if (answer != nullptr && least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone) {
-      // A least squares whose rows leave directions free: eps |x|^2 / 2 biases its optimum by O(eps / sigma^2) along
-      // its weak directions. Two proximal steps, eps |x - x_k|^2 / 2 about the last answer, take that bias to
-      // O((eps / sigma^2)^3) (the same matrix: the engine starts warm).
-      QpProblem& qp = answer == &S.result.x ? S.qp : S.ls;
-      SolverResult& r = answer == &S.result.x ? S.result : S.ls_result;
-      LviEngine& e = answer == &S.result.x ? *S.engine : *S.ls_engine;
-      prox_.setZero();
-      for (int step = 0; step < 2 && answer != nullptr; ++step) {
-        qp.zeta.head(n_) += eps_ * prox_;  // the previous step's centre out, this one's in
-        prox_ = answer->head(n_);
-        qp.zeta.head(n_) -= eps_ * prox_;
-        e.solve_valid(qp, r);
-        info.iterations += r.info.iterations;
-        if (r.info.status != SolverStatus::kSolved) answer = nullptr;
-      }
+      const bool first = answer == &S.result.x;
+      refine(first ? S.qp : S.ls, first ? *S.engine : *S.ls_engine, first ? S.result : S.ls_result,
+             info.iterations);
     }
     if (answer == nullptr) {
       describe_level(static_cast<int>(l), text);

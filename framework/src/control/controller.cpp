@@ -284,6 +284,8 @@ void Controller::solve_levels(StepOutput& out) {
   LevelInfo& first = out.levels.front();
   first.status = result_.info.status;
   first.iterations = result_.info.iterations;
+  cascade_->refine_first(qp_, *engine_, result_, first.iterations);
+  out.info.iterations = first.iterations;
   first.residual = result_.info.residual;
   keep_diagnosis_capacity(first.diagnosis);
   first.diagnosis.clear();

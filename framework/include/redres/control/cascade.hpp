@@ -67,6 +67,9 @@ class Cascade {
   /// controller's) and x, the answer of the lowest level solved. Allocation-free.
   void solve_rest(const Context& ctx, SchemeData& data, const Eigen::VectorXd& x0, std::vector<LevelInfo>& levels,
                   Eigen::VectorXd& x);
+  /// Level 0 (solved by the caller into `qp` with `engine`, answer in `r`): when it is a least squares, its proximal
+  /// steps (below), each adding its iterations to `iterations`. Allocation-free.
+  void refine_first(QpProblem& qp, LviEngine& engine, SolverResult& r, int& iterations);
   /// Writes level 0's tasks' error at x into levels[0].task_error.
   void first_task_error(const SchemeData& data, const Eigen::VectorXd& x, LevelInfo& info) const;
   /// Forgets the lower levels' engines' warm starts.
@@ -82,6 +85,7 @@ class Cascade {
   void hold(int l, const SchemeData& data, const Eigen::VectorXd& x);
   [[nodiscard]] double task_error(int l, const SchemeData& data, const Eigen::VectorXd& x) const;
   void describe_level(int l, TextSink& out) const;
+  void refine(QpProblem& qp, LviEngine& engine, SolverResult& r, int& iterations);
 
   const Scheme* scheme_;
   int n_ = 0;
@@ -97,6 +101,7 @@ class Cascade {
   std::string note_;                                 // a failed try's text while the next writes
   bool least_squares_terms_ = false;                 // the last assembled level has terms in W (scaled)
   Eigen::VectorXd prox_;                             // the centre of the last proximal step
+  Eigen::VectorXd keep_;                             // the answer before a proximal step
 };
 
 }  // namespace redres

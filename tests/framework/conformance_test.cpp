@@ -9,6 +9,7 @@
 #include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/plugin.hpp"
+#include "redres/control/task.hpp"
 #include "redres/extend/conformance.hpp"
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
@@ -35,6 +36,7 @@ TEST(Conformance, EveryBuiltInPluginPassesAndEveryTypeIsChecked) {
   };
   expect_all(objective_registry(), "objective");
   expect_all(constraint_registry(), "constraint");
+  expect_all(task_registry(), "task");
   expect_all(velocity_limit_registry(), "velocity-limit law");
   expect_all(path_registry(), "path");
   expect_all(engine_registry(), "engine");

@@ -8,6 +8,7 @@
 #include "redres/control/path.hpp"
 #include "redres/control/plugin.hpp"
 #include "redres/control/scheme.hpp"
+#include "redres/control/task.hpp"
 #include "redres/model/robot.hpp"
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
@@ -151,13 +152,16 @@ void check_scheme_plugin(const Entry& e, const std::vector<RobotModel>& robots, 
     // Finite contributions, and the gradient of objectives with a potential.
     std::vector<std::unique_ptr<Objective>> objectives;
     std::vector<std::unique_ptr<Constraint>> constraints;
+    std::vector<std::unique_ptr<Task>> tasks;
     const P* raw = p.get();
     if constexpr (std::is_same_v<P, Objective>) {
       objectives.push_back(std::move(p));
-    } else {
+    } else if constexpr (std::is_same_v<P, Constraint>) {
       constraints.push_back(std::move(p));
+    } else {
+      tasks.push_back(std::move(p));
     }
-    const Scheme scheme(robot, std::move(objectives), std::move(constraints));
+    const Scheme scheme(robot, std::move(objectives), std::move(constraints), std::move(tasks));
     QpProblem qp;
     SchemeData scheme_data = scheme.make_data();
     scheme.setup(qp, scheme_data);
@@ -332,6 +336,10 @@ std::vector<ConformanceResult> check_registries(const std::string& origin) {
     if (!wanted(e->origin, origin)) continue;
     check_scheme_plugin<Constraint>(*e, robots, constraint_common_keys(), make_constraint,
                                     Recorder{out, "constraint", e->type});
+  }
+  for (const auto* e : task_registry().entries()) {
+    if (!wanted(e->origin, origin)) continue;
+    check_scheme_plugin<Task>(*e, robots, task_common_keys(), make_task, Recorder{out, "task", e->type});
   }
   for (const auto* e : velocity_limit_registry().entries()) {
     if (!wanted(e->origin, origin)) continue;

@@ -122,11 +122,13 @@ std::filesystem::path levels_variant(const std::string& variant) {
     const std::size_t constraints = text.find("[[constraints]]");
     text = text.substr(0, tasks) + text.substr(constraints);
     if (variant == "single") {
-      text += "\n[[constraints]]\ntype = \"task_tracking\"\ngain = 8.0\n\n[[objectives]]\ntype = \"min_velocity_norm\"\n";
+      text +=
+          "\n[[constraints]]\ntype = \"task_tracking\"\ngain = 8.0\n\n[[objectives]]\ntype = \"min_velocity_norm\"\n";
     } else {
-      text += "\n[[tasks]]\nname = \"tool\"\ntype = \"frame\"\nreference = \"path\"\ngain = 8.0\n\n"
-              "[[objectives]]\ntype = \"min_velocity_norm\"\npriority = " +
-              std::string(variant == "one_level" ? "0" : "1") + "\n";
+      text +=
+          "\n[[tasks]]\nname = \"tool\"\ntype = \"frame\"\nreference = \"path\"\ngain = 8.0\n\n"
+          "[[objectives]]\ntype = \"min_velocity_norm\"\npriority = " +
+          std::string(variant == "one_level" ? "0" : "1") + "\n";
     }
   }
   const std::filesystem::path dir = scratch("levels_" + variant);

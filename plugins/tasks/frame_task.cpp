@@ -17,7 +17,7 @@ constexpr const char* kRowNames[] = {"x", "y", "z", "wx", "wy", "wz", "axis_u", 
 
 class FrameTaskData final : public TaskData {
  public:
-  Eigen::Matrix<double, 6, Eigen::Dynamic> J6;  // the frame's [v; omega] Jacobian
+  Eigen::Matrix<double, 6, Eigen::Dynamic> J6;   // the frame's [v; omega] Jacobian
   bool captured = false;                         // the start pose is known
   Eigen::Vector3d p0 = Eigen::Vector3d::Zero();  // the start position
   Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();
@@ -64,8 +64,8 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
   if (frame_ < 0) {
     std::string names;
     for (const auto& f : robot.frames()) names += (names.empty() ? "'" : ", '") + f.name + "'";
-    throw FieldError("frame", "no frame '" + config_.frame + "' on robot '" + robot.name() + "'; its frames are " +
-                                  names);
+    throw FieldError("frame",
+                     "no frame '" + config_.frame + "' on robot '" + robot.name() + "'; its frames are " + names);
   }
   std::vector<std::string> names = config_.rows;
   if (names.empty()) {
@@ -79,10 +79,11 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
       kinds_.push_back(Row::kAxisV);
       continue;
     }
-    const auto* it = std::find_if(std::begin(kRowNames), std::begin(kRowNames) + 6,
-                                  [&r](const char* name) { return r == name; });
+    const auto* it =
+        std::find_if(std::begin(kRowNames), std::begin(kRowNames) + 6, [&r](const char* name) { return r == name; });
     if (it == std::begin(kRowNames) + 6) {
-      throw FieldError("rows", "unknown row '" + r + "'; expected \"x\", \"y\", \"z\", \"wx\", \"wy\", \"wz\" or \"axis\"");
+      throw FieldError("rows",
+                       "unknown row '" + r + "'; expected \"x\", \"y\", \"z\", \"wx\", \"wy\", \"wz\" or \"axis\"");
     }
     const Row kind = static_cast<Row>(it - std::begin(kRowNames));
     if (std::find(kinds_.begin(), kinds_.end(), kind) != kinds_.end()) {
@@ -91,9 +92,10 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
     kinds_.push_back(kind);
   }
   const bool axis = std::find(kinds_.begin(), kinds_.end(), Row::kAxisU) != kinds_.end();
-  const bool rotation = std::any_of(kinds_.begin(), kinds_.end(),
-                                    [](Row k) { return k == Row::kWx || k == Row::kWy || k == Row::kWz; });
-  if (axis && rotation) throw FieldError("rows", "\"axis\" and the orientation rows \"wx\", \"wy\", \"wz\" exclude each other");
+  const bool rotation =
+      std::any_of(kinds_.begin(), kinds_.end(), [](Row k) { return k == Row::kWx || k == Row::kWy || k == Row::kWz; });
+  if (axis && rotation)
+    throw FieldError("rows", "\"axis\" and the orientation rows \"wx\", \"wy\", \"wz\" exclude each other");
   if (config_.axis) {
     axis_ = vec(*config_.axis);
     if (!(axis_.norm() > 1e-9) || !axis_.allFinite()) throw FieldError("axis", "expected a non-zero direction");
@@ -111,10 +113,10 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
     }
     position_ = config_.position ? vec(*config_.position) : Eigen::Vector3d::Zero();
     const Eigen::Vector3d rpy = config_.rpy ? vec(*config_.rpy) : Eigen::Vector3d::Zero();
-    rotation_ = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
-                 Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-                 Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
-                    .toRotationMatrix();
+    rotation_ =
+        (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
   } else {
     if (config_.position) throw FieldError("position", "is read only with reference = \"fixed\"");
     if (config_.rpy) throw FieldError("rpy", "is read only with reference = \"fixed\"");
@@ -128,9 +130,9 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
   }
   for (const auto* bounds : {&config_.lower, &config_.upper}) {
     if (*bounds && static_cast<int>((*bounds)->size()) != rows()) {
-      throw FieldError(bounds == &config_.lower ? "lower" : "upper",
-                       "expected one bound per row (" + std::to_string(rows()) + "), got " +
-                           std::to_string((*bounds)->size()));
+      throw FieldError(
+          bounds == &config_.lower ? "lower" : "upper",
+          "expected one bound per row (" + std::to_string(rows()) + "), got " + std::to_string((*bounds)->size()));
     }
   }
 }
@@ -147,8 +149,8 @@ void FrameTask::check_mode() const {
     for (int r = 0; r < rows(); ++r) any = any || has_lower(r) || has_upper(r);
     if (!any) throw FieldError("lower", "every bound is infinite: the task would bound nothing");
     for (int r = 0; r < rows(); ++r) {
-      if (has_lower(r) && has_upper(r) && (*config_.lower)[static_cast<std::size_t>(r)] >
-                                              (*config_.upper)[static_cast<std::size_t>(r)]) {
+      if (has_lower(r) && has_upper(r) &&
+          (*config_.lower)[static_cast<std::size_t>(r)] > (*config_.upper)[static_cast<std::size_t>(r)]) {
         throw FieldError("lower", "row '" + row_name(r) + "': lower > upper");
       }
     }
@@ -161,9 +163,13 @@ void FrameTask::check_mode() const {
   }
 }
 
-std::string FrameTask::row_name(int r) const { return kRowNames[static_cast<int>(kinds_[static_cast<std::size_t>(r)])]; }
+std::string FrameTask::row_name(int r) const {
+  return kRowNames[static_cast<int>(kinds_[static_cast<std::size_t>(r)])];
+}
 
-std::string FrameTask::row_unit(int r) const { return static_cast<int>(kinds_[static_cast<std::size_t>(r)]) < 3 ? "m" : "rad"; }
+std::string FrameTask::row_unit(int r) const {
+  return static_cast<int>(kinds_[static_cast<std::size_t>(r)]) < 3 ? "m" : "rad";
+}
 
 bool FrameTask::has_lower(int r) const {
   return config_.lower && std::isfinite((*config_.lower)[static_cast<std::size_t>(r)]);

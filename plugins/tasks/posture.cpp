@@ -35,8 +35,9 @@ Posture::Posture(const Config& config, const RobotModel& robot) : Configured(kTy
 
 void Posture::check_mode() const {
   if (mode() == TaskMode::kInequality) {
-    throw FieldError("mode", "a posture is a target, not bounds: use \"soft\" or \"equality\" (the joint limits are "
-                             "the constraints')");
+    throw FieldError("mode",
+                     "a posture is a target, not bounds: use \"soft\" or \"equality\" (the joint limits are "
+                     "the constraints')");
   }
 }
 

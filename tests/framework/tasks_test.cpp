@@ -18,8 +18,8 @@
 #include <gtest/gtest.h>
 #include <rapidcheck.h>
 #include <rapidcheck/gtest.h>
-#include <Eigen/Geometry>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
@@ -125,7 +125,8 @@ RC_GTEST_PROP(Tasks, AFrameTasksRowsAreTheDerivativeOfItsError, ()) {
   const RobotModel robot(testing::random_spatial(n, TaskRows::kPosition));
   const Eigen::VectorXd theta = testing::random_theta(robot);
   FrameTaskConfig c;
-  c.frame = robot.frames()[static_cast<std::size_t>(*rc::gen::inRange(0, static_cast<int>(robot.frames().size())))].name;
+  c.frame =
+      robot.frames()[static_cast<std::size_t>(*rc::gen::inRange(0, static_cast<int>(robot.frames().size())))].name;
   c.point = {testing::draw(-0.2, 0.2), testing::draw(-0.2, 0.2), testing::draw(-0.2, 0.2)};
   c.reference = "fixed";
   c.position = {testing::draw(-1, 1), testing::draw(-1, 1), testing::draw(-1, 1)};
@@ -159,10 +160,10 @@ TEST(Tasks, TheOrientationErrorIsTheRotationVectorOfTheReferenceTimesTheInverse)
   KinematicsData k(robot);
   compute_kinematics(robot, theta, k, KinematicsLevel::kPosition);
   const Eigen::Matrix3d R = frame_pose(robot, k, robot.find_frame("panda_joint4")).linear();
-  const Eigen::Matrix3d R_d = (Eigen::AngleAxisd(1.1, Eigen::Vector3d::UnitZ()) *
-                               Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))
-                                  .toRotationMatrix();
+  const Eigen::Matrix3d R_d =
+      (Eigen::AngleAxisd(1.1, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   // Turning the frame by e (world axes) brings it onto the reference.
   EXPECT_LT((rotation_from_vector(e) * R - R_d).norm(), 1e-12);
   // d = K e for a fixed reference (gain 1).
@@ -281,9 +282,9 @@ RC_GTEST_PROP(Tasks, TheCascadeAgreesWithAnIndependentLexicographicSolve, ()) {
       }
       if (stacked.rows() == 0) continue;
       // The squared singular values: the eigenvalues of J'J, in increasing order.
-      const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(stacked.transpose() * stacked,
-                                                                               Eigen::EigenvaluesOnly)
-                                     .eigenvalues();
+      const Eigen::VectorXd ev =
+          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(stacked.transpose() * stacked, Eigen::EigenvaluesOnly)
+              .eigenvalues();
       const double top = ev(ev.size() - 1);
       for (Eigen::Index i = 0; i < ev.size(); ++i) RC_PRE(ev(i) < 1e-14 * top || ev(i) > 1e-6 * top);
     }
@@ -299,8 +300,8 @@ RC_GTEST_PROP(Tasks, TheCascadeAgreesWithAnIndependentLexicographicSolve, ()) {
     stack(rig, level, r, n);
     p.levels.push_back(r);
   }
-  p.levels.push_back({Eigen::MatrixXd::Identity(n, n), Eigen::VectorXd::Zero(n), Eigen::MatrixXd(0, n),
-                      Eigen::VectorXd(0)});
+  p.levels.push_back(
+      {Eigen::MatrixXd::Identity(n, n), Eigen::VectorXd::Zero(n), Eigen::MatrixXd(0, n), Eigen::VectorXd(0)});
   const testing::ReferenceSolution ref = testing::solve_lexicographic(p, Eigen::VectorXd::Zero(n));
   if (rig.out.levels[0].status == SolverStatus::kInfeasible) {
     // Level 0's tasks are hard: the step fails (for the failure policy) exactly where they cannot be met.
@@ -384,7 +385,8 @@ RC_GTEST_PROP(Tasks, TheCascadeAgreesWithAnIndependentLexicographicSolve, ()) {
   Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, m);
   if (E.rows() > 0) M.leftCols(E.rows()) = E.transpose();
   if (G.rows() > 0) M.middleCols(E.rows(), G.rows()) = G.transpose();
-  for (std::size_t i = 0; i < at_bound.size(); ++i) M(at_bound[i], E.rows() + G.rows() + static_cast<Eigen::Index>(i)) = 1.0;
+  for (std::size_t i = 0; i < at_bound.size(); ++i)
+    M(at_bound[i], E.rows() + G.rows() + static_cast<Eigen::Index>(i)) = 1.0;
   // Stationarity: x lies in the span of the active constraints' normals (the multipliers' signs are not unique where
   // held rows and bounds overlap; the comparison with the reference above covers the inequalities' side).
   if (m == 0) {
@@ -429,7 +431,8 @@ TEST(Tasks, TheHigherOfTwoConflictingTasksIsMetAndSwappingThePrioritiesSwapsTheO
     const TaskTerms& high = order == 0 ? t : e;
     const TaskTerms& low = order == 0 ? e : t;
     EXPECT_LT(order == 0 ? tool_miss : elbow_miss, 1e-9) << "order " << order;
-    EXPECT_EQ(rig.out.levels[1].status, SolverStatus::kRelaxed) << rig.out.levels[1].diagnosis << " / " << rig.out.info.diagnosis;
+    EXPECT_EQ(rig.out.levels[1].status, SolverStatus::kRelaxed)
+        << rig.out.levels[1].diagnosis << " / " << rig.out.info.diagnosis;
     std::vector<testing::ReferenceLevel> levels{{high.J, high.d, Eigen::MatrixXd(0, 7), Eigen::VectorXd(0)},
                                                 {low.J, low.d, Eigen::MatrixXd(0, 7), Eigen::VectorXd(0)}};
     const Eigen::VectorXd ns = testing::null_space_cascade(levels, 7);

@@ -4,9 +4,9 @@
 // hard constraint holds. It shares no code with redres's cascade: the tests hold the framework's levels to it.
 //
 // Level l minimises  sum ||J_e x - d_e||^2 (its equality and soft tasks) + sum ||max(0, G x - h)||^2 (its
-// inequality tasks, G x <= h; written with slack variables s, G x - s <= h, and ||s||^2)  subject to  lo <= x <= hi,  A x <= b,  and for every higher level k: J_k x = J_k x*_k
-// (its equality and soft rows, where level k ended; kept as an orthonormal basis of their span) and G_k x <= max(h_k, G_k x*_k) (its inequality rows, at what
-// level k reached).
+// inequality tasks, G x <= h; written with slack variables s, G x - s <= h, and ||s||^2)  subject to  lo <= x <= hi,  A
+// x <= b,  and for every higher level k: J_k x = J_k x*_k (its equality and soft rows, where level k ended; kept as an
+// orthonormal basis of their span) and G_k x <= max(h_k, G_k x*_k) (its inequality rows, at what level k reached).
 
 #include <algorithm>
 #include <cmath>
@@ -94,7 +94,7 @@ inline ReferenceSolution solve_lexicographic(const ReferenceProblem& p, const Ei
   ReferenceSolution out;
   Eigen::VectorXd x = x0.cwiseMax(p.lo).cwiseMin(p.hi);
   std::vector<detail::Rows> held_eq, held_in;  // what the higher levels keep
-  Eigen::MatrixXd stacked(0, n);                // every equality and soft row held so far
+  Eigen::MatrixXd stacked(0, n);               // every equality and soft row held so far
   // [M, 0]: rows on x alone, widened to v = (x, s).
   const auto widen = [](const detail::Rows& r, int nv) {
     detail::Rows w{Eigen::MatrixXd::Zero(r.M.rows(), nv), r.c};

@@ -26,10 +26,10 @@ struct Cascade::RowTag {
 struct Cascade::Level {
   int priority = 0;
   std::vector<int> tasks, objectives;
-  int eq_tasks = 0;       // the rows of its equality tasks
-  int in_tasks = 0;       // the inequality rows of its inequality tasks (and, in least squares, its slacks)
-  int held_eq = 0;        // at most this many rows held from the levels above (an orthonormal basis of their span)
-  int held_in = 0;        // inequality rows held from the levels above
+  int eq_tasks = 0;  // the rows of its equality tasks
+  int in_tasks = 0;  // the inequality rows of its inequality tasks (and, in least squares, its slacks)
+  int held_eq = 0;   // at most this many rows held from the levels above (an orthonormal basis of their span)
+  int held_in = 0;   // inequality rows held from the levels above
   std::vector<RowTag> in_tags;  // its QP's inequality rows past the constraints'
   bool has_ls = false;          // below the first, with equality or inequality tasks: a least-squares retry
   // One QP (and its least-squares retry) per number of held rows, 0 to held_eq, each with its engine: the held rows'
@@ -451,8 +451,7 @@ void Cascade::solve_rest(const Context& ctx, SchemeData& data, const Eigen::Vect
     }
     if (answer != nullptr && least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone) {
       const bool first = answer == &S.result.x;
-      refine(first ? S.qp : S.ls, first ? *S.engine : *S.ls_engine, first ? S.result : S.ls_result,
-             info.iterations);
+      refine(first ? S.qp : S.ls, first ? *S.engine : *S.ls_engine, first ? S.result : S.ls_result, info.iterations);
     }
     if (answer == nullptr) {
       describe_level(static_cast<int>(l), text);

@@ -52,8 +52,7 @@ std::unique_ptr<PluginData> Task::make_data() const {
 }
 
 namespace {
-[[gnu::cold]] [[noreturn]] void bad_rows(const Task& task, const char* what, Eigen::Index r, Eigen::Index c,
-                                         double v) {
+[[gnu::cold]] [[noreturn]] void bad_rows(const Task& task, const char* what, Eigen::Index r, Eigen::Index c, double v) {
   std::ostringstream s;
   s << "task '" << task.name() << "'";
   if (!task.source().empty()) s << " (" << task.source() << ")";
@@ -154,13 +153,16 @@ struct TaskCommon {
   double weight = 1.0;
   static const Schema<TaskCommon>& schema() {
     static const Schema<TaskCommon> s{
-        {field("name", &TaskCommon::name, "", "instance name, used in diagnoses and output columns (default: the type)"),
+        {field("name", &TaskCommon::name, "",
+               "instance name, used in diagnoses and output columns (default: the type)"),
          field("active", &TaskCommon::active, "", "false builds the task but leaves it out of the QP"),
          field("mode", &TaskCommon::mode, "",
                "\"equality\" (hard rows J x = d), \"soft\" (weighted least squares in the objective) or "
                "\"inequality\" (lower <= value <= upper)"),
-         field("priority", &TaskCommon::priority, "", "its level: 0 is the highest; each level keeps the optima of "
-               "the levels above it", between<int>(0, 100)),
+         field("priority", &TaskCommon::priority, "",
+               "its level: 0 is the highest; each level keeps the optima of "
+               "the levels above it",
+               between<int>(0, 100)),
          field("weight", &TaskCommon::weight, "",
                "the weight of its least squares (soft mode; and where a lower level cannot meet it)",
                between(1e-12, 1e12))}};

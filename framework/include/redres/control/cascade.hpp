@@ -15,13 +15,14 @@
 /// held, so it decides nothing that a lower level wants. Each level's QP is scaled so that its W's largest diagonal
 /// entry is 1 (the same minimiser, a better conditioned problem for the engine). A least-squares level (soft tasks,
 /// or a retry) is solved twice more with eps |x - x_k|^2 / 2 about its last answer x_k (proximal steps), which takes
-/// eps's bias along the rows' weak directions from O(eps / sigma^2) to its cube. A level below the first whose tasks cannot all be met (its QP fails) is solved again in
-/// least squares: its equality tasks' rows become (weight / 2) |J x - d|^2 and its inequality rows get slack
-/// variables s with (weight / 2) |s|^2 (J_r x - s <= hi_r), so they are met as well as the higher levels allow; the
-/// level's status is then `relaxed`. A level that fails even so keeps the higher levels' answer: the step does not
-/// fail because a low-priority task cannot be met. A level whose objectives have a quadratic term (a velocity norm)
-/// decides every joint velocity left free, so the levels below it are skipped. Level 0 is solved into the
-/// controller's own QP by its own engine, so that a failure there is the step's, handled by the failure policy.
+/// eps's bias along the rows' weak directions from O(eps / sigma^2) to its cube. A level below the first whose tasks
+/// cannot all be met (its QP fails) is solved again in least squares: its equality tasks' rows become (weight / 2) |J x
+/// - d|^2 and its inequality rows get slack variables s with (weight / 2) |s|^2 (J_r x - s <= hi_r), so they are met as
+/// well as the higher levels allow; the level's status is then `relaxed`. A level that fails even so keeps the higher
+/// levels' answer: the step does not fail because a low-priority task cannot be met. A level whose objectives have a
+/// quadratic term (a velocity norm) decides every joint velocity left free, so the levels below it are skipped. Level 0
+/// is solved into the controller's own QP by its own engine, so that a failure there is the step's, handled by the
+/// failure policy.
 ///
 /// Everything is sized at construction; a step allocates nothing.
 
@@ -96,7 +97,7 @@ class Cascade {
   std::vector<std::unique_ptr<Level>> levels_;
   Eigen::MatrixXd held_J_, held_A_;  // the higher levels' optima, as rows
   Eigen::VectorXd held_d_, held_b_;
-  int held_eq_ = 0, held_in_ = 0;  // rows held so far this step
+  int held_eq_ = 0, held_in_ = 0;                    // rows held so far this step
   std::vector<std::vector<std::string>> row_names_;  // each task's row names (for diagnoses)
   std::string note_;                                 // a failed try's text while the next writes
   bool least_squares_terms_ = false;                 // the last assembled level has terms in W (scaled)

@@ -151,7 +151,7 @@ class Controller {
 
  private:
   void solve(double t, StepOutput& out);
-  void solve_levels(StepOutput& out);  // a cascaded scheme's levels below the first
+  void solve_levels(StepOutput& out);    // a cascaded scheme's levels below the first
   void begin_step();                     // the previous step's command becomes theta_dot_prev
   void end_step(const StepOutput& out);  // this step's command and status, for the next
   bool relax(StepOutput& out);           // the elastic QP; false when it fails too

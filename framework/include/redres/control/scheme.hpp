@@ -42,8 +42,8 @@ class Scheme {
          std::vector<std::unique_ptr<Constraint>> constraints, std::vector<std::unique_ptr<Task>> tasks,
          SchemeLevel level = SchemeLevel::kVelocity);
 
-  /// Reads `[[objectives]]`, `[[constraints]]` and `[[tasks]]` arrays of tables from `root`, and the `[scheme]` table's `level`.
-  /// When the robot file gives every joint an acceleration (jerk) limit and no constraint of type
+  /// Reads `[[objectives]]`, `[[constraints]]` and `[[tasks]]` arrays of tables from `root`, and the `[scheme]` table's
+  /// `level`. When the robot file gives every joint an acceleration (jerk) limit and no constraint of type
   /// `joint_acceleration_limits` (`joint_jerk_limits`) is listed, one is added with its defaults, so that the robot's
   /// limits hold in every run (list one with `active = false` to run without). Each plugin's source() is its
   /// table's file:line:col. With `duration` and `step` (> 0), each plugin's check_run(duration, step) runs too, and

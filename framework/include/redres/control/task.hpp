@@ -35,13 +35,13 @@ inline const std::vector<std::pair<TaskMode, const char*>>& enum_names(TaskMode)
 
 /// One step's rows of a task, sized at setup.
 struct TaskTerms {
-  Eigen::MatrixXd J;      //!< rows x n
-  Eigen::VectorXd d;      //!< target velocity of each row (equality, soft)
-  Eigen::VectorXd lo;     //!< lower velocity bound of each row (inequality; -inf where open)
-  Eigen::VectorXd hi;     //!< upper velocity bound of each row (inequality; +inf where open)
-  Eigen::VectorXd error;  //!< each row's error this step: reference - value (equality, soft), or how far the value
-                          //!< is outside its bounds (inequality; 0 inside)
-  double damping = 0.0;   //!< lambda^2 this step: the Levenberg-Marquardt term the task adds (soft tasks only)
+  Eigen::MatrixXd J;       //!< rows x n
+  Eigen::VectorXd d;       //!< target velocity of each row (equality, soft)
+  Eigen::VectorXd lo;      //!< lower velocity bound of each row (inequality; -inf where open)
+  Eigen::VectorXd hi;      //!< upper velocity bound of each row (inequality; +inf where open)
+  Eigen::VectorXd error;   //!< each row's error this step: reference - value (equality, soft), or how far the value
+                           //!< is outside its bounds (inequality; 0 inside)
+  double damping = 0.0;    //!< lambda^2 this step: the Levenberg-Marquardt term the task adds (soft tasks only)
   double sigma_min = 0.0;  //!< the smallest singular value of J this step (tasks with damping; else 0)
 };
 

@@ -29,19 +29,19 @@ namespace redres {
 
 /// The configuration of `frame`.
 struct FrameTaskConfig {
-  std::string frame = "end_effector";                 //!< a name of RobotModel::frames()
-  std::array<double, 3> point{0.0, 0.0, 0.0};         //!< the point in the frame (m)
-  std::vector<std::string> rows{};                    //!< subset of x, y, z, wx, wy, wz, axis (default: position)
-  std::optional<std::array<double, 3>> axis{};        //!< for "axis": the direction in the frame
-  std::optional<std::array<double, 3>> axis_target{}; //!< for "axis": the world direction (default: at the start)
-  std::string reference = "start";                    //!< "start", "fixed" or "path"
-  std::optional<std::array<double, 3>> position{};    //!< reference = "fixed": the world position (m)
-  std::optional<std::array<double, 3>> rpy{};         //!< reference = "fixed": roll, pitch, yaw (rad)
-  PerJoint gain = 1.0;                                //!< K (1/s): one number or one per row
-  std::optional<std::vector<double>> lower{};         //!< inequality: per row (m)
-  std::optional<std::vector<double>> upper{};         //!< inequality: per row (m)
-  double damping = 0.0;                               //!< lambda_max (soft mode); 0: none
-  double damping_threshold = 0.05;                    //!< sigma below which damping grows
+  std::string frame = "end_effector";                  //!< a name of RobotModel::frames()
+  std::array<double, 3> point{0.0, 0.0, 0.0};          //!< the point in the frame (m)
+  std::vector<std::string> rows{};                     //!< subset of x, y, z, wx, wy, wz, axis (default: position)
+  std::optional<std::array<double, 3>> axis{};         //!< for "axis": the direction in the frame
+  std::optional<std::array<double, 3>> axis_target{};  //!< for "axis": the world direction (default: at the start)
+  std::string reference = "start";                     //!< "start", "fixed" or "path"
+  std::optional<std::array<double, 3>> position{};     //!< reference = "fixed": the world position (m)
+  std::optional<std::array<double, 3>> rpy{};          //!< reference = "fixed": roll, pitch, yaw (rad)
+  PerJoint gain = 1.0;                                 //!< K (1/s): one number or one per row
+  std::optional<std::vector<double>> lower{};          //!< inequality: per row (m)
+  std::optional<std::vector<double>> upper{};          //!< inequality: per row (m)
+  double damping = 0.0;                                //!< lambda_max (soft mode); 0: none
+  double damping_threshold = 0.05;                     //!< sigma below which damping grows
 
   static const Schema<FrameTaskConfig>& schema();
 };

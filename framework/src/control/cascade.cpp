@@ -9,7 +9,6 @@
 namespace redres {
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 // A held row whose part outside the rows held before it is below this (relative to its norm) adds nothing.
 constexpr double kDependent = 1e-6;
 }  // namespace

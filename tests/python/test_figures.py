@@ -118,3 +118,27 @@ def test_png_size_refuses_a_file_that_is_no_png(tmp_path):
     bogus.write_bytes(b"GIF89a" + bytes(30))
     with pytest.raises(AssertionError):
         png_size(bogus)
+
+
+def test_the_task_figure_has_a_panel_per_task_and_refuses_runs_without_tasks(tmp_path):
+    # tools/plot_tasks.py over the two priority orders of the conflicting tasks (docs/tasks.md), at a coarse step.
+    runs = []
+    for order in ("tool_first", "elbow_first"):
+        out = tmp_path / order
+        p = redres("run", source(f"configs/panda_conflict_{order}.toml"), "--set", "step=0.05", "--out", str(out),
+                   "--quiet")
+        assert p.returncode == 0, p.stderr
+        runs.append(str(out))
+    tool = source("tools/plot_tasks.py")
+    png = tmp_path / "tasks.png"
+    p = subprocess.run([sys.executable, tool, str(png), *runs], capture_output=True, text=True, check=False)
+    assert p.returncode == 0, p.stderr
+    # Two panels (tool_error, elbow_error) of 8 x 2.4 in, 0.8 in for the legend, at 120 dpi.
+    assert png_size(png) == (round(8 * 120), round((2 * 2.4 + 0.8) * 120))
+    # A run without tasks has no task columns: a clear error, no file.
+    plain = tmp_path / "plain"
+    p = redres("run", source("configs/planar_4link_circle.toml"), "--set", "step=0.05", "--out", str(plain), "--quiet")
+    assert p.returncode == 0, p.stderr
+    none = tmp_path / "none.png"
+    p = subprocess.run([sys.executable, tool, str(none), str(plain)], capture_output=True, text=True, check=False)
+    assert p.returncode != 0 and "no task error columns" in p.stderr and not none.exists()

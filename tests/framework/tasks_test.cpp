@@ -302,7 +302,12 @@ RC_GTEST_PROP(Tasks, TheCascadeAgreesWithAnIndependentLexicographicSolve, ()) {
   }
   p.levels.push_back(
       {Eigen::MatrixXd::Identity(n, n), Eigen::VectorXd::Zero(n), Eigen::MatrixXd(0, n), Eigen::VectorXd(0)});
-  const testing::ReferenceSolution ref = testing::solve_lexicographic(p, Eigen::VectorXd::Zero(n));
+  testing::ReferenceSolution ref;
+  try {
+    ref = testing::solve_lexicographic(p, Eigen::VectorXd::Zero(n));
+  } catch (const std::runtime_error& e) {
+    RC_DISCARD(std::string("the reference could not solve it: ") + e.what());  // rare: SLSQP's iteration limit
+  }
   if (rig.out.levels[0].status == SolverStatus::kInfeasible) {
     // Level 0's tasks are hard: the step fails (for the failure policy) exactly where they cannot be met.
     RC_ASSERT(ref.residual[0] > 1e-12);
@@ -324,12 +329,12 @@ RC_GTEST_PROP(Tasks, TheCascadeAgreesWithAnIndependentLexicographicSolve, ()) {
     break;
   }
   RC_CLASSIFY(compared < p.levels.size(), "a lower level failed and kept the answer above it");
-  // Compared lexicographically: at the first level where the two differ (by more than 1e-6, relative), redres's
-  // value must be the lower one (below it, a better higher level may cost a lower one).
+  // Compared lexicographically: at the first level where the two differ (by more than 1e-7 relative, 1e-10 absolute),
+  // redres's value must be the lower one (below it, a better higher level may cost a lower one).
   bool same = true;
   for (std::size_t l = 0; l < compared && same; ++l) {
     const double mine = level_value(p.levels[l], x), theirs = ref.residual[l];
-    if (std::abs(mine - theirs) <= 1e-6 * (1.0 + theirs)) continue;
+    if (std::abs(mine - theirs) <= 1e-7 * theirs + 1e-10) continue;
     same = false;
     if (!(mine < theirs)) {
       std::ostringstream m;
@@ -348,8 +353,14 @@ RC_GTEST_PROP(Tasks, TheCascadeAgreesWithAnIndependentLexicographicSolve, ()) {
   RC_CLASSIFY(same, "the reference reaches the same optimum at every level");
   RC_CLASSIFY(!same, "SLSQP stops short at a level (redres's optimum is lower)");
   if (compared < p.levels.size()) return;
-  if (same && !((x - ref.x).norm() < 1e-5 * (1.0 + ref.x.norm()))) {
+  // Where every task level agrees, the answers agree: the last level, |x|^2, is strongly convex, so for its optimum x*
+  // and any point y of the same set |y - x*|^2 <= |y|^2 - |x*|^2. redres's x is the optimum when the reference's point
+  // lies that close to it, to 1e-5 in x (the engines' tolerance, 1e-9 on the scaled QPs, over the rows' conditioning).
+  const double mine_last = x.squaredNorm(), theirs_last = ref.x.squaredNorm();
+  const bool agree = (x - ref.x).squaredNorm() <= std::max(0.0, theirs_last - mine_last) + 1e-10;
+  if (same && !agree) {
     std::ostringstream m;
+    m.precision(12);
     m << "x " << x.transpose() << "\nreference " << ref.x.transpose() << "\n";
     for (const LevelInfo& level : rig.out.levels) {
       m << "priority " << level.priority << " " << to_string(level.status) << " " << level.diagnosis << "\n";

@@ -107,7 +107,10 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
     axis_target_ = a.normalized();
   }
   gain_ = config_.gain.resolve(rows(), "gain", "row");
-  if (config_.reference == "fixed") {
+  reference_ = config_.reference == "fixed"  ? Reference::kFixed
+               : config_.reference == "path" ? Reference::kPath
+                                             : Reference::kStart;
+  if (reference_ == Reference::kFixed) {
     if (has_position_rows() && !config_.position) {
       throw FieldError("position", "reference = \"fixed\" with position rows needs `position` (m, world)");
     }
@@ -123,7 +126,7 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
     position_.setZero();
     rotation_.setIdentity();
   }
-  if (config_.reference == "path" && robot.kind() == ChainKind::kPlanar) {
+  if (reference_ == Reference::kPath && robot.kind() == ChainKind::kPlanar) {
     for (Row k : kinds_) {
       if (k == Row::kZ) throw FieldError("rows", "a planar robot's path has no z row");
     }
@@ -218,10 +221,10 @@ void FrameTask::compute(const Context& ctx, TaskData& data) const {
   // The reference position and velocity, orientation and axis.
   Eigen::Vector3d p_d = position_, v_d = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_d = rotation_;
-  if (config_.reference == "start") {
+  if (reference_ == Reference::kStart) {
     p_d = own.p0;
     R_d = own.R0;
-  } else if (config_.reference == "path") {
+  } else if (reference_ == Reference::kPath) {
     REDRES_REQUIRE(ctx.r_d != nullptr && ctx.r_d_dot != nullptr, "frame task",
                    "the context carries the path's r_d and r_d_dot (reference = \"path\")");
     const int rows_p = robot.position_rows();

@@ -179,24 +179,6 @@ void Cascade::reset() {
   }
 }
 
-namespace {
-// W(0:n, 0:n) += w J'J, zeta(0:n) -= w J'd.
-void add_least_squares(QpProblem& qp, const Eigen::MatrixXd& J, const Eigen::VectorXd& d, double w) {
-  const Eigen::Index n = J.cols(), k = J.rows();
-  for (Eigen::Index c = 0; c < n; ++c) {
-    for (Eigen::Index r = 0; r < n; ++r) {
-      double g = 0.0;
-      for (Eigen::Index i = 0; i < k; ++i) g += J(i, r) * J(i, c);
-      qp.W(r, c) += w * g;
-    }
-    double z = 0.0;
-    for (Eigen::Index i = 0; i < k; ++i) z += J(i, c) * d(i);
-    qp.zeta(c) -= w * z;
-  }
-  qp.w_diagonal = false;
-}
-}  // namespace
-
 void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_squares) {
   const Level& L = *levels_[static_cast<std::size_t>(l)];
   const int n = n_;
@@ -224,7 +206,7 @@ void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_
     switch (t.mode()) {
       case TaskMode::kEquality:
         if (least_squares) {
-          add_least_squares(qp, terms.J, terms.d, t.weight());
+          QpBuilder(qp).add_least_squares(terms.J, terms.d, t.weight());
         } else {
           qp.J.block(eq, 0, rows, n) = terms.J;
           qp.d.segment(eq, rows) = terms.d;
@@ -232,7 +214,7 @@ void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_
         }
         break;
       case TaskMode::kSoft:
-        add_least_squares(qp, terms.J, terms.d, t.weight());
+        QpBuilder(qp).add_least_squares(terms.J, terms.d, t.weight());
         for (int i = 0; i < n; ++i) qp.W(i, i) += t.weight() * terms.damping;
         break;
       case TaskMode::kInequality:

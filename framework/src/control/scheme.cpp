@@ -21,26 +21,21 @@ Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> 
       tasks_(std::move(tasks)),
       scheme_level_(level) {
   std::set<std::string> names;
-  const auto check_level = [level](const Plugin& p, const char* kind) {
-    if (!p.active() || p.supports(level)) return;
-    throw std::invalid_argument(std::string(kind) + " '" + p.name() + "' (type " + p.type() +
+  // Every plugin: present, uniquely named, working at the scheme's level; the scheme reads the deepest kinematics.
+  const auto admit = [&](const Plugin* p, const char* kind) {
+    REDRES_REQUIRE(p != nullptr, "Scheme", std::string("every ") + kind + " is non-null");
+    REDRES_REQUIRE(names.insert(p->name()).second, "Scheme",
+                   "plugin names are unique (two are named '" + p->name() + "'; rename one with set_name())");
+    level_ = std::max(level_, p->kinematics_level());
+    if (!p->active() || p->supports(level)) return;
+    throw std::invalid_argument(std::string(kind) + " '" + p->name() + "' (type " + p->type() +
                                 ") does not work at the " +
                                 (level == SchemeLevel::kAcceleration ? "acceleration" : "velocity") +
                                 " level ([scheme] level); docs/motion.md lists the plugins that do");
   };
-  for (const auto& o : objectives_) {
-    REDRES_REQUIRE(o != nullptr, "Scheme", "every objective is non-null");
-    REDRES_REQUIRE(names.insert(o->name()).second, "Scheme",
-                   "plugin names are unique (two are named '" + o->name() + "'; rename one with set_name())");
-    level_ = std::max(level_, o->kinematics_level());
-    check_level(*o, "objective");
-  }
+  for (const auto& o : objectives_) admit(o.get(), "objective");
   for (const auto& c : constraints_) {
-    REDRES_REQUIRE(c != nullptr, "Scheme", "every constraint is non-null");
-    REDRES_REQUIRE(names.insert(c->name()).second, "Scheme",
-                   "plugin names are unique (two are named '" + c->name() + "'; rename one with set_name())");
-    level_ = std::max(level_, c->kinematics_level());
-    check_level(*c, "constraint");
+    admit(c.get(), "constraint");
     const int e = c->equality_rows(robot);
     const int i = c->inequality_rows(robot);
     REDRES_REQUIRE(e >= 0 && i >= 0, "Scheme", "constraint '" + c->name() + "' declares non-negative row counts");
@@ -54,11 +49,7 @@ Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> 
   m_eq_c_ = m_eq_;
   m_in_c_ = m_in_;
   for (const auto& t : tasks_) {
-    REDRES_REQUIRE(t != nullptr, "Scheme", "every task is non-null");
-    REDRES_REQUIRE(names.insert(t->name()).second, "Scheme",
-                   "plugin names are unique (two are named '" + t->name() + "'; rename one with set_name())");
-    level_ = std::max(level_, t->kinematics_level());
-    check_level(*t, "task");
+    admit(t.get(), "task");
     task_active_.push_back(t->active());
   }
   // The levels: the active objectives' and tasks' priorities, highest (0) first.

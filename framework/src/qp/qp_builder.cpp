@@ -26,8 +26,9 @@ void QpBuilder::add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H) {
 
 void QpBuilder::add_least_squares(const Eigen::Ref<const Eigen::MatrixXd>& J,
                                   const Eigen::Ref<const Eigen::VectorXd>& d, double w) {
-  const Eigen::Index n = qp_->n(), k = J.rows();
-  REDRES_REQUIRE(J.cols() == n && d.size() == k, "QpBuilder::add_least_squares", "J is k x n and d has k entries");
+  const Eigen::Index n = J.cols(), k = J.rows();
+  REDRES_REQUIRE(n <= qp_->n() && d.size() == k, "QpBuilder::add_least_squares",
+                 "J has at most n columns and d has one entry per row of J");
   const double s = weight_ * w;
   Eigen::MatrixXd& W = qp_->W;
   for (Eigen::Index c = 0; c < n; ++c) {

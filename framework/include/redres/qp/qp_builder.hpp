@@ -30,7 +30,8 @@ class QpBuilder {
   void add_diagonal(const Eigen::Ref<const Eigen::VectorXd>& diagonal);
   /// W += weight * H (H symmetric); marks W as non-diagonal when H has off-diagonal entries.
   void add_hessian(const Eigen::Ref<const Eigen::MatrixXd>& H);
-  /// A least squares (w / 2) |J x - d|^2 (J: k x n): W += weight * w * J'J, zeta -= weight * w * J'd. Allocation-free.
+  /// A least squares (w / 2) |J x - d|^2 (J: k x m, on the first m <= n variables): W += weight * w * J'J,
+  /// zeta -= weight * w * J'd. Allocation-free.
   void add_least_squares(const Eigen::Ref<const Eigen::MatrixXd>& J, const Eigen::Ref<const Eigen::VectorXd>& d,
                          double w);
   /// zeta += weight * z.

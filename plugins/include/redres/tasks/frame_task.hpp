@@ -74,7 +74,9 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
   [[nodiscard]] bool has_position_rows() const;
   [[nodiscard]] bool has_orientation_rows() const;
 
+  enum class Reference { kStart, kFixed, kPath };
   int frame_ = -1;
+  Reference reference_ = Reference::kStart;  // config_.reference, read once
   std::vector<Row> kinds_;
   Eigen::VectorXd gain_;
   Eigen::Vector3d point_, axis_;

@@ -6,7 +6,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
-bash scripts/build.sh release
+# Only what the comparison runs: the CLI and the library (the tests, benchmarks, examples and the Python module are
+# scripts/test.sh's).
+bash scripts/build.sh release redres_cli
 # The figures run plot_run.py with the python3 found on PATH; put Debian's, which has the matplotlib and numpy that
 # install_deps.sh installed, first (another python3, e.g. a pyenv shim, may come first and lack them).
 export PATH="/usr/bin:$PATH"

@@ -15,6 +15,8 @@ stage() {  # stage NAME COMMAND...: runs the command and records its wall time
   echo "==> [$name] took $((SECONDS - start)) s"
 }
 stage install bash scripts/install_deps.sh
+# Every warning of redres's own code is an error here, so that the release and sanitizer builds stay free of them.
+export REDRES_WERROR=ON
 for preset in release debug-asan; do
   stage "$preset build" bash scripts/build.sh "$preset"
   stage "$preset test" ctest --preset "$preset" -j "$jobs"

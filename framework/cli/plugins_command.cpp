@@ -1,4 +1,4 @@
-// `redres plugins`: every registered objective, constraint, velocity-limit law, path and LVI engine, with its keys:
+// `redres plugins`: every registered plugin of every kind (extend/plugin_kinds.hpp), with its keys:
 // type, unit, default or whether it is required (or one of a group), validity rule and meaning. The listing comes
 // from each plugin's Config schema, so it cannot drift from what the TOML reader accepts.
 
@@ -8,13 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "redres/control/engine_registry.hpp"
-#include "redres/control/path.hpp"
-#include "redres/control/plugin.hpp"
-#include "redres/control/task.hpp"
-#include "redres/model/velocity_limit.hpp"
-#include "redres/parsers/velocity_limit_registry.hpp"
-#include "redres/qp/lvi.hpp"
+#include "redres/extend/plugin_kinds.hpp"
 #include "redres/run/file_keys.hpp"
 #include "redres/run/scenario.hpp"
 
@@ -39,19 +33,21 @@ void print_keys(const std::vector<KeyInfo>& keys) {
   }
 }
 
-template <class R>
-void print_registry(const R& registry, const std::string& title, const std::vector<KeyInfo>& common,
-                    const std::string& common_title) {
-  std::cout << title << "\n";
+void print_kind(const PluginKind& kind) {
+  std::cout << kind.heading << "\n";
+  std::vector<KeyInfo> common = kind.common_keys();
+  if (kind.extra_keys) {
+    for (const KeyInfo& k : kind.extra_keys()) common.push_back(k);
+  }
   if (!common.empty()) {
-    std::cout << "  " << common_title << "\n";
+    std::cout << "  " << kind.common_heading << "\n";
     print_keys(common);
   }
-  for (const auto* e : registry.entries()) {
-    std::cout << "  " << e->type << (e->origin == "built-in" ? "" : "   (from " + e->origin + ")") << "\n      "
-              << e->summary << "\n";
-    print_keys(e->keys);
-    for (const auto& [group, rule] : e->groups) std::cout << "      group " << group << ": " << rule << "\n";
+  for (const PluginEntryInfo& e : kind.entries()) {
+    std::cout << "  " << e.type << (e.origin == "built-in" ? "" : "   (from " + e.origin + ")") << "\n      "
+              << e.summary << "\n";
+    print_keys(e.keys);
+    for (const auto& [group, rule] : e.groups) std::cout << "      group " << group << ": " << rule << "\n";
   }
   std::cout << "\n";
 }
@@ -71,16 +67,15 @@ nlohmann::json keys_json(const std::vector<KeyInfo>& keys) {
   return out;
 }
 
-template <class R>
-nlohmann::json registry_json(const R& registry) {
+nlohmann::json entries_json(const PluginKind& kind) {
   nlohmann::json out = nlohmann::json::array();
-  for (const auto* e : registry.entries()) {
+  for (const PluginEntryInfo& e : kind.entries()) {
     nlohmann::json groups = nlohmann::json::object();
-    for (const auto& [group, rule] : e->groups) groups[group] = rule;
-    out.push_back({{"type", e->type},
-                   {"summary", e->summary},
-                   {"origin", e->origin},
-                   {"keys", keys_json(e->keys)},
+    for (const auto& [group, rule] : e.groups) groups[group] = rule;
+    out.push_back({{"type", e.type},
+                   {"summary", e.summary},
+                   {"origin", e.origin},
+                   {"keys", keys_json(e.keys)},
                    {"groups", groups}});
   }
   return out;
@@ -112,34 +107,16 @@ int print_file_keys(const std::string& file, bool json) {
 
 void print_plugins(bool json) {
   if (json) {
-    const nlohmann::json out = {{"objectives", registry_json(objective_registry())},
-                                {"objective_common_keys", keys_json(objective_common_keys())},
-                                {"constraints", registry_json(constraint_registry())},
-                                {"constraint_common_keys", keys_json(constraint_common_keys())},
-                                {"tasks", registry_json(task_registry())},
-                                {"task_common_keys", keys_json(task_common_keys())},
-                                {"velocity_limits", registry_json(velocity_limit_registry())},
-                                {"paths", registry_json(path_registry())},
-                                {"path_common_keys", keys_json(describe_keys(PathPlacement::schema()))},
-                                {"engines", registry_json(engine_registry())},
-                                {"solver_common_keys", keys_json(solver_common_keys())},
-                                {"solver_policy_keys", keys_json(solver_policy_keys())}};
+    nlohmann::json out = nlohmann::json::object();
+    for (const PluginKind& kind : plugin_kinds()) {
+      out[kind.plural] = entries_json(kind);
+      if (!kind.common_json.empty()) out[kind.common_json] = keys_json(kind.common_keys());
+      if (!kind.extra_json.empty()) out[kind.extra_json] = keys_json(kind.extra_keys());
+    }
     std::cout << out.dump(2) << "\n";
     return;
   }
-  print_registry(objective_registry(), "objectives ([[objectives]] tables in a scenario)", objective_common_keys(),
-                 "keys of every objective:");
-  print_registry(constraint_registry(), "constraints ([[constraints]] tables in a scenario; hard, no weight)",
-                 constraint_common_keys(), "keys of every constraint:");
-  print_registry(task_registry(), "tasks ([[tasks]] tables in a scenario; docs/tasks.md)", task_common_keys(),
-                 "keys of every task:");
-  print_registry(velocity_limit_registry(), "velocity-limit laws ([joints.velocity_limit] in a robot file)", {}, "");
-  print_registry(path_registry(), "paths (the [path] table of a scenario)", describe_keys(PathPlacement::schema()),
-                 "keys of every path (placement and timing):");
-  std::vector<KeyInfo> solver_keys = solver_common_keys();
-  for (const KeyInfo& k : solver_policy_keys()) solver_keys.push_back(k);
-  print_registry(engine_registry(), "LVI engines (the [solver] table of a scenario)", solver_keys,
-                 "keys of every engine, and the run's policy for a step that is not solved:");
+  for (const PluginKind& kind : plugin_kinds()) print_kind(kind);
 }
 
 }  // namespace redres::cli

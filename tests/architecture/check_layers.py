@@ -31,7 +31,10 @@ ALLOWED = {
     "extend": {"common", "config", "model", "parsers", "qp", "control", "run", "plant"},
     "plant": {"common", "config", "model"},
 }
-PLUGIN_DIRS = {"objectives", "constraints", "engines", "paths", "velocity_limits"}
+# The plugin kinds (their directories plugins/<plural>/ and plugins/include/redres/<plural>/) come from the one table
+# of kinds, framework/src/extend/plugin_kinds.cpp: each kind is a line `kind("name", "plural", ...)` there.
+KINDS_TABLE = "framework/src/extend/plugin_kinds.cpp"
+KIND = re.compile(r'\bkind\(\s*"([^"]+)",\s*"([A-Za-z0-9_]+)"')
 
 # Known breaks: (file, include) -> the reason and the change that removes it. A listed break that no longer occurs
 # is reported, so that the list never outlives its reason.
@@ -52,8 +55,22 @@ def includes(path):
         return INCLUDE.findall(f.read())
 
 
+def plugin_dirs(root, problems):
+    """The plural of every plugin kind in the table of kinds."""
+    path = os.path.join(root, KINDS_TABLE)
+    if not os.path.isfile(path):
+        problems.append(f"{KINDS_TABLE}: missing (the table of plugin kinds)")
+        return set()
+    with open(path, encoding="utf-8") as f:
+        kinds = {plural for _, plural in KIND.findall(f.read())}
+    if not kinds:
+        problems.append(f"{KINDS_TABLE}: no kind(\"name\", \"plural\", ...) line found")
+    return kinds
+
+
 def check(root):
     problems = []
+    PLUGIN_DIRS = plugin_dirs(root, problems)
     used_exceptions = set()
     inc_root = os.path.join(root, "framework", "include", "redres")
     src_root = os.path.join(root, "framework", "src")
@@ -123,6 +140,14 @@ def check(root):
             problems.append(f"{path}: listed exception for {name} no longer needed: remove it from EXCEPTIONS")
     if not os.path.isdir(plugin_inc):
         problems.append("plugins/include: missing")
+    # Every directory of plugins is a kind of the table, so that the rules above cover it.
+    for top in ("plugins", "plugins/include/redres"):
+        full = os.path.join(root, top)
+        if not os.path.isdir(full):
+            continue
+        for d in sorted(os.listdir(full)):
+            if os.path.isdir(os.path.join(full, d)) and d != "include" and d not in PLUGIN_DIRS:
+                problems.append(f"{top}/{d}: not a plugin kind of {KINDS_TABLE} (kinds: {', '.join(sorted(PLUGIN_DIRS))})")
     return problems
 
 
@@ -135,6 +160,9 @@ def write(root, path, text):
 
 def self_test():
     clean_tree = {
+        KINDS_TABLE: 'k.push_back(kind("path", "paths", "the [path] table"));\n'
+                     'k.push_back(kind("task", "tasks", "[[tasks]]"));\n'
+                     'k.push_back(kind("engine", "engines", "[solver]"));\n',
         "framework/include/redres/common/error.hpp": "#pragma once\n",
         "framework/include/redres/model/robot.hpp": '#include "redres/common/error.hpp"\n',
         "framework/src/common/text.hpp": "#pragma once\n",
@@ -149,6 +177,8 @@ def self_test():
         "framework/include/redres/flat.hpp": "#pragma once\n",
         "plugins/paths/line.cpp": '#include "common/text.hpp"\n',
         "framework/cli/run.cpp": '#include "redres/engines/newton.hpp"\n',
+        "framework/python/src/module.cpp": '#include "redres/tasks/frame_task.hpp"\n',
+        "plugins/widgets/knob.cpp": '#include "redres/model/robot.hpp"\n',
     }
     with tempfile.TemporaryDirectory() as root:
         for path, text in clean_tree.items():
@@ -167,11 +197,16 @@ def self_test():
             "framework/include/redres/flat.hpp: a header outside every area",
             "a plugin includes the private framework header common/text.hpp",
             "framework/cli/run.cpp: includes the plugin header redres/engines/newton.hpp",
+            "framework/python/src/module.cpp: includes the plugin header redres/tasks/frame_task.hpp",
+            "plugins/widgets: not a plugin kind of framework/src/extend/plugin_kinds.cpp",
         ]
         for w in wanted:
             assert any(w in p for p in found), f"not reported: {w}\nreported: {found}"
         assert len(found) == len(wanted), found
-    print("check_layers self-test: 8 planted violations reported, the clean tree passes")
+        # Without the table of kinds, no plugin directory is known: that is reported, not passed.
+        os.remove(os.path.join(root, KINDS_TABLE))
+        assert any("the table of plugin kinds" in p for p in check(root)), check(root)
+    print(f"check_layers self-test: {len(wanted)} planted violations reported, the clean tree passes")
 
 
 def main(argv):

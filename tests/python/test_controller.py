@@ -144,6 +144,15 @@ def test_a_measured_velocity_steps_within_the_pandas_acceleration_limits():
     with pytest.raises(ValueError, match="velocity jump"):
         ctrl.set_failure_policy("hold")
     ctrl.set_failure_policy("brake", recover_error=0.002)
+    assert ctrl.failure_policy == "brake"
+    # The names are the scenario file's [solver] on_infeasible names, read by the same table.
+    ctrl.set_failure_policy("relax", relax_weight=1e3)
+    assert ctrl.failure_policy == "relax"
+    ctrl.set_failure_policy("stop")
+    assert ctrl.failure_policy == "stop"
+    with pytest.raises(ValueError, match="one of 'hold', 'stop', 'relax', 'continue', 'brake', got 'halt'"):
+        ctrl.set_failure_policy("halt")
+    assert ctrl.failure_policy == "stop"  # a refused name changes nothing
 
 
 def test_a_scheme_with_priority_levels_reports_each_level_and_keeps_the_hand_on_its_path():

@@ -1,5 +1,5 @@
 // A plugin library for the loader tests: loaded at run time with dlopen, it registers one objective and one
-// constraint exactly as a user's library would (tests/framework/plugin_loader_test.cpp, tests/cli/).
+// constraint exactly as a user's library would (tests/cli/plugin_loader_test.cpp).
 
 #include <redres/control/plugin.hpp>
 

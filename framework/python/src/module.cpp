@@ -696,18 +696,26 @@ PYBIND11_MODULE(_redres, m) {
           "set_failure_policy",
           [](py::handle p, const std::string& policy, double relax_weight, double recover_error) {
             PyController& c = live(p);
-            const FailurePolicy f = policy == "hold"    ? FailurePolicy::kHold
-                                    : policy == "relax" ? FailurePolicy::kRelax
-                                    : policy == "brake" ? FailurePolicy::kBrake
-                                                        : throw std::invalid_argument(
-                                                              "Controller.set_failure_policy: expected "
-                                                              "'hold', 'relax' or 'brake', got '" +
-                                                              policy + "'");
+            FailurePolicy f{};
+            try {
+              f = failure_policy_from_name(policy);
+            } catch (const std::invalid_argument& e) {
+              throw std::invalid_argument(std::string("Controller.set_failure_policy: ") + e.what());
+            }
             in_turn(c, "Controller.set_failure_policy",
                     [&](Controller& k) { k.set_failure_policy(f, relax_weight, recover_error); });
           },
           py::arg("policy"), py::arg("relax_weight") = 1e4, py::arg("recover_error") = 1e-3,
-          "What a failed step does: 'hold', 'relax' or 'brake' (docs/motion.md).")
+          "What a failed step does: 'hold', 'stop' (gives up as 'hold' does; the caller's loop ends), 'relax' or "
+          "'brake', the names of a scenario's [solver] on_infeasible (docs/motion.md).")
+      .def_property_readonly(
+          "failure_policy",
+          [](py::handle p) {
+            PyController& c = live(p);
+            return in_turn(c, "Controller.failure_policy",
+                           [](Controller& k) { return std::string(failure_policy_name(k.failure_policy())); });
+          },
+          "the failure policy's name: 'hold', 'stop', 'relax' or 'brake'")
       .def_property_readonly(
           "theta_ddot",
           [](py::handle p) {

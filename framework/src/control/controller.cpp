@@ -32,7 +32,9 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
       measured_(Eigen::VectorXd::Zero(robot.dof())),
       v_(Eigen::VectorXd::Zero(robot.dof())),
       lim_lo_(Eigen::VectorXd::Zero(robot.dof())),
-      lim_hi_(Eigen::VectorXd::Zero(robot.dof())) {
+      lim_hi_(Eigen::VectorXd::Zero(robot.dof())),
+      jerk_lo_(Eigen::VectorXd::Zero(robot.dof())),
+      jerk_hi_(Eigen::VectorXd::Zero(robot.dof())) {
   REDRES_REQUIRE(&scheme.robot() == &robot, "Controller", "the scheme was built for this robot");
   REDRES_REQUIRE(T > 0.0 && tau > 0.0, "Controller", "T > 0 and tau > 0");
   if (path != nullptr) {
@@ -333,37 +335,29 @@ void Controller::set_failure_policy(FailurePolicy policy, double relax_weight, d
         "' has none (give `acceleration_limit` in the robot file)");
   }
   policy_ = policy;
-  relax_weight_ = policy == FailurePolicy::kHold ? 0.0 : relax_weight;
+  const bool elastic = policy == FailurePolicy::kRelax || policy == FailurePolicy::kBrake;
+  relax_weight_ = elastic ? relax_weight : 0.0;
   recover_error_ = recover_error;
-  if (policy == FailurePolicy::kHold) {
-    relax_engine_.reset();
+  if (!elastic) {
+    fallback_.release();
     return;
   }
   note_.reserve(kDiagnosisCapacity);
-  if (!relax_engine_) {
-    relax_engine_ = make_engine(std::string(engine_->name()), engine_->settings());
-    relaxed_.setup(qp_);
-    relax_engine_->setup(qp_.n(), 0, qp_.m_in(), relaxed_result_);
-    row_miss_.resize(qp_.m_eq());
-  }
+  if (!fallback_.ready()) fallback_.setup(qp_, *engine_);
 }
 
 bool Controller::relax(StepOutput& out) {
   // The elastic QP (qp/elastic.hpp): the rows become a penalty of weight rho; bounds and inequality rows stay.
   const double rho = relax_weight_;
-  relaxed_.build(qp_, rho);
-  relax_engine_->solve_valid(relaxed_.problem(), relaxed_result_);
-  const SolverInfo& r = relaxed_result_.info;
+  const SolverResult& relaxed = fallback_.solve(qp_, rho);
+  const SolverInfo& r = relaxed.info;
   if (r.status != SolverStatus::kSolved) {
     TextSink(out.info.diagnosis).precision(6) << "; the elastic QP (rows relaxed with weight " << rho
                                               << ") failed too: " << to_string(r.status) << ": " << r.diagnosis;
     return false;
   }
-  const Eigen::VectorXd& x = relaxed_result_.x;
-  row_miss_.noalias() = qp_.J * x;  // sized at set_failure_policy(): no temporary
-  row_miss_ -= qp_.d;
-  out.task_row_error = qp_.m_eq() > 0 ? row_miss_.cwiseAbs().maxCoeff() : 0.0;
-  apply(x, out);
+  out.task_row_error = fallback_.row_miss();
+  apply(relaxed.x, out);
   // The failed solve's text goes after the relaxation's: kept aside in note_ (both reserved, so no allocation).
   note_.assign(out.info.diagnosis);  // note_ is reserved: a copy, so each string keeps its own storage
   keep_diagnosis_capacity(out.info.diagnosis);
@@ -377,58 +371,28 @@ bool Controller::relax(StepOutput& out) {
 }
 
 void Controller::brake(StepOutput& out) {
-  // theta_dot = s b (b the velocity before the step, s >= 0: along the previous direction): the smallest s that keeps
-  // every joint's acceleration limits, velocity limits and, where all can hold, its jerk limits from the previous
-  // acceleration. s = 1 keeps the velocity and always meets the acceleration limits; s > 1 is taken only when the
-  // jerk limits ask for it (an arm accelerating cannot turn to braking at once).
-  const double tau = ctx_.tau;
+  // The braking law (control/brake.hpp): theta_dot = s b, b the velocity before the step.
   const Eigen::VectorXd& b = base();
   robot_->acceleration_limits(kin_.theta, lim_lo_, lim_hi_);
-  double s_lo = 0.0, s_hi = std::numeric_limits<double>::infinity();
-  int decides = -1;  // the joint whose limit sets s
-  // s in [lo, hi] for every joint with b_j != 0, from a bound lo_j <= (s - 1) b_j / tau + shift <= hi_j.
-  const auto within = [&](int j, double lo, double hi, double& s_min, double& s_max) {
-    double s1 = 1.0 + tau * lo / b(j), s2 = 1.0 + tau * hi / b(j);
-    if (s1 > s2) std::swap(s1, s2);
-    s_min = std::max(s_min, s1);
-    s_max = std::min(s_max, s2);
-  };
-  // A joint whose limits are not finite here (a law outside its range) or whose velocity is not finite sets nothing.
-  const auto usable_joint = [&](int j) {
-    return b(j) != 0.0 && std::isfinite(b(j)) && std::isfinite(lim_lo_(j)) && std::isfinite(lim_hi_(j));
-  };
-  for (int j = 0; j < robot_->dof(); ++j) {
-    if (!usable_joint(j)) continue;
-    const double before = s_lo;
-    within(j, lim_lo_(j), lim_hi_(j), s_lo, s_hi);
-    if (s_lo > before) decides = j;
-    // The velocity limits: s b_j within [vlo_j, vhi_j] (evaluated at this step's theta), where b_j itself is.
-    if (b(j) > 0.0 && b(j) <= vhi_(j)) s_hi = std::min(s_hi, vhi_(j) / b(j));
-    if (b(j) < 0.0 && b(j) >= vlo_(j)) s_hi = std::min(s_hi, vlo_(j) / b(j));
-  }
-  s_hi = std::max(s_hi, s_lo);
-  double s = s_lo;
-  bool jerk_yields = false;
+  BrakeInput in;
+  in.velocity = &b;
+  in.acceleration_lower = &lim_lo_;
+  in.acceleration_upper = &lim_hi_;
+  in.velocity_lower = &vlo_;
+  in.velocity_upper = &vhi_;
   if (robot_->has_jerk_limits()) {
-    robot_->jerk_limits(kin_.theta, lim_lo_, lim_hi_);
-    double lo = s_lo, hi = s_hi;
-    int jerk_decides = decides;
-    for (int j = 0; j < robot_->dof(); ++j) {
-      if (!usable_joint(j)) continue;
-      // The acceleration (s - 1) b_j / tau within a_prev + tau [j^-, j^+].
-      const double a_prev = (prev_(j) - prev2_(j)) / tau;
-      const double before = lo;
-      within(j, a_prev + tau * lim_lo_(j), a_prev + tau * lim_hi_(j), lo, hi);
-      if (lo > before) jerk_decides = j;
-    }
-    jerk_yields = lo > hi;
-    if (!jerk_yields) {
-      s = lo;
-      decides = jerk_decides;
-    } else {
-      s = std::clamp(lo, s_lo, s_hi);  // as near the jerk limits as the acceleration and velocity limits allow
-    }
+    robot_->jerk_limits(kin_.theta, jerk_lo_, jerk_hi_);
+    in.jerk_lower = &jerk_lo_;
+    in.jerk_upper = &jerk_hi_;
   }
+  in.previous = &prev_;
+  in.previous2 = &prev2_;
+  in.tau = ctx_.tau;
+  const BrakeScale scale = braking_scale(in);
+  const double s = scale.scale;
+  const int decides = scale.deciding_joint;
+  const bool jerk_yields = scale.jerk_yields;
+  const double tau = ctx_.tau;
   out.theta_dot = s * b;
   for (int j = 0; j < robot_->dof(); ++j) {
     if (!std::isfinite(out.theta_dot(j))) out.theta_dot(j) = 0.0;  // never a non-finite command

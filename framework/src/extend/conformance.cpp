@@ -4,11 +4,13 @@
 #include <set>
 #include <sstream>
 
+#include "extend/kind_checks.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/plugin.hpp"
 #include "redres/control/scheme.hpp"
 #include "redres/control/task.hpp"
+#include "redres/extend/plugin_kinds.hpp"
 #include "redres/model/robot.hpp"
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
@@ -320,27 +322,39 @@ bool wanted(const std::string& entry_origin, const std::string& origin) {
   return origin.empty() || entry_origin == origin;
 }
 
+const std::vector<RobotModel>& robots() {
+  static const std::vector<RobotModel> r = test_robots();
+  return r;
+}
+
 }  // namespace
 
-std::vector<ConformanceResult> check_registries() { return check_registries(""); }
+namespace kind_checks {
 
-std::vector<ConformanceResult> check_registries(const std::string& origin) {
-  std::vector<ConformanceResult> out;
-  const std::vector<RobotModel> robots = test_robots();
+void objectives(const std::string& origin, std::vector<ConformanceResult>& out) {
   for (const auto* e : objective_registry().entries()) {
     if (!wanted(e->origin, origin)) continue;
-    check_scheme_plugin<Objective>(*e, robots, objective_common_keys(), make_objective,
+    check_scheme_plugin<Objective>(*e, robots(), objective_common_keys(), make_objective,
                                    Recorder{out, "objective", e->type});
   }
+}
+
+void constraints(const std::string& origin, std::vector<ConformanceResult>& out) {
   for (const auto* e : constraint_registry().entries()) {
     if (!wanted(e->origin, origin)) continue;
-    check_scheme_plugin<Constraint>(*e, robots, constraint_common_keys(), make_constraint,
+    check_scheme_plugin<Constraint>(*e, robots(), constraint_common_keys(), make_constraint,
                                     Recorder{out, "constraint", e->type});
   }
+}
+
+void tasks(const std::string& origin, std::vector<ConformanceResult>& out) {
   for (const auto* e : task_registry().entries()) {
     if (!wanted(e->origin, origin)) continue;
-    check_scheme_plugin<Task>(*e, robots, task_common_keys(), make_task, Recorder{out, "task", e->type});
+    check_scheme_plugin<Task>(*e, robots(), task_common_keys(), make_task, Recorder{out, "task", e->type});
   }
+}
+
+void velocity_limits(const std::string& origin, std::vector<ConformanceResult>& out) {
   for (const auto* e : velocity_limit_registry().entries()) {
     if (!wanted(e->origin, origin)) continue;
     const Recorder rec{out, "velocity-limit law", e->type};
@@ -356,12 +370,27 @@ std::vector<ConformanceResult> check_registries(const std::string& origin) {
       // Only laws whose defaults build can be round-tripped here (reported under "defaults").
     }
   }
+}
+
+void paths(const std::string& origin, std::vector<ConformanceResult>& out) {
   for (const auto* e : path_registry().entries()) {
     if (wanted(e->origin, origin)) check_path(*e, Recorder{out, "path", e->type});
   }
+}
+
+void engines(const std::string& origin, std::vector<ConformanceResult>& out) {
   for (const auto* e : engine_registry().entries()) {
     if (wanted(e->origin, origin)) check_engine(*e, Recorder{out, "engine", e->type});
   }
+}
+
+}  // namespace kind_checks
+
+std::vector<ConformanceResult> check_registries() { return check_registries(""); }
+
+std::vector<ConformanceResult> check_registries(const std::string& origin) {
+  std::vector<ConformanceResult> out;
+  for (const PluginKind& kind : plugin_kinds()) kind.check(origin, out);
   return out;
 }
 

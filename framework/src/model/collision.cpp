@@ -729,7 +729,7 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
   }
   // The libccd solver (unsigned queries only: signed ones are never made, see collision.hpp).
   // GJK to 1e-12: at libccd's 1e-8 a cylinder's distance came out up to 1.9e-6 m too large; at 1e-12 every pair matches
-  // an independent computation (alternating projections, tests/framework/collision_test.cpp) to 1e-9 m.
+  // an independent computation (alternating projections, tests/framework/model/collision_test.cpp) to 1e-9 m.
   impl_->unsigned_request = fcl::DistanceRequestd(true, false, 0.0, 0.0, 1e-12, fcl::GST_LIBCCD);
 }
 

@@ -307,10 +307,10 @@ Result distance(const Core& a, const Core& b) {
   ccd.epa_tolerance = 1e-4;  // unused: EPA is never run
   ccd.mpr_tolerance = 1e-9;
   ccd.dist_tolerance = 1e-12;
-  ccd_real_t depth = 0.0;
+  ccd_real_t mpr_depth = 0.0;
   ccd_vec3_t dir{}, pos{};
   Eigen::Vector3d n = Eigen::Vector3d::Zero();
-  if (ccdMPRPenetration(&a, &b, &ccd, &depth, &dir, &pos) == 0) n = Eigen::Vector3d(dir.v[0], dir.v[1], dir.v[2]);
+  if (ccdMPRPenetration(&a, &b, &ccd, &mpr_depth, &dir, &pos) == 0) n = Eigen::Vector3d(dir.v[0], dir.v[1], dir.v[2]);
   if (!(n.allFinite() && n.norm() > 0.5)) {
     // MPR found no overlap (the cores touch) or no direction: the centres' direction.
     n = world_centre(b) - world_centre(a);

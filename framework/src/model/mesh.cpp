@@ -86,7 +86,8 @@ void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent
     piece.reserve(piece.size() + mesh.mNumVertices);
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
       const aiVector3D p = at * mesh.mVertices[v];
-      const Eigen::Vector3d q(scale.x() * p.x, scale.y() * p.y, scale.z() * p.z);
+      const Eigen::Vector3d q(scale.x() * static_cast<double>(p.x), scale.y() * static_cast<double>(p.y),
+                              scale.z() * static_cast<double>(p.z));
       if (!q.allFinite()) throw std::runtime_error("mesh '" + out.file.string() + "': a vertex is not finite");
       piece.push_back(q);
     }

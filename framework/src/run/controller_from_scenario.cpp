@@ -10,13 +10,7 @@ std::unique_ptr<Controller> Controller::from_scenario(Scenario& s) {
   auto ctrl = std::make_unique<Controller>(*s.robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
   ctrl->set_orientation_turn(s.orientation_turn);
   ctrl->set_kinematics_level(KinematicsLevel::kGradient);
-  if (s.on_infeasible == OnInfeasible::kRelax) {
-    ctrl->set_failure_policy(FailurePolicy::kRelax, s.relax_weight, s.recover_error);
-  } else if (s.on_infeasible == OnInfeasible::kBrake) {
-    ctrl->set_failure_policy(FailurePolicy::kBrake, s.relax_weight, s.recover_error);
-  } else if (!s.robot->has_acceleration_limits()) {
-    ctrl->set_failure_policy(FailurePolicy::kHold);  // hold, and stop's failed step (the run ends there)
-  }
+  ctrl->set_failure_policy(s.on_infeasible, s.relax_weight, s.recover_error);
   return ctrl;
 }
 

@@ -118,12 +118,14 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   out.steps_over_acceleration_limit = run.steps_over_acceleration_limit;
   out.steps_over_jerk_limit = run.steps_over_jerk_limit;
   for (int j = 0; j < n; ++j) out.final_theta.push_back(tr(rows - 1, c_th[static_cast<std::size_t>(j)]));
-  out.solver = {run.engine(), it_sum / static_cast<double>(rows), it_max, max_res, run.failures, run.first_failure,
-                run.stopped};
-  out.solver.on_infeasible = s.on_infeasible == OnInfeasible::kStop    ? "stop"
-                             : s.on_infeasible == OnInfeasible::kRelax ? "relax"
-                             : s.on_infeasible == OnInfeasible::kBrake ? "brake"
-                                                                       : "hold";
+  out.solver.engine = run.engine();
+  out.solver.mean_iterations = it_sum / static_cast<double>(rows);
+  out.solver.max_iterations = it_max;
+  out.solver.max_residual = max_res;
+  out.solver.failures = run.failures;
+  out.solver.first_failure = run.first_failure;
+  out.solver.stopped = run.stopped;
+  out.solver.on_infeasible = std::string(failure_policy_name(s.on_infeasible));
   out.solver.braked_steps = run.braked_steps;
   out.solver.held_steps = run.held_steps;
   out.solver.relaxed_steps = run.relaxed_steps;

@@ -23,15 +23,8 @@ namespace {
 
 // The [solver] table's keys that are the run's, not the engine's: what a failed step does. Read through a schema,
 // like the engine's keys, so that `redres plugins` lists them with their defaults and rules.
-enum class Policy { kHold, kStop, kRelax, kContinue, kBrake };
-auto enum_names(Policy) {
-  return std::array{
-      std::pair{Policy::kHold, std::string_view("hold")}, std::pair{Policy::kStop, std::string_view("stop")},
-      std::pair{Policy::kRelax, std::string_view("relax")}, std::pair{Policy::kContinue, std::string_view("continue")},
-      std::pair{Policy::kBrake, std::string_view("brake")}};
-}
 struct SolverPolicy {
-  Policy on_infeasible = Policy::kHold;
+  FailurePolicy on_infeasible = FailurePolicy::kHold;
   double relax_weight = 1e4;
   double recover_error = 1e-3;
   double max_task_error = 0.01;
@@ -465,7 +458,7 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                [](const TableReader& r, C& c) {
                  Scenario& s = c.s;
                  const bool limits = s.robot->has_acceleration_limits();
-                 s.on_infeasible = limits ? OnInfeasible::kBrake : OnInfeasible::kHold;
+                 s.on_infeasible = limits ? FailurePolicy::kBrake : FailurePolicy::kHold;
                  if (!r.has("solver")) {
                    s.engine = make_engine("projection");
                    return;
@@ -474,26 +467,21 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                  const TableReader solver(t.file_ptr(), t.raw(), "solver");
                  SolverPolicy policy;
                  read_config(solver, SolverPolicy::schema(), policy);
-                 if (solver.has("on_infeasible")) {
-                   s.on_infeasible = policy.on_infeasible == Policy::kStop    ? OnInfeasible::kStop
-                                     : policy.on_infeasible == Policy::kRelax ? OnInfeasible::kRelax
-                                     : policy.on_infeasible == Policy::kBrake ? OnInfeasible::kBrake
-                                                                              : OnInfeasible::kHold;
-                 }
+                 if (solver.has("on_infeasible")) s.on_infeasible = policy.on_infeasible;
                  s.relax_weight = policy.relax_weight;
                  s.recover_error = policy.recover_error;
                  s.max_task_error = policy.max_task_error;
                  const std::string chosen = solver.has("on_infeasible")
                                                 ? std::string(solver.string("on_infeasible"))
                                                 : std::string(limits ? "brake" : "hold") + "\", the default";
-                 if (s.on_infeasible == OnInfeasible::kHold && limits) {
+                 if (s.on_infeasible == FailurePolicy::kHold && limits) {
                    solver.fail("on_infeasible", "\"" + chosen +
                                                     "\" stops every joint at once, a velocity jump that robot '" +
                                                     s.robot->name() +
                                                     "''s acceleration limits forbid; use \"brake\" (the default for "
                                                     "it), \"relax\" or \"stop\"");
                  }
-                 if (s.on_infeasible == OnInfeasible::kBrake && !limits) {
+                 if (s.on_infeasible == FailurePolicy::kBrake && !limits) {
                    solver.fail("on_infeasible",
                                "\"brake\" decelerates within the joints' acceleration limits, and "
                                "robot '" +
@@ -501,14 +489,14 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                                    "' gives none on some joint (`acceleration_limit` in the robot "
                                    "file's [[joints]])");
                  }
-                 if (solver.has("relax_weight") && s.on_infeasible != OnInfeasible::kRelax &&
-                     s.on_infeasible != OnInfeasible::kBrake) {
+                 if (solver.has("relax_weight") && s.on_infeasible != FailurePolicy::kRelax &&
+                     s.on_infeasible != FailurePolicy::kBrake) {
                    solver.fail("relax_weight",
                                "is used only with on_infeasible = \"relax\" or \"brake\" "
                                "(on_infeasible is \"" +
                                    chosen + "\")");
                  }
-                 if (solver.has("recover_error") && s.on_infeasible != OnInfeasible::kBrake) {
+                 if (solver.has("recover_error") && s.on_infeasible != FailurePolicy::kBrake) {
                    solver.fail("recover_error",
                                "is used only with on_infeasible = \"brake\" (on_infeasible is \"" + chosen + "\")");
                  }

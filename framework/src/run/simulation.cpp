@@ -57,7 +57,7 @@ bool integrate(const Scenario& s, Controller& ctrl, StepLog& log, RunResult& run
   ctrl.reevaluate(theta_pred, t2, out2);  // the same step: the plugins see the same previous command
   const int failures_before_stage = run.failures;
   log.note(out2, t2);
-  if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before_stage) {
+  if (s.on_infeasible == FailurePolicy::kStop && run.failures > failures_before_stage) {
     run.stopped = true;
     return false;
   }
@@ -149,7 +149,7 @@ bool step_goes_on(const Scenario& s, StepLog& log, RunResult& run, int k, int st
     run.interrupted = true;
     return false;
   }
-  if (s.on_infeasible == OnInfeasible::kStop && run.failures > failures_before) {
+  if (s.on_infeasible == FailurePolicy::kStop && run.failures > failures_before) {
     run.stopped = true;
     return false;
   }

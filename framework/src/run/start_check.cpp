@@ -125,7 +125,7 @@ StartReport check_start(Scenario& s) {
   report.sigma_min = task_sigma_min(robot, theta, k);
   report.w = k.w;
   // Under on_infeasible = "relax" a singular start is allowed: the elastic QP moves the arm out of it.
-  if (!(report.sigma_min >= kSingularTolerance) && s.on_infeasible != OnInfeasible::kRelax) {
+  if (!(report.sigma_min >= kSingularTolerance) && s.on_infeasible != FailurePolicy::kRelax) {
     double sigma = 0.0;
     const Eigen::VectorXd near = nearby_regular(robot, theta, k, sigma);
     std::string suggestion = "on_infeasible = \"relax\" lets the run start there";

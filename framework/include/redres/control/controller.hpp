@@ -10,11 +10,12 @@
 
 #include <Eigen/Core>
 
+#include "redres/control/brake.hpp"
 #include "redres/control/cascade.hpp"
+#include "redres/control/failure_policy.hpp"
 #include "redres/control/orientation_reference.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/scheme.hpp"
-#include "redres/qp/elastic.hpp"
 #include "redres/qp/lvi.hpp"
 
 namespace redres {
@@ -39,16 +40,6 @@ struct StepOutput {
 };
 
 struct Scenario;
-
-/// What a step whose QP is not solved does (docs/motion.md has the table):
-/// - kHold: theta_dot = 0, at once. Refused for a robot with acceleration limits (a velocity jump).
-/// - kRelax: solves the elastic QP (rows relaxed into a weighted penalty, every bound kept); when that fails too,
-///   brakes (a robot with acceleration limits) or holds.
-/// - kBrake (needs acceleration limits on every joint): decelerates every joint along the previous command within
-///   its acceleration (and jerk) limits. While the task's position error exceeds the recovery bound (a step after
-///   braking falls behind its moving target) the elastic QP is tried first, so that the arm catches up within its
-///   limits instead of braking again; once the error is back under the bound a failed step brakes.
-enum class FailurePolicy { kHold, kRelax, kBrake };
 
 /// Runs the scheme for one robot. The robot, scheme, engine and path must outlive the controller.
 class Controller {
@@ -116,10 +107,11 @@ class Controller {
   /// how much the rows are missed; when it does not, the step holds with the first failure's status. weight = 0
   /// turns relaxation off. Allocates (a second engine of the same type and its QP): call it before the loop.
   void set_relaxation(double weight);
-  /// The failure policy (FailurePolicy), with the elastic QP's weight (> 0; used by kRelax and kBrake) and the
-  /// position error (m, > 0) above which kBrake tries the elastic QP first. Throws std::invalid_argument for kBrake
-  /// or kHold on a robot that has (kHold) or lacks (kBrake) acceleration limits on every joint. The default is kBrake
-  /// for a robot with acceleration limits, else kHold. Allocates: call it before the loop.
+  /// The failure policy (control/failure_policy.hpp), with the elastic QP's weight (> 0; used by kRelax and kBrake)
+  /// and the position error (m, > 0) above which kBrake tries the elastic QP first. kStop gives up at once as kHold
+  /// does (a robot with acceleration limits brakes); the caller's loop ends there. Throws std::invalid_argument for
+  /// kBrake or kHold on a robot that has (kHold) or lacks (kBrake) acceleration limits on every joint. The default is
+  /// kBrake for a robot with acceleration limits, else kHold. Allocates: call it before the loop.
   void set_failure_policy(FailurePolicy policy, double relax_weight = 1e4, double recover_error = 1e-3);
   [[nodiscard]] FailurePolicy failure_policy() const noexcept { return policy_; }
   /// Forgets the engine's warm start and a captured (not an explicitly set) orientation reference.
@@ -180,16 +172,14 @@ class Controller {
   Eigen::VectorXd prev_, prev2_, pending_;  // theta_dot_prev, theta_dot_prev2, this step's applied command
   Eigen::VectorXd measured_;                // the caller's measured joint velocity, during a step that has one
   SolverStatus pending_status_ = SolverStatus::kNotRun;
-  bool have_pending_ = false;        // a step was made whose command is not yet theta_dot_prev
-  bool started_ = false;             // the plugins were told that the run starts
-  Eigen::VectorXd row_miss_;         // J x - d of a relaxed step
-  Eigen::VectorXd v_;                // acceleration level: the joint velocity at this step
-  Eigen::VectorXd lim_lo_, lim_hi_;  // acceleration (then jerk) limits at theta, for braking
+  bool have_pending_ = false;          // a step was made whose command is not yet theta_dot_prev
+  bool started_ = false;               // the plugins were told that the run starts
+  Eigen::VectorXd v_;                  // acceleration level: the joint velocity at this step
+  Eigen::VectorXd lim_lo_, lim_hi_;    // acceleration limits at theta, for braking
+  Eigen::VectorXd jerk_lo_, jerk_hi_;  // jerk limits at theta, for braking
   FailurePolicy policy_ = FailurePolicy::kHold;
-  double recover_error_ = 1e-3;              // kBrake: the position error above which the elastic QP goes first
-  std::unique_ptr<LviEngine> relax_engine_;  // an engine like *engine_ for the elastic QP
-  ElasticQp relaxed_;                        // the elastic QP (no equality rows)
-  SolverResult relaxed_result_;
+  double recover_error_ = 1e-3;       // kBrake: the position error above which the elastic QP goes first
+  ElasticFallback fallback_;          // the elastic QP of kRelax and kBrake, with its engine
   std::unique_ptr<Cascade> cascade_;  // a cascaded scheme's levels (null with one level)
   Eigen::VectorXd x_levels_;          // the answer of the lowest level solved
 };

@@ -30,7 +30,7 @@ struct SolverStats {
   int failures = 0;                     //!< solves that were not `solved`
   std::string first_failure;            //!< "t = ...: <status>: <diagnosis>", or empty
   bool stopped = false;                 //!< the run ended at its first failed step ([solver] on_infeasible = "stop")
-  std::string on_infeasible;            //!< the policy: "hold", "stop" or "relax"
+  std::string on_infeasible;            //!< the policy: "hold", "stop", "relax" or "brake"
   int held_steps = 0;                   //!< failed steps held with theta_dot = 0
   int relaxed_steps = 0;                //!< steps solved with the rows relaxed ("relax")
   int braked_steps = 0;                 //!< failed steps that braked ("brake", or "relax" where the elastic QP failed)

@@ -37,18 +37,6 @@ namespace redres {
 
 /// Integration of theta_dot.
 enum class Integrator { kEuler, kHeun };
-/// What a run does at a step whose QP cannot be solved ([solver] on_infeasible; docs/scenario_format.md):
-/// - kHold ("hold", the default; "continue" is its older name): theta_dot = 0 for that step, and on to T;
-/// - kStop ("stop"): the run ends there, with every row up to that step;
-/// - kRelax ("relax"): the step solves the elastic QP (Controller::set_relaxation) with [solver] relax_weight; it
-///   holds only when that fails too.
-/// - kBrake ("brake", the default for a robot with acceleration limits on every joint): the step decelerates every
-///   joint along the previous command within its acceleration (and jerk) limits (Controller FailurePolicy::kBrake),
-///   and a run that falls behind catches up through the elastic QP while its position error exceeds [solver]
-///   recover_error.
-/// A failed step never integrates the engine's unconverged iterate. A robot with acceleration limits refuses "hold"
-/// (a velocity jump), and under "relax" brakes where the elastic QP fails too.
-enum class OnInfeasible { kHold, kStop, kRelax, kBrake };
 
 /// A loaded scenario. Owns everything a run needs.
 struct Scenario {
@@ -69,7 +57,9 @@ struct Scenario {
   /// [orientation] turn: the rotation (a world-frame rotation vector, rad; planar: its z) the end effector turns
   /// through over the run, from the orientation it has at t = 0 (Controller::set_orientation_turn); zero: hold it.
   Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();
-  OnInfeasible on_infeasible = OnInfeasible::kHold;  //!< [solver] on_infeasible: "hold", "stop" or "relax"
+  /// [solver] on_infeasible: what a step whose QP is not solved does (control/failure_policy.hpp); a failed step never
+  /// integrates the engine's unconverged iterate, and under kStop the run ends there, with every row up to that step.
+  FailurePolicy on_infeasible = FailurePolicy::kHold;
   double relax_weight = 1e4;     //!< [solver] relax_weight: rho of the elastic QP under "relax" and "brake" (1 to 1e8)
   double recover_error = 1e-3;   //!< [solver] recover_error (m): under "brake", the elastic QP goes first above it
   double max_task_error = 0.01;  //!< [solver] max_task_error (m): a larger position error makes the run no success

@@ -254,7 +254,7 @@ TEST(OnInfeasible, HoldNeverIntegratesAFailedStep) {
   for (const char* policy : {"hold", "continue"}) {
     Scenario s = load_scenario(file, {"theta0=[0.3, 0.6, 0.6, 0.4]", "solver.engine=\"projection\"",
                                       "solver.on_infeasible=\"" + std::string(policy) + "\""});
-    EXPECT_EQ(s.on_infeasible, OnInfeasible::kHold);
+    EXPECT_EQ(s.on_infeasible, FailurePolicy::kHold);
     const RunResult run = simulate(s);
     const Trajectory& tr = run.trajectory;
     ASSERT_EQ(tr.size(), 201u);

@@ -146,6 +146,11 @@ Eigen::Vector3d project(const ShapeSpec& s, const Eigen::Isometry3d& T, const Ei
       }
       break;
     }
+    case ShapeSpec::Kind::kConvex:
+    case ShapeSpec::Kind::kOctree:
+    case ShapeSpec::Kind::kPoints:
+      ADD_FAILURE() << "project(): the analytic projection is written for primitives only";
+      break;
   }
   return T * q;
 }

@@ -331,7 +331,9 @@ TEST(Clouds, CapsuleDistancesMatchFclAndBruteForce) {
       const ShapeDistance none = q.distance(0, T, 1, Tc, d.distance - 1e-9);
       EXPECT_TRUE(std::isinf(none.distance) && none.distance > 0.0);
     }
-    if (grow == 0.0) EXPECT_GE(compared_fcl, 20);
+    if (grow == 0.0) {
+      EXPECT_GE(compared_fcl, 20);
+    }
     EXPECT_GE(overlapping, 1) << "some trials overlap the cloud";
   }
 }

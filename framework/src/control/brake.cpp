@@ -1,0 +1,67 @@
+#include "redres/control/brake.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace redres {
+
+BrakeScale braking_scale(const BrakeInput& in) {
+  const Eigen::VectorXd& b = *in.velocity;
+  const Eigen::VectorXd& a_lo = *in.acceleration_lower;
+  const Eigen::VectorXd& a_hi = *in.acceleration_upper;
+  const Eigen::VectorXd& v_lo = *in.velocity_lower;
+  const Eigen::VectorXd& v_hi = *in.velocity_upper;
+  const double tau = in.tau;
+  const auto n = b.size();
+  double s_lo = 0.0, s_hi = std::numeric_limits<double>::infinity();
+  int decides = -1;
+  // s in [lo, hi] for every joint with b_j != 0, from a bound lo_j <= (s - 1) b_j / tau <= hi_j.
+  const auto within = [&](Eigen::Index j, double lo, double hi, double& s_min, double& s_max) {
+    double s1 = 1.0 + tau * lo / b(j), s2 = 1.0 + tau * hi / b(j);
+    if (s1 > s2) std::swap(s1, s2);
+    s_min = std::max(s_min, s1);
+    s_max = std::min(s_max, s2);
+  };
+  const auto usable_joint = [&](Eigen::Index j) {
+    return b(j) != 0.0 && std::isfinite(b(j)) && std::isfinite(a_lo(j)) && std::isfinite(a_hi(j));
+  };
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (!usable_joint(j)) continue;
+    const double before = s_lo;
+    within(j, a_lo(j), a_hi(j), s_lo, s_hi);
+    if (s_lo > before) decides = static_cast<int>(j);
+    // The velocity limits: s b_j within [v_lo_j, v_hi_j], where b_j itself is.
+    if (b(j) > 0.0 && b(j) <= v_hi(j)) s_hi = std::min(s_hi, v_hi(j) / b(j));
+    if (b(j) < 0.0 && b(j) >= v_lo(j)) s_hi = std::min(s_hi, v_lo(j) / b(j));
+  }
+  s_hi = std::max(s_hi, s_lo);
+  BrakeScale out;
+  out.scale = s_lo;
+  if (in.jerk_lower != nullptr && in.jerk_upper != nullptr) {
+    const Eigen::VectorXd& j_lo = *in.jerk_lower;
+    const Eigen::VectorXd& j_hi = *in.jerk_upper;
+    double lo = s_lo, hi = s_hi;
+    int jerk_decides = decides;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (!usable_joint(j)) continue;
+      // The acceleration (s - 1) b_j / tau within a_prev + tau [j^-, j^+].
+      const double a_prev = ((*in.previous)(j) - (*in.previous2)(j)) / tau;
+      const double before = lo;
+      within(j, a_prev + tau * j_lo(j), a_prev + tau * j_hi(j), lo, hi);
+      if (lo > before) jerk_decides = static_cast<int>(j);
+    }
+    out.jerk_yields = lo > hi;
+    if (!out.jerk_yields) {
+      out.scale = lo;
+      decides = jerk_decides;
+    } else {
+      out.scale = std::clamp(lo, s_lo, s_hi);  // as near the jerk limits as the acceleration and velocity limits allow
+    }
+  }
+  out.deciding_joint = decides;
+  return out;
+}
+
+}  // namespace redres

@@ -12,7 +12,7 @@ packages=(
   libjs-three chromium
   libgtest-dev libgmock-dev librapidcheck-dev libbenchmark-dev liborocos-kdl-dev
   python3 python3-dev python3-matplotlib python3-numpy python3-pil python3-h5py
-  pybind11-dev python3-pybind11 python3-pytest
+  pybind11-dev python3-pybind11 python3-pytest python3-pip python3-setuptools python3-wheel python3-venv mypy
   "$@"
 )
 

@@ -10,11 +10,15 @@
 #include "redres/common/error.hpp"
 #include "redres/config/plugin_loader.hpp"
 
+#ifndef REDRES_VERSION
+#error "REDRES_VERSION (the project's version) is set by framework/CMakeLists.txt"
+#endif
+
 int main(int argc, char** argv) {
   CLI::App app{"redres: redundancy resolution of redundant manipulators (QP from plugins, solved as an LVI)"};
   app.require_subcommand(1);
   app.fallthrough();  // options of the main command (--plugin) may also follow the subcommand
-  app.set_version_flag("--version", "redres 0.1.0");
+  app.set_version_flag("--version", "redres " REDRES_VERSION);  // project(VERSION) in CMakeLists.txt
   redres::cli::Action action;
   std::vector<std::string> plugin_libraries;
   app.add_option("--plugin", plugin_libraries,

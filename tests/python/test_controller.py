@@ -1,6 +1,8 @@
 """redres.Controller from Python: a caller's own Euler loop over Controller.step reproduces scenario.run() bit for
 bit, a controller built from typed plugin configurations meets its task rows, and failures are statuses."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -171,3 +173,110 @@ def test_a_scheme_with_priority_levels_reports_each_level_and_keeps_the_hand_on_
     _, info = redres.Controller.from_scenario(redres.Scenario.load(source("configs/paper_r_tvcmm.toml"))).step(
         redres.Scenario.load(source("configs/paper_r_tvcmm.toml")).theta0, 0.0)
     assert info.levels == []
+
+
+# The scenario files' schemes, written as typed configurations: the same plugins in the same order (a scenario adds
+# the robot file's acceleration and jerk limits after its own constraints when it lists none; a Python controller
+# adds nothing, so they are listed here).
+def panda_tool_elbow_posture_scheme():
+    return dict(
+        tasks=[redres.tasks.Frame(name="tool", frame="end_effector", reference="path", gain=8.0, priority=0),
+               redres.tasks.Frame(name="elbow", frame="panda_joint4", rows=["z"], mode="inequality", lower=[0.5],
+                                  gain=4.0, priority=1),
+               redres.tasks.Posture(name="posture", mode="soft", gain=1.0, priority=2)],
+        objectives=[redres.objectives.MinVelocityNorm(weight=0.01, priority=2)],
+        constraints=[redres.constraints.JointAngleMargin(kappa=4.0, margin=0.05),
+                     redres.constraints.JointVelocityLimits(), redres.constraints.JointAccelerationLimits(),
+                     redres.constraints.JointJerkLimits()],
+        path=redres.paths.Circle(radius=0.15, normal=[0.0, 1.0, 0.0], start_angle_deg=0))
+
+
+def iiwa_pose_manipulability_levels_scheme():
+    return dict(
+        tasks=[redres.tasks.Frame(name="pose", frame="end_effector", rows=["x", "y", "z", "wx", "wy", "wz"],
+                                  reference="path", gain=8.0, priority=0)],
+        objectives=[redres.objectives.MinVelocityNorm(priority=1),
+                    redres.objectives.Manipulability(measure="log_det", schedule="smoothstep", ramp_fraction=0.1,
+                                                     p=0.5, priority=1)],
+        constraints=[redres.constraints.JointAngleMargin(kappa=4.0, margin=0.05),
+                     redres.constraints.JointVelocityLimits()],
+        path=redres.paths.Circle(radius=0.06, normal=[0.0, 0.0, 1.0], timing="cycloidal"))
+
+
+@pytest.mark.parametrize("config, scheme, levels", [
+    ("configs/panda_tool_elbow_posture.toml", panda_tool_elbow_posture_scheme, [0, 1, 2]),
+    ("configs/iiwa_pose_manipulability_levels.toml", iiwa_pose_manipulability_levels_scheme, [0, 1]),
+])
+def test_a_controller_with_tasks_from_python_steps_as_the_scenarios_controller(config, scheme, levels):
+    s = redres.Scenario.load(source(config))
+    theirs = redres.Controller.from_scenario(s)
+    ours = redres.Controller(s.robot, engine="newton", T=s.duration, tau=s.step, theta0=s.theta0, **scheme())
+    assert "tasks" in repr(ours)
+    theta = s.theta0.copy()
+    for k in range(150):
+        t = k * s.step
+        want, want_info = theirs.step(theta, t)
+        got, got_info = ours.step(theta, t)
+        assert want_info.ok, want_info.diagnosis
+        assert [level.priority for level in got_info.levels] == levels
+        assert [level.status for level in got_info.levels] == [level.status for level in want_info.levels]
+        assert got.tolist() == want.tolist(), (k, got - want)  # bit for bit
+        assert ours.r_d.tolist() == theirs.r_d.tolist()
+        theta = theta + s.step * want
+
+
+def test_the_python_controller_forwards_every_keyword_of_the_cpp_one():
+    # The binding's signature is the first line of its docstring: every parameter it takes is one of the Python
+    # class's, so none is dropped on the way (and none is added that C++ would not take).
+    first = redres._redres.Controller.__init__.__doc__.splitlines()[0]
+    cpp = re.findall(r"(?:\(|, )(\w+): ", first)[1:]  # (self: ..., robot: ..., ...; a type may hold ", ")
+    assert cpp[:3] == ["robot", "objectives", "constraints"], first
+    python = list(__import__("inspect").signature(redres.Controller.__init__).parameters)[1:]
+    assert sorted(cpp) == sorted(python)
+    assert {"tasks", "level", "regularization", "orientation_turn"} <= set(python)
+
+
+def test_tasks_level_and_regularization_reach_the_scheme():
+    robot = redres.Robot.load(source("robots/franka_panda.toml"))
+    theta = robot.home.copy()
+    common = dict(objectives=[redres.objectives.MinVelocityNorm()], T=1.0, tau=0.01)
+    # One soft posture task at priority 1 below the hand: two levels.
+    ctrl = redres.Controller(robot, tasks=[redres.tasks.Frame(frame="end_effector", reference="path"),
+                                           redres.tasks.Posture(mode="soft", priority=1)],
+                             path=redres.paths.Circle(radius=0.05), **common)
+    _, info = ctrl.step(theta, 0.0)
+    assert info.ok and [level.priority for level in info.levels] == [0, 1], info.diagnosis
+    # A Python objective takes a priority too.
+    class Centering(redres.Objective):
+        kinematics = "position"
+
+        def contribute(self, ctx, qp):
+            qp.add_linear(ctx.theta - robot.home)
+    ctrl = redres.Controller(robot, objectives=[redres.objectives.MinVelocityNorm(), Centering(priority=1)],
+                             constraints=[redres.constraints.TaskTracking()], T=1.0, tau=0.01)
+    _, info = ctrl.step(theta, 0.0, robot.kinematics(theta).f, np.zeros(3))
+    assert info.ok and [level.priority for level in info.levels] == [0, 1], info.diagnosis
+    # The acceleration level is built (it steps with r_d_ddot).
+    with pytest.raises(ValueError, match="does not work at the acceleration level"):
+        redres.Controller(robot, constraints=[redres.constraints.TaskTracking()], level="acceleration", **common)
+    ctrl = redres.Controller(robot, objectives=[redres.objectives.MinAccelerationNorm()],
+                             constraints=[redres.constraints.TaskTracking()], level="acceleration", T=1.0, tau=0.01)
+    k = robot.kinematics(theta)
+    _, info = ctrl.step(theta, 0.0, k.f, np.zeros(3), np.zeros(3))
+    assert info.ok, info.diagnosis
+    with pytest.raises(ValueError, match=r"regularization: expected a number in \(0, 1\]"):
+        redres.Controller(robot, regularization=0.0, **common)
+    with pytest.raises(ValueError, match="orientation_turn of a spatial robot has 3 entries"):
+        redres.Controller(robot, orientation_turn=[0.1, 0.2], **common)
+
+
+def test_a_configuration_in_the_wrong_list_is_named():
+    robot = redres.Robot.load(source("robots/franka_panda.toml"))
+    with pytest.raises(TypeError, match=r"tasks\[0\] is redres.objectives.MinVelocityNorm\(\) \(kind 'objective'\); "
+                                        r"expected a redres.tasks.\* configuration"):
+        redres.Controller(robot, tasks=[redres.objectives.MinVelocityNorm()])
+    with pytest.raises(TypeError, match=r"objectives\[1\] is redres.tasks.Posture\(\) \(kind 'task'\)"):
+        redres.Controller(robot, objectives=[redres.objectives.MinVelocityNorm(), redres.tasks.Posture()])
+    with pytest.raises(redres.ConfigError, match="key 'lower'"):
+        redres.Controller(robot, objectives=[redres.objectives.MinVelocityNorm()],
+                          tasks=[redres.tasks.Frame(frame="end_effector", rows=["z"], lower=[0.5])])

@@ -14,7 +14,7 @@ from conftest import cli, source
 def test_every_registered_plugin_has_a_typed_configuration():
     listed = json.loads(cli("plugins", "--json").stdout)
     for kind, module in (("objectives", redres.objectives), ("constraints", redres.constraints),
-                         ("paths", redres.paths), ("engines", redres.engines)):
+                         ("tasks", redres.tasks), ("paths", redres.paths), ("engines", redres.engines)):
         types = [e["type"] for e in listed[kind]]
         assert types, kind
         for t in types:
@@ -25,7 +25,7 @@ def test_every_registered_plugin_has_a_typed_configuration():
     assert "p" in str(__import__("inspect").signature(redres.objectives.Manipulability))
     assert "schedule" in redres.objectives.Manipulability.__doc__
     kinds = {e["kind"] for e in redres.plugins()}
-    assert kinds == {"objective", "constraint", "path", "engine", "velocity_limit"}
+    assert kinds == {"objective", "constraint", "task", "path", "engine", "velocity_limit"}
 
 
 def test_bad_typed_configurations_raise_naming_the_key():

@@ -19,6 +19,8 @@ file:line:col; a wrong size or a NaN raises ValueError naming the condition. A f
 exception: it is a status (StepInfo.status, Result.failures and Result.first_failure).
 """
 
+from __future__ import annotations
+
 import atexit as _atexit
 import inspect as _inspect
 import json as _json
@@ -29,11 +31,19 @@ import sys as _sys
 import tomllib as _tomllib
 import types as _types
 from concurrent.futures import ThreadPoolExecutor as _ThreadPoolExecutor
+from typing import TYPE_CHECKING as _TYPE_CHECKING
+from typing import Any as _Any
+from typing import Callable as _Callable
+from typing import Iterable as _Iterable
+from typing import Mapping as _Mapping
+from typing import Sequence as _Sequence
+from typing import Union as _Union
 
 from . import _redres
 from ._redres import (  # noqa: F401  (re-exported)
     ConfigError,
     Kinematics,
+    LevelInfo,
     Result,
     Robot,
     Scenario,
@@ -45,11 +55,17 @@ from ._redres import (  # noqa: F401  (re-exported)
     trajectory_column_groups,
 )
 
-__version__ = "0.1.0"
+if _TYPE_CHECKING:
+    import numpy as _np
+    from numpy.typing import ArrayLike as _ArrayLike
+
+# The version is written once, in the top-level CMakeLists.txt's project(); the extension carries it.
+__version__: str = _redres.__version__
 __all__ = [
-    "ConfigError", "Constraint", "Controller", "Kinematics", "Objective", "Result", "Robot", "Scenario", "StepContext",
-    "StepInfo", "StepQp", "Comparison", "check_plugins", "compare", "constraints", "engines", "mujoco_available",
-    "objectives", "paths", "plugins", "register", "sweep",
+    "ConfigError", "Constraint", "Controller", "Kinematics", "LevelInfo", "Objective", "PluginConfig", "Result",
+    "Robot", "Scenario", "StepContext", "StepInfo", "StepQp", "Comparison", "check_plugins", "compare", "constraints",
+    "engines", "mujoco_available", "objectives", "paths", "plugins", "register", "sweep", "tasks",
+    "trajectory_column_groups",
 ]
 
 
@@ -80,7 +96,8 @@ def _toml(value):
     raise TypeError(f"cannot write a value of type {type(value).__name__} as TOML")
 
 
-def _load_scenario(path, overrides=None):
+def _load_scenario(path: _Union[str, _os.PathLike[str]],
+                   overrides: _Mapping[str, _Any] | None = None) -> Scenario:
     """Loads a scenario TOML file. `overrides` maps keys to values as `redres run --set` does, e.g.
     {"objectives.1.p": 1.0, "solver.engine": "newton", "task": ["x", "y", "z", "wz"]} (array entries by 0-based
     index). A bad file or override raises redres.ConfigError with file:line:col."""
@@ -90,7 +107,7 @@ def _load_scenario(path, overrides=None):
     return Scenario._load(path, items)
 
 
-Scenario.load = staticmethod(_load_scenario)
+setattr(Scenario, "load", staticmethod(_load_scenario))  # (setattr: mypy reads the stub's Scenario.load)
 Scenario.__doc__ = """A loaded scenario: a robot, theta(0), T and tau, a path, objectives, constraints and an engine.
 
 redres.Scenario.load(path, overrides={...}) reads a scenario TOML file; scenario.run() runs it and returns a
@@ -118,10 +135,11 @@ class PluginConfig:
     """A plugin's typed configuration: its type and keys, checked when it is made (types and rules; checks that need
     the robot, such as one value per joint, run when a Controller is built). Passed to redres.Controller."""
 
-    kind = None
-    type = None
+    kind: str = ""  # "objective", "constraint", "task", "path" or "engine" (set by each configuration class)
+    type: str = ""  # the plugin's type name, e.g. "min_velocity_norm"
 
-    def __init__(self, **keys):
+    def __init__(self, **keys: _Any) -> None:
+        """Checks `keys` against the plugin's keys (types and rules); a bad one raises redres.ConfigError naming it."""
         self._keys = dict(keys)
         _redres._check_config(self.kind, self._spec_table, self._spec_where)
 
@@ -136,11 +154,11 @@ class PluginConfig:
         return f"redres.{self.kind}s.{type(self).__name__}"
 
     @property
-    def config(self):
+    def config(self) -> dict[str, _Any]:
         """The keys given (the rest take their defaults)."""
         return dict(self._keys)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in self._keys.items())
         return f"redres.{self.kind}s.{type(self).__name__}({args})"
 
@@ -175,7 +193,7 @@ def _config_class(entry):
         "kind": entry["kind"], "type": entry["type"], "__doc__": _describe(entry),
         "__module__": f"redres.{entry['kind']}s",
     })
-    cls.__signature__ = _inspect.Signature(params)
+    setattr(cls, "__signature__", _inspect.Signature(params))
     return cls
 
 
@@ -187,9 +205,10 @@ def _namespace(kind, title):
 
 objectives = _namespace("objective", "Objectives")
 constraints = _namespace("constraint", "Constraints")
+tasks = _namespace("task", "Tasks (rows on a frame or the joints, each hard, soft or an inequality, at a priority)")
 paths = _namespace("path", "Paths")
 engines = _namespace("engine", "LVI engines")
-_namespaces = {"objective": objectives, "constraint": constraints, "path": paths, "engine": engines}
+_namespaces = {"objective": objectives, "constraint": constraints, "task": tasks, "path": paths, "engine": engines}
 
 
 def _refresh_namespaces():
@@ -202,33 +221,37 @@ def _refresh_namespaces():
             setattr(module, name, _config_class(entry))
 
 
-def plugins(kind=None):
-    """Every registered plugin (objective, constraint, path, engine, velocity_limit) as a dict: kind, type, summary,
-    origin, keys (name, default, unit, help, rule, type, presence, group), common_keys and groups. `kind` filters."""
+def plugins(kind: str | None = None) -> list[dict[str, _Any]]:
+    """Every registered plugin (objective, constraint, task, path, engine, velocity_limit) as a dict: kind, type,
+    summary, origin, keys (name, default, unit, help, rule, type, presence, group), common_keys and groups. `kind`
+    filters."""
     return [e for e in _redres._registry() if kind is None or e["kind"] == kind]
 
 
 # --- plugins written in Python -------------------------------------------------------------------------------------
 
 class _PythonPlugin:
-    type = None          # the name under which register() files the class (default: the class name)
-    keys = {}            # key -> default value; its type fixes how a scenario file's value is read
-    help = {}            # key -> one line of help
+    type: str | None = None  # the name under which register() files the class (default: the class name)
+    keys: dict[str, _Any] = {}  # key -> default value; its type fixes how a scenario file's value is read
+    help: dict[str, str] = {}   # key -> one line of help
     summary = ""         # one line, for redres.plugins() and `redres plugins`
     kinematics = "all"   # what contribute() reads: 'position', 'jacobian', 'gradient' (w, grad w), 'manipulability' (+ dJ) or 'all'
-    name = None          # instance name in diagnoses (default: the type)
+    name: str | None = None  # instance name in diagnoses (default: the type)
     active = True
 
-    def __init__(self, **config):
+    def __init__(self, **config: _Any) -> None:
+        """Sets each of the class's keys (from `config`, else its default) and the common name, weight, active and
+        (objectives) priority as attributes; an unknown key raises TypeError."""
         for key, default in self.keys.items():
             setattr(self, key, config.pop(key, default))
-        for key in ("name", "weight", "active"):
+        for key in ("name", "weight", "active", "priority"):
             if key in config:
                 setattr(self, key, config.pop(key))
         if config:
             raise TypeError(f"{type(self).__name__}: unknown keys {sorted(config)}; its keys are {sorted(self.keys)}")
 
-    def contribute(self, ctx, qp):
+    def contribute(self, ctx: StepContext, qp: StepQp) -> None:
+        """Adds this plugin's share of the step's QP (called from the C++ step); subclasses define it."""
         raise NotImplementedError(f"{type(self).__name__}.contribute(ctx, qp)")
 
 
@@ -243,14 +266,15 @@ class Objective(_PythonPlugin):
     P(theta) whose gradient is the linear term per unit weight: the conformance checks (redres.check_plugins) then
     compare the two by central differences.
 
-    Class attributes: keys (key -> default), help, summary, kinematics, type; instance attributes name, weight
-    and active. Use an instance in redres.Controller(objectives=[...]), or redres.register(MyObjective) to name it
+    Class attributes: keys (key -> default), help, summary, kinematics, type; instance attributes name, weight,
+    active and priority (0, the highest, by default). Use an instance in redres.Controller(objectives=[...]), or redres.register(MyObjective) to name it
     in scenario files ([[objectives]] type = "...", its keys read as the defaults' types).
 
     Cost: each step calls into Python once per Python plugin (the GIL is taken, the views are made); measured
     against the same objective in C++ in docs/python.md."""
 
     weight = 1.0
+    priority = 0         # its priority level (0 the highest; docs/tasks.md)
 
 
 class Constraint(_PythonPlugin):
@@ -266,7 +290,7 @@ class Constraint(_PythonPlugin):
     inequality_rows = 0
 
 
-def register(cls, type=None, replace=False):
+def register(cls: type[Objective] | type[Constraint], type: str | None = None, replace: bool = False) -> str:
     """Makes a redres.Objective or redres.Constraint subclass available to scenario files and the registries under
     `type` (default: cls.type or the class name). Its keys are read from the TOML table with the types of its
     defaults; instances are made as cls(**keys). replace=True first drops a class registered before from the same
@@ -304,22 +328,37 @@ class Controller(_redres.Controller):
         theta_dot, info = ctrl.step(theta, t, r_d, r_d_dot)   # or your own (reference_dim entries)
 
     Objectives and constraints are typed configurations (redres.objectives.*, redres.constraints.*) or instances of
-    Python subclasses of redres.Objective / redres.Constraint. The path is placed at the end effector's position at
-    theta0 (default: the robot's home). info is a redres.StepInfo: a step that does not solve has info.ok False and
-    a diagnosis; it does not raise. Controller.from_scenario(s) steps a loaded scenario's scheme. ctrl.qp is the last
+    Python subclasses of redres.Objective / redres.Constraint; tasks are typed configurations (redres.tasks.*, as
+    [[tasks]] in a scenario), each at a priority: with several priorities the step solves the levels in turn
+    (docs/tasks.md) and info.levels reports each. The path is placed at the end effector's position at theta0
+    (default: the robot's home). info is a redres.StepInfo: a step that does not solve has info.ok False and a
+    diagnosis; it does not raise. Controller.from_scenario(s) steps a loaded scenario's scheme. ctrl.qp is the last
     step's QP; ctrl.f, ctrl.r_d and ctrl.w its task values. The GIL is released during a step (taken again only for
     Python plugins)."""
 
-    def __init__(self, robot, objectives=(), constraints=(), engine="newton", path=None, T=1.0, tau=0.01,
-                 theta0=None):
-        """Builds the scheme from `objectives` and `constraints` (typed configurations or Python plugin instances)
-        for `robot` (a redres.Robot), the LVI engine (a name or a redres.engines.* configuration), and the optional
-        path (a redres.paths.* configuration, placed at f(theta0)); T is the task duration and tau the control step
-        (s), both visible to the plugins. Everything is sized here: step() allocates nothing."""
-        super().__init__(robot, list(objectives), list(constraints), engine, path, T, tau, theta0)
+    def __init__(self, robot: Robot, objectives: _Iterable[_Any] = (), constraints: _Iterable[_Any] = (),
+                 tasks: _Iterable[PluginConfig] = (), engine: _Union[str, PluginConfig] = "newton",
+                 path: PluginConfig | None = None, T: float = 1.0, tau: float = 0.01,
+                 theta0: _ArrayLike | None = None, level: str = "velocity", regularization: float | None = None,
+                 orientation_turn: _Union[float, _ArrayLike, None] = None) -> None:
+        """Builds the scheme for `robot` (a redres.Robot) from `objectives`, `constraints` (typed configurations or
+        Python plugin instances) and `tasks` (redres.tasks.* configurations), at `level` ('velocity' or
+        'acceleration'); the LVI engine (a name or a redres.engines.* configuration), and the optional path (a
+        redres.paths.* configuration, placed at f(theta0)). T is the task duration and tau the control step (s), both
+        visible to the plugins. regularization is the eps |x|^2 / 2 of every priority level (a scenario's [scheme]
+        regularization; default 1e-9); orientation_turn the rotation the end effector turns through over T (a
+        scenario's [orientation] turn: rad, a number for a planar robot, a rotation vector (3,) for a spatial one).
+        Everything is sized here: step() allocates nothing.
+
+        Unlike a scenario file, nothing is added for you: list JointAccelerationLimits() and JointJerkLimits() among
+        the constraints to hold a robot file's acceleration and jerk limits (a scenario adds them when it lists
+        none)."""
+        super().__init__(robot, list(objectives), list(constraints), engine=engine, path=path, T=T, tau=tau,
+                         theta0=theta0, level=level, tasks=list(tasks), regularization=regularization,
+                         orientation_turn=orientation_turn)
 
     @staticmethod
-    def from_scenario(scenario):
+    def from_scenario(scenario: Scenario) -> _redres.Controller:
         """The controller that `redres run` simulates for a loaded redres.Scenario: its scheme, engine and path, its
         orientation turn, and its [solver] on_infeasible policy (with "relax", the elastic QP). Same as
         scenario.controller()."""
@@ -336,28 +375,33 @@ class Comparison:
     columns = tuple(key for key, _ in _redres._comparison([])[0])  # comparison.csv's heading, in order
     headings = tuple(heading for _, heading in _redres._comparison([])[0])  # comparison.md's
 
-    def __init__(self, results):
-        self.results = list(results)
+    def __init__(self, results: _Iterable[Result]) -> None:
+        """Holds `results` (redres.Result objects) in the given order."""
+        self.results: list[Result] = list(results)
 
-    def __getitem__(self, name):
+    def __getitem__(self, name: str) -> Result:
+        """The run named `name` (its scenario's name); KeyError when there is none."""
         for r in self.results:
             if r.name == name:
                 return r
         raise KeyError(name)
 
-    def table(self):
+    def table(self) -> list[dict[str, _Any]]:
+        """One dict per run, keyed as comparison.csv's columns (Comparison.columns), numbers as numbers."""
         columns, rows, _ = _redres._comparison(self.results)
         keys = [key for key, _ in columns]
         return [dict(zip(keys, row)) for row in rows]
 
-    def markdown(self):
+    def markdown(self) -> str:
+        """comparison.md's table, with its headings (Comparison.headings), as `redres compare` writes it."""
         return _redres._comparison(self.results)[2]
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"<redres.Comparison of {len(self.results)} runs>"
 
 
-def compare(scenarios, overrides=None, jobs=None):
+def compare(scenarios: _Iterable[_Union[str, _os.PathLike[str], Scenario]],
+            overrides: _Mapping[str, _Any] | None = None, jobs: int | None = None) -> Comparison:
     """Runs several scenarios (paths or loaded redres.Scenario objects; `overrides` apply to those given as paths)
     on `jobs` threads (default: one per core, at most one per scenario) and returns a redres.Comparison. Every file
     is loaded before any run starts, so a bad one raises before anything runs."""
@@ -369,7 +413,8 @@ def compare(scenarios, overrides=None, jobs=None):
     return Comparison(results)
 
 
-def sweep(path, jobs=None, shard=None, out_dir=None):
+def sweep(path: _Union[str, _os.PathLike[str]], jobs: int | None = None, shard: str | None = None,
+          out_dir: _Union[str, _os.PathLike[str], None] = None) -> list[dict[str, _Any]]:
     """Runs a sweep file (docs/sweeps.md) as `redres sweep` does, on `jobs` threads (default: one per core) with the
     GIL released, and returns its table: a list of dicts, one per variation in variation order, with the axes'
     values, status, diagnosis and every summary figure, as Python values: numbers as int or float, flags as bool,
@@ -379,17 +424,17 @@ def sweep(path, jobs=None, shard=None, out_dir=None):
     return [dict(zip(columns, row)) for row in rows]
 
 
-def _result_summary(self):
+def _result_summary(self: Result) -> dict[str, _Any]:
     """summary.json of the run, as a dict (docs/output_formats.md)."""
     return _json.loads(self.summary_json)
 
 
-def _result_trajectory(self):
+def _result_trajectory(self: Result) -> dict[str, _np.ndarray]:
     """Every column as a dict of numpy arrays (views of the run's row-major table, no copy)."""
     return {name: self[name] for name in self.columns}
 
 
-Result.summary = property(_result_summary)
-Result.trajectory = property(_result_trajectory)
+setattr(Result, "summary", property(_result_summary))  # (setattr: mypy reads the stub's properties)
+setattr(Result, "trajectory", property(_result_trajectory))
 
 _refresh_namespaces()

@@ -22,6 +22,7 @@
 #include "python_plugins.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
+#include "redres/control/task.hpp"
 #include "redres/model/kinematics.hpp"
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/robot_toml.hpp"
@@ -36,6 +37,10 @@
 #include "redres/run/sweep.hpp"
 #include "redres/run/trajectory_columns.hpp"
 #include "types.hpp"
+
+#ifndef REDRES_VERSION
+#error "REDRES_VERSION (the project's version) is set by framework/python/CMakeLists.txt"
+#endif
 
 namespace redres::python {
 namespace {
@@ -284,30 +289,86 @@ toml::table spec_table(py::handle item, std::string& where) {
   return to_table(item.attr("_spec_table").cast<py::dict>(), where);
 }
 
+// A plugin configuration of `kind` ("objective", "constraint", "task") in a Controller's list `list`, or a clear
+// TypeError for one of another kind (e.g. an objective among the tasks, whose type the task registry would not know).
+void check_kind(py::handle item, const char* kind, const char* list, std::size_t index) {
+  const std::string got = py::str(item.attr("kind")).cast<std::string>();
+  if (got != kind) {
+    throw py::type_error("Controller: " + std::string(list) + "[" + std::to_string(index) + "] is " +
+                         py::repr(item).cast<std::string>() + " (kind '" + got + "'); expected a redres." + kind +
+                         "s.* configuration");
+  }
+}
+
+// The orientation turn of a Controller (as a scenario's [orientation] turn): a number about z for a planar robot, a
+// world-frame rotation vector (3,) for a spatial one.
+Eigen::Vector3d turn_of(const RobotModel& model, const py::handle& value) {
+  Eigen::Vector3d turn = Eigen::Vector3d::Zero();
+  if (model.kind() == ChainKind::kPlanar) {
+    if (!py::isinstance<py::float_>(value) && !py::isinstance<py::int_>(value)) {
+      throw py::type_error("Controller: orientation_turn of a planar robot is a number (rad, about z)");
+    }
+    turn.z() = value.cast<double>();
+  } else {
+    const auto v = value.cast<Eigen::VectorXd>();
+    if (v.size() != 3) {
+      throw std::invalid_argument("Controller: orientation_turn of a spatial robot has 3 entries, got " +
+                                  std::to_string(v.size()));
+    }
+    turn = v;
+  }
+  if (!turn.allFinite()) throw std::invalid_argument("Controller: orientation_turn is finite");
+  return turn;
+}
+
 std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::list& objectives,
                                               const py::list& constraints, py::object engine, py::object path, double T,
                                               double tau, std::optional<Eigen::VectorXd> theta0,
-                                              const std::string& level) {
+                                              const std::string& level, const py::list& tasks,
+                                              std::optional<double> regularization, py::object orientation_turn) {
   auto c = std::make_unique<PyController>();
   c->robot = robot.model;
   const RobotModel& model = *c->robot;
   std::vector<std::unique_ptr<Objective>> objs;
   std::vector<std::unique_ptr<Constraint>> cons;
+  std::vector<std::unique_ptr<Task>> tasks_made;
+  std::size_t index = 0;
   for (py::handle item : objectives) {
     std::string where;
+    if (is_spec(item)) check_kind(item, "objective", "objectives", index);
     objs.push_back(is_spec(item) ? make_objective_from(spec_table(item, where), where, model)
                                  : wrap_objective(py::reinterpret_borrow<py::object>(item), model));
+    ++index;
   }
+  index = 0;
   for (py::handle item : constraints) {
     std::string where;
+    if (is_spec(item)) check_kind(item, "constraint", "constraints", index);
     cons.push_back(is_spec(item) ? make_constraint_from(spec_table(item, where), where, model)
                                  : wrap_constraint(py::reinterpret_borrow<py::object>(item), model));
+    ++index;
+  }
+  index = 0;
+  for (py::handle item : tasks) {
+    if (!is_spec(item)) {
+      throw py::type_error("Controller: tasks[" + std::to_string(index) + "] is " + py::repr(item).cast<std::string>() +
+                           "; expected a redres.tasks.* configuration");
+    }
+    check_kind(item, "task", "tasks", index);
+    std::string where;
+    tasks_made.push_back(make_task_from(spec_table(item, where), where, model));
+    ++index;
   }
   if (level != "velocity" && level != "acceleration") {
     throw std::invalid_argument("Controller: expected level 'velocity' or 'acceleration', got '" + level + "'");
   }
-  c->scheme = std::make_unique<Scheme>(model, std::move(objs), std::move(cons),
+  if (regularization && !(*regularization > 0.0 && *regularization <= 1.0)) {
+    throw std::invalid_argument("Controller: regularization: expected a number in (0, 1], got " +
+                                std::to_string(*regularization));
+  }
+  c->scheme = std::make_unique<Scheme>(model, std::move(objs), std::move(cons), std::move(tasks_made),
                                        level == "velocity" ? SchemeLevel::kVelocity : SchemeLevel::kAcceleration);
+  if (regularization) c->scheme->set_regularization(*regularization);
   if (py::isinstance<py::str>(engine)) {
     c->engine = make_engine(engine.cast<std::string>());
   } else {
@@ -328,6 +389,7 @@ std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::li
     c->path = make_path(reader_of(t, where), pc);
   }
   c->controller = std::make_unique<Controller>(model, *c->scheme, *c->engine, c->path.get(), T, tau);
+  if (!orientation_turn.is_none()) c->controller->set_orientation_turn(turn_of(model, orientation_turn));
   c->out = c->controller->make_output();
   return c;
 }
@@ -417,6 +479,7 @@ py::list registry_listing() {
   py::list out;
   list_registry(objective_registry(), "objective", objective_common_keys(), out);
   list_registry(constraint_registry(), "constraint", constraint_common_keys(), out);
+  list_registry(task_registry(), "task", task_common_keys(), out);
   list_registry(path_registry(), "path", describe_keys(PathPlacement::schema()), out);
   list_registry(engine_registry(), "engine", solver_common_keys(), out);
   list_registry(velocity_limit_registry(), "velocity_limit", {}, out);
@@ -430,6 +493,8 @@ PYBIND11_MODULE(_redres, m) {
   using namespace redres;
   using namespace redres::python;
   m.doc() = "redres: redundancy resolution of redundant manipulators (the C++ core; use the `redres` package)";
+  // The version is written once, in the top-level CMakeLists.txt's project(); CMake passes it here.
+  m.attr("__version__") = REDRES_VERSION;
 
   auto& config_error = py::register_exception<ConfigError>(m, "ConfigError", PyExc_ValueError);
   config_error.doc() =
@@ -471,27 +536,36 @@ PYBIND11_MODULE(_redres, m) {
             return PyRobot{std::make_shared<const RobotModel>(load_robot(path))};
           },
           py::arg("path"), "Loads a robot TOML file; a bad file raises redres.ConfigError with file:line:col.")
-      .def_property_readonly("name", [](const PyRobot& r) { return r.model->name(); })
+      .def_property_readonly(
+          "name", [](const PyRobot& r) { return r.model->name(); }, "the robot's name (its file's `name`)")
       .def_property_readonly(
           "kind", [](const PyRobot& r) { return std::string(to_string(r.model->kind())); }, "'planar' or 'spatial'")
       .def_property_readonly(
           "dof", [](const PyRobot& r) { return r.model->dof(); }, "number of joints n")
       .def_property_readonly(
           "task_dim", [](const PyRobot& r) { return r.model->task_dim(); }, "task rows m")
-      .def_property_readonly("task_names", [](const PyRobot& r) { return r.model->task_names(); })
-      .def_property_readonly("reference_names", [](const PyRobot& r) { return r.model->reference_names(); })
-      .def_property_readonly("joint_names",
-                             [](const PyRobot& r) {
-                               std::vector<std::string> names;
-                               for (const auto& j : r.model->joints()) names.push_back(j.name);
-                               return names;
-                             })
+      .def_property_readonly(
+          "task_names", [](const PyRobot& r) { return r.model->task_names(); },
+          "the task rows' names, e.g. ['x', 'y', 'z'] (the rows of f and J)")
+      .def_property_readonly(
+          "reference_names", [](const PyRobot& r) { return r.model->reference_names(); },
+          "the reference rows' names (the entries of r_d and r_d_dot, and of StepContext.f)")
+      .def_property_readonly(
+          "joint_names",
+          [](const PyRobot& r) {
+            std::vector<std::string> names;
+            for (const auto& j : r.model->joints()) names.push_back(j.name);
+            return names;
+          },
+          "the joints' names, in order")
       .def_property_readonly(
           "lower_limits", [](const PyRobot& r) { return Eigen::VectorXd(r.model->lower_limits()); }, "theta^- (n,)")
       .def_property_readonly(
           "upper_limits", [](const PyRobot& r) { return Eigen::VectorXd(r.model->upper_limits()); }, "theta^+ (n,)")
-      .def_property_readonly("home", [](const PyRobot& r) { return Eigen::VectorXd(r.model->home()); })
-      .def_property_readonly("source", [](const PyRobot& r) { return r.model->source(); })
+      .def_property_readonly(
+          "home", [](const PyRobot& r) { return Eigen::VectorXd(r.model->home()); }, "the home configuration (n,)")
+      .def_property_readonly(
+          "source", [](const PyRobot& r) { return r.model->source(); }, "the file the robot was read from")
       .def(
           "kinematics", [](const PyRobot& r, const Eigen::VectorXd& theta) { return kinematics_of(r.model, theta); },
           py::arg("theta"),
@@ -515,20 +589,26 @@ PYBIND11_MODULE(_redres, m) {
                        "A finished run: the trajectory's columns as numpy arrays (views, no copy) and its summary.\n\n"
                        "result['theta_1'] is one column; result.columns lists them; result.summary is summary.json "
                        "as a dict; result.failures counts failed steps (a failed step is a status, not an exception).")
-      .def_property_readonly("columns", [](const PyResult& r) { return r.run->trajectory.columns(); })
-      .def("__getitem__",
-           [](py::object self, const std::string& name) {
-             const PyResult& r = self.cast<const PyResult&>();
-             const auto& cols = r.run->trajectory.columns();
-             const auto it = std::find(cols.begin(), cols.end(), name);
-             if (it == cols.end()) throw py::key_error("no column '" + name + "' in the trajectory");
-             return column_view(r.run->trajectory, static_cast<std::size_t>(it - cols.begin()), self);
-           })
-      .def("__contains__",
-           [](const PyResult& r, const std::string& name) {
-             const auto& cols = r.run->trajectory.columns();
-             return std::find(cols.begin(), cols.end(), name) != cols.end();
-           })
+      .def_property_readonly(
+          "columns", [](const PyResult& r) { return r.run->trajectory.columns(); },
+          "the trajectory's column names, in order (trajectory.csv's heading)")
+      .def(
+          "__getitem__",
+          [](py::object self, const std::string& name) {
+            const PyResult& r = self.cast<const PyResult&>();
+            const auto& cols = r.run->trajectory.columns();
+            const auto it = std::find(cols.begin(), cols.end(), name);
+            if (it == cols.end()) throw py::key_error("no column '" + name + "' in the trajectory");
+            return column_view(r.run->trajectory, static_cast<std::size_t>(it - cols.begin()), self);
+          },
+          py::arg("name"), "one column as a read-only numpy view (no copy); KeyError for an unknown name")
+      .def(
+          "__contains__",
+          [](const PyResult& r, const std::string& name) {
+            const auto& cols = r.run->trajectory.columns();
+            return std::find(cols.begin(), cols.end(), name) != cols.end();
+          },
+          py::arg("name"), "whether the trajectory has the column `name`")
       .def_property_readonly(
           "values",
           [](py::object self) {
@@ -541,19 +621,30 @@ PYBIND11_MODULE(_redres, m) {
             return a;
           },
           "every column, (rows, columns), row-major, a view")
-      .def_property_readonly("summary_json", [](const PyResult& r) { return to_json(*r.summary); })
-      .def_property_readonly("failures", [](const PyResult& r) { return r.run->failures; })
-      .def_property_readonly("first_failure", [](const PyResult& r) { return r.run->first_failure; })
-      .def_property_readonly("status", [](const PyResult& r) { return r.run->failures == 0 ? "ok" : "failed_steps"; })
-      .def_property_readonly("engine", [](const PyResult& r) { return r.run->engine(); })
-      .def_property_readonly("name", [](const PyResult& r) { return r.summary->name; })
+      .def_property_readonly(
+          "summary_json", [](const PyResult& r) { return to_json(*r.summary); },
+          "summary.json of the run, as text (Result.summary parses it)")
+      .def_property_readonly(
+          "failures", [](const PyResult& r) { return r.run->failures; }, "the number of failed steps")
+      .def_property_readonly(
+          "first_failure", [](const PyResult& r) { return r.run->first_failure; },
+          "when and why the first step failed (empty when none did)")
+      .def_property_readonly(
+          "status", [](const PyResult& r) { return r.run->failures == 0 ? "ok" : "failed_steps"; },
+          "'ok', or 'failed_steps' when a step failed")
+      .def_property_readonly(
+          "engine", [](const PyResult& r) { return r.run->engine(); }, "the LVI engine the run used")
+      .def_property_readonly(
+          "name", [](const PyResult& r) { return r.summary->name; }, "the scenario's name")
       .def_property_readonly(
           "final_theta",
           [](const PyResult& r) {
             return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
                 r.summary->final_theta.data(), static_cast<Eigen::Index>(r.summary->final_theta.size())));
-          })
-      .def_property_readonly("wall_time_s", [](const PyResult& r) { return r.run->wall_time_s; })
+          },
+          "theta at the end of the run (n,)")
+      .def_property_readonly(
+          "wall_time_s", [](const PyResult& r) { return r.run->wall_time_s; }, "how long the run took (s, wall clock)")
       .def(
           "write",
           [](const PyResult& r, const std::filesystem::path& dir, const std::string& record) {
@@ -567,7 +658,7 @@ PYBIND11_MODULE(_redres, m) {
                (r.run->failures == 0 ? std::string("ok") : std::to_string(r.run->failures) + " failed steps") + ">";
       });
 
-  py::class_<PyScenario>(m, "Scenario")
+  py::class_<PyScenario>(m, "Scenario", "A loaded scenario (redres.Scenario.load(path, overrides)).")
       .def_static(
           "_load",
           [](const std::filesystem::path& path,
@@ -575,20 +666,28 @@ PYBIND11_MODULE(_redres, m) {
             return PyScenario{std::make_shared<Scenario>(load_scenario(path, override_strings(o)))};
           },
           py::arg("path"), py::arg("overrides") = py::none())
-      .def_property_readonly("name", [](const PyScenario& s) { return s.scenario->name; })
-      .def_property_readonly("source", [](const PyScenario& s) { return s.scenario->source; })
-      .def_property_readonly("robot",
-                             [](const PyScenario& s) {
-                               return PyRobot{std::shared_ptr<const RobotModel>(s.scenario, s.scenario->robot.get())};
-                             })
-      .def_property_readonly("theta0", [](const PyScenario& s) { return Eigen::VectorXd(s.scenario->theta0); })
+      .def_property_readonly(
+          "name", [](const PyScenario& s) { return s.scenario->name; }, "the scenario's name")
+      .def_property_readonly(
+          "source", [](const PyScenario& s) { return s.scenario->source; }, "the file the scenario was read from")
+      .def_property_readonly(
+          "robot",
+          [](const PyScenario& s) {
+            return PyRobot{std::shared_ptr<const RobotModel>(s.scenario, s.scenario->robot.get())};
+          },
+          "its robot, with the task rows the scenario chose")
+      .def_property_readonly(
+          "theta0", [](const PyScenario& s) { return Eigen::VectorXd(s.scenario->theta0); },
+          "the start configuration (n,)")
       .def_property_readonly(
           "duration", [](const PyScenario& s) { return s.scenario->duration; }, "T (s)")
       .def_property_readonly(
           "step", [](const PyScenario& s) { return s.scenario->tau; }, "tau (s)")
       .def_property_readonly(
           "steps", [](const PyScenario& s) { return s.scenario->steps(); }, "N = T / tau")
-      .def_property_readonly("engine", [](const PyScenario& s) { return std::string(s.scenario->engine->name()); })
+      .def_property_readonly(
+          "engine", [](const PyScenario& s) { return std::string(s.scenario->engine->name()); },
+          "the LVI engine's name")
       .def("run", &run_scenario, py::arg("progress") = py::none(),
            "Runs the scenario from theta0 over [0, T] and returns a redres.Result. The GIL is released while it "
            "runs (Python threads can run other scenarios meanwhile); progress(fraction, t), if given, is called "
@@ -601,11 +700,11 @@ PYBIND11_MODULE(_redres, m) {
       });
 
   py::class_<LevelStepInfo>(m, "LevelInfo", "one priority level's outcome at a step (docs/tasks.md)")
-      .def_readonly("priority", &LevelStepInfo::priority)
+      .def_readonly("priority", &LevelStepInfo::priority, "the level's priority (0 the highest)")
       .def_readonly("status", &LevelStepInfo::status,
                     "'solved', 'relaxed' (its tasks in least squares), 'not_run' (skipped) or why it failed")
-      .def_readonly("iterations", &LevelStepInfo::iterations)
-      .def_readonly("residual", &LevelStepInfo::residual)
+      .def_readonly("iterations", &LevelStepInfo::iterations, "the engine's iterations at this level")
+      .def_readonly("residual", &LevelStepInfo::residual, "||e(u)||_2 of the level's LVI at its answer")
       .def_readonly("task_error", &LevelStepInfo::task_error, "the largest miss of its tasks' rows at the answer")
       .def_readonly("diagnosis", &LevelStepInfo::diagnosis, "why it was relaxed, skipped or failed")
       .def("__repr__", [](const LevelStepInfo& l) {
@@ -614,7 +713,7 @@ PYBIND11_MODULE(_redres, m) {
   py::class_<StepInfo>(m, "StepInfo", "One step's solver outcome.")
       .def_readonly("status", &StepInfo::status, "'solved', 'max_iterations', 'infeasible' or 'numerical_error'")
       .def_property_readonly("ok", &StepInfo::ok, "status == 'solved'")
-      .def_readonly("iterations", &StepInfo::iterations)
+      .def_readonly("iterations", &StepInfo::iterations, "the engine's iterations (all levels together)")
       .def_readonly("residual", &StepInfo::residual, "||e(u)||_2 of the LVI at the answer")
       .def_readonly("engine", &StepInfo::engine, "the engine that ran (a fallback names itself)")
       .def_readonly("diagnosis", &StepInfo::diagnosis, "empty when solved; else which joint, bound, row and plugin")
@@ -625,13 +724,17 @@ PYBIND11_MODULE(_redres, m) {
         return "<redres.StepInfo " + i.status + ", " + std::to_string(i.iterations) + " iterations>";
       });
 
-  py::class_<PyController>(m, "Controller")
+  py::class_<PyController>(m, "Controller",
+                           "The per-step API for a caller's own loop (use redres.Controller, which documents it).")
       .def(py::init(&make_controller), py::arg("robot"), py::arg("objectives"), py::arg("constraints"),
            py::arg("engine") = "newton", py::arg("path") = py::none(), py::arg("T") = 1.0, py::arg("tau") = 0.01,
-           py::arg("theta0") = py::none(), py::arg("level") = "velocity",
-           "Builds the scheme from the objectives and constraints for the robot, the engine (a name or an engine "
-           "configuration) and the optional path (placed at f(theta0)); T and tau in s. Sized here: step() "
-           "allocates nothing.")
+           py::arg("theta0") = py::none(), py::arg("level") = "velocity", py::arg("tasks") = py::list(),
+           py::arg("regularization") = py::none(), py::arg("orientation_turn") = py::none(),
+           "Builds the scheme from the objectives, constraints and tasks (their priorities make the levels) for the "
+           "robot, at `level` ('velocity' or 'acceleration'), the engine (a name or an engine configuration) and the "
+           "optional path (placed at f(theta0)); T and tau in s; regularization is the eps of every priority level "
+           "(default 1e-9); orientation_turn the rotation the end effector turns through over T (rad). Sized here: "
+           "step() allocates nothing.")
       .def("__repr__",
            [](py::handle p) {
              if (made(p) == nullptr) return std::string("<redres.Controller, never made>");
@@ -639,8 +742,9 @@ PYBIND11_MODULE(_redres, m) {
              const Controller& k = *c.controller;
              return "<redres.Controller robot '" + k.robot().name() + "', " + std::to_string(k.robot().dof()) +
                     " joints, " + std::to_string(k.scheme().objectives().size()) + " objectives, " +
-                    std::to_string(k.scheme().constraints().size()) + " constraints, engine '" +
-                    std::string(k.engine_name()) + "'>";
+                    std::to_string(k.scheme().constraints().size()) + " constraints, " +
+                    std::to_string(k.scheme().tasks().size()) + " tasks, engine '" + std::string(k.engine_name()) +
+                    "'>";
            })
       .def(
           "step",
@@ -738,11 +842,13 @@ PYBIND11_MODULE(_redres, m) {
             in_turn(c, "Controller.reset", [](Controller& k) { k.reset(); });
           },
           "Forgets the engine's warm start.")
-      .def_property_readonly("robot",
-                             [](py::handle p) {
-                               PyController& c = live(p);
-                               return PyRobot{c.robot};
-                             })
+      .def_property_readonly(
+          "robot",
+          [](py::handle p) {
+            PyController& c = live(p);
+            return PyRobot{c.robot};
+          },
+          "the robot the controller steps")
       .def_property_readonly(
           "r_d",
           [](py::handle p) {
@@ -750,12 +856,13 @@ PYBIND11_MODULE(_redres, m) {
             return in_turn(c, "Controller.r_d", [](Controller& k) { return Eigen::VectorXd(k.r_d()); });
           },
           "the last step's desired task coordinates")
-      .def_property_readonly("r_d_dot",
-                             [](py::handle p) {
-                               PyController& c = live(p);
-                               return in_turn(c, "Controller.r_d_dot",
-                                              [](Controller& k) { return Eigen::VectorXd(k.r_d_dot()); });
-                             })
+      .def_property_readonly(
+          "r_d_dot",
+          [](py::handle p) {
+            PyController& c = live(p);
+            return in_turn(c, "Controller.r_d_dot", [](Controller& k) { return Eigen::VectorXd(k.r_d_dot()); });
+          },
+          "the last step's desired task velocity")
       .def_property_readonly(
           "f",
           [](py::handle p) {
@@ -763,11 +870,13 @@ PYBIND11_MODULE(_redres, m) {
             return in_turn(c, "Controller.f", [](Controller& k) { return Eigen::VectorXd(k.kinematics().f); });
           },
           "the last step's task coordinates f(theta)")
-      .def_property_readonly("w",
-                             [](py::handle p) {
-                               PyController& c = live(p);
-                               return in_turn(c, "Controller.w", [](Controller& k) { return k.kinematics().w; });
-                             })
+      .def_property_readonly(
+          "w",
+          [](py::handle p) {
+            PyController& c = live(p);
+            return in_turn(c, "Controller.w", [](Controller& k) { return k.kinematics().w; });
+          },
+          "the last step's manipulability w = det(J J')")
       .def_property_readonly(
           "qp",
           [](py::handle p) {

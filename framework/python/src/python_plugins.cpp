@@ -336,6 +336,7 @@ void apply_common(py::handle instance, P& plugin) {
   if (py::hasattr(instance, "active")) plugin.set_active(instance.attr("active").cast<bool>());
   if constexpr (std::is_same_v<P, Objective>) {
     if (py::hasattr(instance, "weight")) plugin.set_weight(instance.attr("weight").cast<double>());
+    if (py::hasattr(instance, "priority")) plugin.set_priority(instance.attr("priority").cast<int>());
   }
 }
 
@@ -405,6 +406,10 @@ std::unique_ptr<Constraint> make_constraint_from(const toml::table& config, cons
   return make_constraint(reader_of(config, where), robot);
 }
 
+std::unique_ptr<Task> make_task_from(const toml::table& config, const std::string& where, const RobotModel& robot) {
+  return make_task(reader_of(config, where), robot);
+}
+
 void check_config(const std::string& kind, const toml::table& config, const std::string& where) {
   const TableReader r = reader_of(config, where);
   if (kind == "engine") {
@@ -436,6 +441,8 @@ void check_config(const std::string& kind, const toml::table& config, const std:
   } else if (kind == "constraint") {
     if (config.contains("weight")) r.fail("weight", "constraints are hard and have no weight");
     check(constraint_registry(), constraint_common_keys());
+  } else if (kind == "task") {
+    check(task_registry(), task_common_keys());
   } else if (kind == "path") {
     check(path_registry(), describe_keys(PathPlacement::schema()));
   } else {
@@ -581,8 +588,10 @@ void bind_python_plugins(py::module_& m) {
           "n", [](const StepQp& q) { return q.n; }, "number of joints")
       .def_property_readonly(
           "weight", [](const StepQp& q) { return q.get().weight(); }, "the objective's weight")
-      .def_property_readonly("equality_rows", [](const StepQp& q) { return q.eq_rows; })
-      .def_property_readonly("inequality_rows", [](const StepQp& q) { return q.in_rows; })
+      .def_property_readonly(
+          "equality_rows", [](const StepQp& q) { return q.eq_rows; }, "this constraint's equality rows (J x = d)")
+      .def_property_readonly(
+          "inequality_rows", [](const StepQp& q) { return q.in_rows; }, "this constraint's inequality rows (A x <= b)")
       .def(
           "add_identity", [](StepQp& q, double scale) { q.get().add_identity(scale); }, py::arg("scale") = 1.0,
           "W += weight * scale * I")

@@ -10,6 +10,7 @@
 #include <pybind11/pybind11.h>
 
 #include "redres/control/plugin.hpp"
+#include "redres/control/task.hpp"
 
 namespace redres::python {
 
@@ -52,6 +53,8 @@ std::unique_ptr<Objective> make_objective_from(const toml::table& config, const 
                                                const RobotModel& robot);
 std::unique_ptr<Constraint> make_constraint_from(const toml::table& config, const std::string& where,
                                                  const RobotModel& robot);
+/// A task from its typed configuration (a [[tasks]] entry; its mode, priority and weight among its keys).
+std::unique_ptr<Task> make_task_from(const toml::table& config, const std::string& where, const RobotModel& robot);
 /// Checks a configuration without a robot: the type exists, every key is one of its own or a common key, and every
 /// value has its type and obeys its rule (checks that need the robot, such as one value per joint, wait for it).
 void check_config(const std::string& kind, const toml::table& config, const std::string& where);

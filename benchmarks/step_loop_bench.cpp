@@ -65,7 +65,7 @@ void BM_PaperRun_Redres(benchmark::State& state, const char* engine, bool fresh)
 
 void BM_PaperRun_RedresNoRecord(benchmark::State& state) {
   Scenario s = paper_scenario("newton");
-  Controller ctrl(*s.robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
+  Controller ctrl(*s.robot, *s.scheme, s.engine.make(), s.path.get(), s.duration, s.tau);
   StepOutput out = ctrl.make_output();
   Eigen::VectorXd theta(s.robot->dof());
   const int steps = s.steps();

@@ -271,7 +271,7 @@ int validate_scenario(const RunOptions& options) {
   std::cout << opts->scenarios.front() << ": ok: '" << s.name << "', robot " << s.robot->name() << " ("
             << s.robot->dof() << " joints), " << s.steps() << " steps of " << s.tau << " s, path "
             << s.path->description() << ", " << s.scheme->objectives().size() << " objective(s), "
-            << s.scheme->constraints().size() << " constraint(s), engine " << s.engine->name() << "\n";
+            << s.scheme->constraints().size() << " constraint(s), engine " << s.engine.type << "\n";
   print_ik(s);
   if (s.plant.kind == PlantKind::kMujoco) {
     const auto substeps = std::lround(s.tau / s.plant.timestep);

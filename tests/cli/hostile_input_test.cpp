@@ -21,6 +21,7 @@
 #include "redres/model/velocity_limit.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
+#include "test_util.hpp"
 
 namespace redres {
 namespace {
@@ -32,11 +33,6 @@ std::string repeat(const std::string& s, int n, const std::string& sep) {
 }
 
 void write(const std::filesystem::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
-
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 // The first line of the CLI's output.
 std::string first_line(const std::string& out) { return out.substr(0, out.find('\n')); }
@@ -291,7 +287,9 @@ TEST(HostileInput, ANonFiniteVelocityLimitMidRunIsAFailedStepNotTheEndOfTheRun) 
     }
     const bool bad = run.trajectory(r, status) == static_cast<double>(static_cast<int>(SolverStatus::kInvalidProblem));
     EXPECT_EQ(bad, r >= first) << "row " << r;
-    if (r <= first) EXPECT_EQ(run.trajectory.at(r, "theta_1"), base.trajectory.at(r, "theta_1")) << "row " << r;
+    if (r <= first) {
+      EXPECT_EQ(run.trajectory.at(r, "theta_1"), base.trajectory.at(r, "theta_1")) << "row " << r;
+    }
     if (bad && r + 1 < run.trajectory.size()) {
       EXPECT_EQ(run.trajectory.at(r + 1, "theta_1"), run.trajectory.at(r, "theta_1"));
     }

@@ -23,14 +23,10 @@
 #include "redres/run/run_output.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
+#include "test_util.hpp"
 
 namespace redres {
 namespace {
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 std::set<std::string> names_in(const std::filesystem::path& dir) {
   std::set<std::string> names;
@@ -84,7 +80,7 @@ TEST(RunOutputs, AFileAnEarlierRunWroteAndThisOneDoesNotIsRemovedAndAUsersFileSt
   none.none = true;
   (void)write_run(*s.robot, run, summary, out, none);
   EXPECT_EQ(names_in(out), (std::set<std::string>{".redres-outputs", "summary.json", "notes.txt"}));
-  EXPECT_EQ(slurp(out / "notes.txt"), "mine");
+  EXPECT_EQ(read_text(out / "notes.txt"), "mine");
   EXPECT_EQ(read_output_manifest(out), std::vector<std::string>{"summary.json"});
 }
 
@@ -98,7 +94,7 @@ TEST(RunOutputs, AManifestNeverNamesAnythingOutsideItsDirectory) {
   Scenario s = load_scenario(short_scenario(dir / "in"));
   const RunResult run = simulate(s);
   (void)write_run(*s.robot, run, summarise(s, run), dir / "out");
-  EXPECT_EQ(slurp(dir / "victim.txt"), "keep");
+  EXPECT_EQ(read_text(dir / "victim.txt"), "keep");
 }
 
 TEST(RunOutputsCli, FiguresOfAnEarlierPlotsRunAreRemovedByARunWithoutPlots) {
@@ -123,7 +119,7 @@ TEST(RunOutputsCli, FiguresOfAnEarlierPlotsRunAreRemovedByARunWithoutPlots) {
   const Cli again = redres("run '" + file.string() + "' --out '" + out.string() + "' --quiet");
   ASSERT_EQ(again.code, 0) << again.out;
   for (const auto& f : figures) EXPECT_FALSE(std::filesystem::exists(out / f)) << f;
-  EXPECT_EQ(slurp(out / "my_plot.png"), "the user's");
+  EXPECT_EQ(read_text(out / "my_plot.png"), "the user's");
   EXPECT_TRUE(std::filesystem::exists(out / "trajectory.csv"));
 }
 
@@ -135,7 +131,7 @@ TEST(RunOutputsCli, OutIsCheckedBeforeTheRunStarts) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("--out " + (dir / "a_file").string() + ": exists and is not a directory"), std::string::npos)
       << r.out;
-  EXPECT_EQ(slurp(dir / "a_file"), "x");
+  EXPECT_EQ(read_text(dir / "a_file"), "x");
   const Cli p = redres("run '" + file.string() + "' --out /proc/version/out --quiet");
   EXPECT_EQ(p.code, 2) << p.out;
   EXPECT_NE(p.out.find("--out /proc/version/out: cannot create the directory"), std::string::npos) << p.out;
@@ -153,9 +149,9 @@ TEST(CompareCli, SameStemsGetTheirOwnDirectoriesAndNamesAreQuotedInTheCsv) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_TRUE(std::filesystem::exists(out / "x" / "summary.json"));
   EXPECT_TRUE(std::filesystem::exists(out / "x-2" / "summary.json"));
-  EXPECT_EQ(nlohmann::json::parse(slurp(out / "x" / "summary.json"))["name"], "circle, newton");
-  EXPECT_EQ(nlohmann::json::parse(slurp(out / "x-2" / "summary.json"))["name"], "circle \"b\"");
-  const std::string csv = slurp(out / "comparison.csv");
+  EXPECT_EQ(nlohmann::json::parse(read_text(out / "x" / "summary.json"))["name"], "circle, newton");
+  EXPECT_EQ(nlohmann::json::parse(read_text(out / "x-2" / "summary.json"))["name"], "circle \"b\"");
+  const std::string csv = read_text(out / "comparison.csv");
   // The name, then the label (no `label` in the files: the name), quoted the same way.
   EXPECT_NE(csv.find("\n\"circle, newton\",\"circle, newton\",newton,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("\n\"circle \"\"b\"\"\",\"circle \"\"b\"\"\",newton,"), std::string::npos) << csv;
@@ -218,15 +214,15 @@ TEST(SignalsCli, SigintEndsRunCompareAndSweepWithExitCode130) {
     const int code = interrupt_after({"run", paper, "--out", (dir / "run").string(), "--quiet", "--set", long_run_set(),
                                       "--set", "solver.engine=nlopt"},
                                      std::chrono::milliseconds(1500), dir / "run.log");
-    EXPECT_EQ(code, 130) << slurp(dir / "run.log");
-    EXPECT_EQ(nlohmann::json::parse(slurp(dir / "run" / "summary.json"))["status"], "interrupted");
+    EXPECT_EQ(code, 130) << read_text(dir / "run.log");
+    EXPECT_EQ(nlohmann::json::parse(read_text(dir / "run" / "summary.json"))["status"], "interrupted");
   }
   {
     const int code = interrupt_after({"compare", paper, paper, "--out", (dir / "compare").string(), "--quiet",
                                       "--no-plots", "--set", long_run_set(), "--set", "solver.engine=nlopt"},
                                      std::chrono::milliseconds(1500), dir / "compare.log");
-    EXPECT_EQ(code, 130) << slurp(dir / "compare.log");
-    EXPECT_EQ(nlohmann::json::parse(slurp(dir / "compare" / "paper_r_tvcmm" / "summary.json"))["status"],
+    EXPECT_EQ(code, 130) << read_text(dir / "compare.log");
+    EXPECT_EQ(nlohmann::json::parse(read_text(dir / "compare" / "paper_r_tvcmm" / "summary.json"))["status"],
               "interrupted");
     EXPECT_FALSE(std::filesystem::exists(dir / "compare" / "paper_r_tvcmm-2")) << "the second run started";
     EXPECT_TRUE(std::filesystem::exists(dir / "compare" / "comparison.csv"));
@@ -238,11 +234,11 @@ TEST(SignalsCli, SigintEndsRunCompareAndSweepWithExitCode130) {
     const int code = interrupt_after(
         {"sweep", (dir / "sweep.toml").string(), "--out", (dir / "sweep").string(), "--quiet", "--jobs", "1"},
         std::chrono::milliseconds(1500), dir / "sweep.log");
-    EXPECT_EQ(code, 130) << slurp(dir / "sweep.log");
-    const auto meta = nlohmann::json::parse(slurp(dir / "sweep" / "sweep.json"));
+    EXPECT_EQ(code, 130) << read_text(dir / "sweep.log");
+    const auto meta = nlohmann::json::parse(read_text(dir / "sweep" / "sweep.json"));
     EXPECT_EQ(meta["interrupted"], true);
     EXPECT_LT(meta["rows"].get<int>(), 4);
-    EXPECT_NE(slurp(dir / "sweep" / "sweep.csv").find("interrupted"), std::string::npos);
+    EXPECT_NE(read_text(dir / "sweep" / "sweep.csv").find("interrupted"), std::string::npos);
   }
 }
 

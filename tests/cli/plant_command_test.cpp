@@ -13,16 +13,10 @@
 
 #include "cli_util.hpp"
 #include "redres/plant/mujoco_model.hpp"
+#include "test_util.hpp"
 
 namespace redres {
 namespace {
-
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 TEST(PlantCommand, AMujocoScenarioRunsOrNamesThePackageToInstall) {
   const std::filesystem::path out = scratch("plant_run");

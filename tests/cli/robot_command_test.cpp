@@ -51,7 +51,9 @@ TEST(RobotCommand, TheJsonGivesPosesAndTheSelfDistancesNearestFirst) {
       EXPECT_TRUE(shape["side_branch"].get<bool>());
       EXPECT_EQ(shape["joint_name"], "panda_joint7");
     }
-    if (shape["link"] == "panda_hand") EXPECT_FALSE(shape["side_branch"].get<bool>());
+    if (shape["link"] == "panda_hand") {
+      EXPECT_FALSE(shape["side_branch"].get<bool>());
+    }
     // Every shape: its kind, pose (xyz, rpy in the link frame) and the mesh it was fitted to.
     EXPECT_EQ(shape["kind"], "capsule");
     EXPECT_EQ(shape["rpy"].size(), 3u);

@@ -122,9 +122,8 @@ inline constexpr std::chrono::milliseconds kRunBudget{200};
 /// the scheme and the solver are the ones the file asked for), kMaxSolverIterations per solve, and kRunBudget.
 inline RunResult run_briefly(Scenario& scenario, int max_steps) {
   scenario.duration = std::min(scenario.duration, max_steps * scenario.tau);
-  SolverSettings settings = scenario.engine->settings();
-  settings.max_iterations = std::min(settings.max_iterations, kMaxSolverIterations);
-  scenario.engine->set_settings(settings);  // before simulate(): the engines set up their fallbacks from it
+  // Before simulate(): each run's engine, and its fallbacks, are made from the scenario's settings.
+  scenario.engine.settings.max_iterations = std::min(scenario.engine.settings.max_iterations, kMaxSolverIterations);
   std::atomic<bool> stop{false};
   const auto start = std::chrono::steady_clock::now();
   RunResult run;

@@ -26,6 +26,13 @@ def test_every_registered_plugin_has_a_typed_configuration():
     assert "schedule" in redres.objectives.Manipulability.__doc__
     kinds = {e["kind"] for e in redres.plugins()}
     assert kinds == {"objective", "constraint", "task", "path", "engine", "velocity_limit"}
+    # One namespace per kind of the library's table of kinds, and the same plugins as `redres plugins --json` lists.
+    for kind in kinds:
+        plural = kind + "s"
+        assert isinstance(getattr(redres, plural), type(redres)), plural
+        assert plural in redres.__all__
+        built_in = {e["type"] for e in redres.plugins(kind) if e["origin"] == "built-in"}
+        assert {e["type"] for e in listed[plural] if e["origin"] == "built-in"} == built_in
 
 
 def test_bad_typed_configurations_raise_naming_the_key():

@@ -145,13 +145,13 @@ inline ReferenceSolution solve_lexicographic(const ReferenceProblem& p, const Ei
     std::mt19937 rng(static_cast<unsigned>(out.at.size()) * 7919U + 17U);
     std::uniform_real_distribution<double> jitter(-0.5, 0.5);
     for (int start = 0; start < 4; ++start) {
-      Eigen::VectorXd x0 = start == 1 ? Eigen::VectorXd::Zero(n) : x;
-      if (start >= 2) x0 += Eigen::VectorXd::NullaryExpr(n, [&] { return jitter(rng); });
-      x0 = x0.cwiseMax(p.lo).cwiseMin(p.hi);
+      Eigen::VectorXd x_start = start == 1 ? Eigen::VectorXd::Zero(n) : x;
+      if (start >= 2) x_start += Eigen::VectorXd::NullaryExpr(n, [&] { return jitter(rng); });
+      x_start = x_start.cwiseMax(p.lo).cwiseMin(p.hi);
       std::vector<double> w(static_cast<std::size_t>(nv), 0.0);
-      std::copy(x0.data(), x0.data() + n, w.begin());
+      std::copy(x_start.data(), x_start.data() + n, w.begin());
       if (k > 0) {
-        const Eigen::VectorXd s0 = (level.G * x0 - level.h).cwiseMax(0.0);
+        const Eigen::VectorXd s0 = (level.G * x_start - level.h).cwiseMax(0.0);
         std::copy(s0.data(), s0.data() + k, w.begin() + n);
       }
       double fw = 0.0;

@@ -64,7 +64,7 @@ __version__: str = _redres.__version__
 __all__ = [
     "ConfigError", "Constraint", "Controller", "Kinematics", "LevelInfo", "Objective", "PluginConfig", "Result",
     "Robot", "Scenario", "StepContext", "StepInfo", "StepQp", "Comparison", "check_plugins", "compare", "constraints",
-    "engines", "mujoco_available", "objectives", "paths", "plugins", "register", "sweep", "tasks",
+    "engines", "mujoco_available", "objectives", "paths", "plugins", "register", "sweep", "tasks", "velocity_limits",
     "trajectory_column_groups",
 ]
 
@@ -197,18 +197,30 @@ def _config_class(entry):
     return cls
 
 
-def _namespace(kind, title):
-    module = _types.ModuleType(f"redres.{kind}s", f"{title}: typed configurations of the registered {kind}s.")
+# The namespaces of typed configurations, one per plugin kind of the library's one table of kinds
+# (extend/plugin_kinds.hpp): redres.objectives, redres.constraints, redres.tasks, ...
+_KINDS = {k["plural"]: k for k in _redres._plugin_kinds()}
+
+
+def _namespace(plural: str) -> _types.ModuleType:
+    kind = _KINDS[plural]
+    module = _types.ModuleType(f"redres.{plural}", f"Typed configurations of the registered {plural.replace('_', '-')}: "
+                                                   f"{kind['heading']}.")
     _sys.modules[module.__name__] = module
     return module
 
 
-objectives = _namespace("objective", "Objectives")
-constraints = _namespace("constraint", "Constraints")
-tasks = _namespace("task", "Tasks (rows on a frame or the joints, each hard, soft or an inequality, at a priority)")
-paths = _namespace("path", "Paths")
-engines = _namespace("engine", "LVI engines")
-_namespaces = {"objective": objectives, "constraint": constraints, "task": tasks, "path": paths, "engine": engines}
+objectives = _namespace("objectives")
+constraints = _namespace("constraints")
+tasks = _namespace("tasks")
+velocity_limits = _namespace("velocity_limits")
+paths = _namespace("paths")
+engines = _namespace("engines")
+_namespaces = {_KINDS[m.__name__.split(".")[1]]["kind"]: m
+               for m in (objectives, constraints, tasks, velocity_limits, paths, engines)}
+if {m.__name__.split(".")[1] for m in _namespaces.values()} != set(_KINDS):
+    raise ImportError("redres: the Python namespaces are not the library's plugin kinds "
+                      f"({sorted(_KINDS)}): add the new kind's namespace to redres/__init__.py")
 
 
 def _refresh_namespaces():

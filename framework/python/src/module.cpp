@@ -23,6 +23,7 @@
 #include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
 #include "redres/control/task.hpp"
+#include "redres/extend/plugin_kinds.hpp"
 #include "redres/model/kinematics.hpp"
 #include "redres/model/velocity_limit.hpp"
 #include "redres/parsers/robot_toml.hpp"
@@ -455,34 +456,42 @@ py::dict key_dict(const KeyInfo& k) {
   return d;
 }
 
-template <class Reg>
-void list_registry(const Reg& registry, const std::string& kind, const std::vector<KeyInfo>& common, py::list& out) {
-  for (const auto* e : registry.entries()) {
-    py::dict d;
-    d["kind"] = kind;
-    d["type"] = e->type;
-    d["summary"] = e->summary;
-    d["origin"] = e->origin;
-    py::list keys, common_keys;
-    for (const auto& k : e->keys) keys.append(key_dict(k));
-    for (const auto& k : common) common_keys.append(key_dict(k));
-    d["keys"] = keys;
-    d["common_keys"] = common_keys;
-    py::list groups;
-    for (const auto& [g, what] : e->groups) groups.append(py::make_tuple(g, what));
-    d["groups"] = groups;
-    out.append(d);
-  }
-}
-
+// Every registered plugin of every kind of the one table of kinds (extend/plugin_kinds.hpp).
 py::list registry_listing() {
   py::list out;
-  list_registry(objective_registry(), "objective", objective_common_keys(), out);
-  list_registry(constraint_registry(), "constraint", constraint_common_keys(), out);
-  list_registry(task_registry(), "task", task_common_keys(), out);
-  list_registry(path_registry(), "path", describe_keys(PathPlacement::schema()), out);
-  list_registry(engine_registry(), "engine", solver_common_keys(), out);
-  list_registry(velocity_limit_registry(), "velocity_limit", {}, out);
+  for (const PluginKind& kind : plugin_kinds()) {
+    py::list common_keys;
+    for (const auto& k : kind.common_keys()) common_keys.append(key_dict(k));
+    for (const PluginEntryInfo& e : kind.entries()) {
+      py::dict d;
+      d["kind"] = kind.id;
+      d["type"] = e.type;
+      d["summary"] = e.summary;
+      d["origin"] = e.origin;
+      py::list keys;
+      for (const auto& k : e.keys) keys.append(key_dict(k));
+      d["keys"] = keys;
+      d["common_keys"] = common_keys;
+      py::list groups;
+      for (const auto& [g, what] : e.groups) groups.append(py::make_tuple(g, what));
+      d["groups"] = groups;
+      out.append(d);
+    }
+  }
+  return out;
+}
+
+// The table of kinds itself: each kind's id, its namespace (plural) and where files name it.
+py::list kinds_listing() {
+  py::list out;
+  for (const PluginKind& kind : plugin_kinds()) {
+    py::dict d;
+    d["kind"] = kind.id;
+    d["plural"] = kind.plural;
+    d["name"] = kind.name;
+    d["heading"] = kind.heading;
+    out.append(d);
+  }
   return out;
 }
 
@@ -686,8 +695,7 @@ PYBIND11_MODULE(_redres, m) {
       .def_property_readonly(
           "steps", [](const PyScenario& s) { return s.scenario->steps(); }, "N = T / tau")
       .def_property_readonly(
-          "engine", [](const PyScenario& s) { return std::string(s.scenario->engine->name()); },
-          "the LVI engine's name")
+          "engine", [](const PyScenario& s) { return s.scenario->engine.type; }, "the LVI engine's name")
       .def("run", &run_scenario, py::arg("progress") = py::none(),
            "Runs the scenario from theta0 over [0, T] and returns a redres.Result. The GIL is released while it "
            "runs (Python threads can run other scenarios meanwhile); progress(fraction, t), if given, is called "
@@ -955,6 +963,7 @@ PYBIND11_MODULE(_redres, m) {
       "The standard columns of trajectory.csv (and of a Result), group by group: name (or prefix), count ('1', "
       "'n' per joint, 'm_ref' per reference row), unit and meaning; the same list the C++ run fills its rows from.");
   m.def("_registry", &registry_listing);
+  m.def("_plugin_kinds", &kinds_listing);
   m.def(
       "mujoco_available", [] { return mujoco_available(); },
       "Whether this build of redres has the MuJoCo plant ([plant] kind = \"mujoco\"; docs/plant.md).");

@@ -13,6 +13,18 @@
 
 namespace redres {
 
+Controller::Controller(const RobotModel& robot, const Scheme& scheme, std::unique_ptr<LviEngine> engine,
+                       const Path* path, double T, double tau)
+    : Controller(
+          robot, scheme,
+          *[&]() -> LviEngine* {
+            REDRES_REQUIRE(engine != nullptr, "Controller", "an engine (not null)");
+            return engine.get();
+          }(),
+          path, T, tau) {
+  own_engine_ = std::move(engine);
+}
+
 Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine& engine, const Path* path, double T,
                        double tau)
     : robot_(&robot),

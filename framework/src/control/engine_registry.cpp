@@ -29,7 +29,7 @@ const std::vector<KeyInfo>& solver_common_keys() {
   return keys;
 }
 
-std::unique_ptr<LviEngine> make_engine(const TableReader& solver) {
+EngineSpec read_engine_spec(const TableReader& solver) {
   EngineChoice choice;
   read_config(solver, EngineChoice::schema(), choice);
   const EngineRegistry& reg = engine_registry();
@@ -39,15 +39,29 @@ std::unique_ptr<LviEngine> make_engine(const TableReader& solver) {
     for (const auto* e : reg.entries()) names += (names.empty() ? "'" : ", '") + e->type + "'";
     solver.fail("engine", "expected one of " + names + ", got '" + choice.engine + "'");
   }
-  SolverSettings s;
-  read_config(solver, SolverSettings::schema(), s);
-  const std::any config = entry->read(solver);
+  EngineSpec spec;
+  spec.type = choice.engine;
+  read_config(solver, SolverSettings::schema(), spec.settings);
+  spec.config = entry->read(solver);
   solver.finish();
   try {
-    return entry->make(config, s);
+    (void)entry->make(spec.config, spec.settings);  // what make() will build, checked here, at the file's place
   } catch (const FieldError& e) {
     rethrow_at(solver, e);
   }
+  return spec;
+}
+
+std::unique_ptr<LviEngine> make_engine(const TableReader& solver) { return read_engine_spec(solver).make(); }
+
+std::unique_ptr<LviEngine> EngineSpec::make() const {
+  if (!config.has_value()) return make_engine(type, settings);
+  const auto* e = engine_registry().find(type);
+  if (e == nullptr) {
+    throw std::invalid_argument("EngineSpec::make: unknown engine '" + type +
+                                "'; known engines: " + engine_registry().names_like(type));
+  }
+  return engine_registry().create(type, config, settings);
 }
 
 std::unique_ptr<LviEngine> make_engine(const std::string& name, const SolverSettings& settings) {

@@ -12,8 +12,8 @@ FailurePolicy failure_policy_from_name(std::string_view name) {
   for (const auto& [policy, n] : enum_names(FailurePolicy{})) {
     if (n == name) return policy;
   }
-  throw std::invalid_argument("expected a failure policy, one of " + config_io::enum_choices<FailurePolicy>() + ", got '" +
-                              std::string(name) + "'");
+  throw std::invalid_argument("expected a failure policy, one of " + config_io::enum_choices<FailurePolicy>() +
+                              ", got '" + std::string(name) + "'");
 }
 
 std::string_view failure_policy_name(FailurePolicy policy) { return config_io::enum_name(policy); }

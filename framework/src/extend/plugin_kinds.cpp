@@ -37,6 +37,7 @@ PluginKind kind(std::string name, std::string plural, std::string heading, std::
   PluginKind k;
   k.name = std::move(name);
   k.plural = std::move(plural);
+  k.id = k.plural.substr(0, k.plural.size() - 1);  // "objectives" -> "objective"
   k.heading = std::move(heading);
   k.common_json = std::move(common_json);
   k.common_heading = std::move(common_heading);

@@ -4,10 +4,10 @@
 
 namespace redres {
 
-std::unique_ptr<Controller> Controller::from_scenario(Scenario& s) {
-  REDRES_REQUIRE(s.robot && s.scheme && s.engine, "Controller::from_scenario",
-                 "the scenario has a robot, a scheme and an engine (as load_scenario makes it)");
-  auto ctrl = std::make_unique<Controller>(*s.robot, *s.scheme, *s.engine, s.path.get(), s.duration, s.tau);
+std::unique_ptr<Controller> Controller::from_scenario(const Scenario& s) {
+  REDRES_REQUIRE(s.robot && s.scheme, "Controller::from_scenario",
+                 "the scenario has a robot and a scheme (as load_scenario makes it)");
+  auto ctrl = std::make_unique<Controller>(*s.robot, *s.scheme, s.engine.make(), s.path.get(), s.duration, s.tau);
   ctrl->set_orientation_turn(s.orientation_turn);
   ctrl->set_kinematics_level(KinematicsLevel::kGradient);
   ctrl->set_failure_policy(s.on_infeasible, s.relax_weight, s.recover_error);

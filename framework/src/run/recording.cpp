@@ -28,6 +28,10 @@ Eigen::Vector3d continuous_rotation_vector(const Eigen::Vector3d& w, const Eigen
 }  // namespace
 
 std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders) {
+  return run_columns(s, recorders, s.plant.kind);
+}
+
+std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders, PlantKind plant) {
   std::vector<std::string> columns = standard_trajectory_columns(*s.robot);
   const auto add_recorder = [&](const Plugin& p, std::size_t objective, std::size_t constraint,
                                 std::size_t task = kNoPlugin) {
@@ -55,7 +59,7 @@ std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* r
       columns.push_back("level_" + std::to_string(level.priority) + "_iterations");
     }
   }
-  if (s.plant.kind == PlantKind::kMujoco) {
+  if (plant == PlantKind::kMujoco) {
     for (auto& c : plant_columns(s.robot->dof())) columns.push_back(std::move(c));
   }
   return columns;

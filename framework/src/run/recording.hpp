@@ -32,8 +32,10 @@ inline constexpr std::size_t kNoPlugin = static_cast<std::size_t>(-1);
 /// The columns a run of `s` records: the standard ones, then the plugins' own (a name that an earlier plugin took
 /// is "<plugin>.<column>"), with each recording plugin (its data not yet known) when `recorders` is given, then, for a
 /// scheme with several priority levels, level_<p>_status and level_<p>_iterations per level (priority p), then the
-/// MuJoCo plant's (plant_columns()) when the scenario runs on it.
+/// MuJoCo plant's (plant_columns()) when the run is on it (`plant`, by default the scenario's).
 [[nodiscard]] std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders);
+[[nodiscard]] std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders,
+                                                   PlantKind plant);
 
 /// The columns the MuJoCo plant adds at the end of a row: measured_theta_dot_1..n, torque_1..n, contacts,
 /// penetration.

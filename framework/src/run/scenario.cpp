@@ -460,7 +460,7 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                  const bool limits = s.robot->has_acceleration_limits();
                  s.on_infeasible = limits ? FailurePolicy::kBrake : FailurePolicy::kHold;
                  if (!r.has("solver")) {
-                   s.engine = make_engine("projection");
+                   s.engine = EngineSpec{};  // projection, with the default settings
                    return;
                  }
                  const TableReader t = r.table("solver");
@@ -500,7 +500,7 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                    solver.fail("recover_error",
                                "is used only with on_infeasible = \"brake\" (on_infeasible is \"" + chosen + "\")");
                  }
-                 s.engine = make_engine(solver);
+                 s.engine = read_engine_spec(solver);
                }),
       entry<C>("orientation", "table [orientation]", "", "none",
                "the end effector's orientation reference, for a pose task (below)",

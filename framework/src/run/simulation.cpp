@@ -20,13 +20,20 @@ std::string RunResult::engine() const {
   return out;
 }
 
-RunResult simulate(Scenario& s, const ProgressCallback& progress) {
+RunResult simulate(const Scenario& s, const ProgressCallback& progress) {
   RunResult run;
   simulate(s, run, progress);
   return run;
 }
 
 namespace {
+
+// Every field of `run` as a new run has it, but the table's storage (reused when it has room).
+void reset_run(RunResult& run) {
+  Trajectory storage = std::move(run.trajectory);
+  run = RunResult{};
+  run.trajectory = std::move(storage);
+}
 
 // Integrates one step from theta at t with the step's solution `out`: Euler's method, or Heun's (one more QP, at the
 // Euler prediction, into `out2`); at the acceleration level the step's constant acceleration exactly. `velocity` is
@@ -165,22 +172,18 @@ double column_max(const Trajectory& tr, const std::string& name) {
 
 // A run on the MuJoCo plant (docs/plant.md, "The plant"): each control step reads the measured state, solves, and
 // holds the command over the plant's MuJoCo steps.
-void simulate_plant(Scenario& s, RunResult& run, const ProgressCallback& progress, const std::atomic<bool>* stop) {
+void simulate_kinematic(const Scenario& s, RunResult& run, const ProgressCallback& progress,
+                        const std::atomic<bool>* stop);
+
+void simulate_plant(const Scenario& s, RunResult& run, const ProgressCallback& progress,
+                    const std::atomic<bool>* stop) {
   const int steps = s.steps();
   const int n = s.robot->dof();
   PlantFacts facts;
   {
     // The same scenario on the kinematic plant, for the kinematic-vs-dynamic error.
-    const PlantConfig plant = s.plant;
-    s.plant.kind = PlantKind::kKinematic;
     RunResult kinematic;
-    try {
-      simulate(s, kinematic, {}, stop);
-    } catch (...) {
-      s.plant = plant;
-      throw;
-    }
-    s.plant = plant;
+    simulate_kinematic(s, kinematic, {}, stop);
     facts.kinematic_max_position_error = column_max(kinematic.trajectory, "position_error");
   }
   std::vector<Recorder> recorders;
@@ -257,22 +260,32 @@ void simulate_plant(Scenario& s, RunResult& run, const ProgressCallback& progres
 
 }  // namespace
 
-void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, const std::atomic<bool>* stop) {
-  const int steps = s.steps();
-  {
-    Trajectory storage = std::move(run.trajectory);  // every field as a new run has it, but the table's storage
-    run = RunResult{};
-    run.trajectory = std::move(storage);
-  }
-  std::vector<Recorder> recorders;
-  std::vector<std::string> columns = run_columns(s, &recorders);
-  REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
-                 "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
-                     std::to_string(columns.size()) + " columns do not)");
+void simulate(const Scenario& s, RunResult& run, const ProgressCallback& progress, const std::atomic<bool>* stop) {
   if (s.plant.kind == PlantKind::kMujoco) {
+    reset_run(run);
+    std::vector<Recorder> recorders;
+    const std::vector<std::string> columns = run_columns(s, &recorders);
+    const int steps = s.steps();
+    REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
+                   "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
+                       std::to_string(columns.size()) + " columns do not)");
     simulate_plant(s, run, progress, stop);
     return;
   }
+  simulate_kinematic(s, run, progress, stop);
+}
+
+namespace {
+
+void simulate_kinematic(const Scenario& s, RunResult& run, const ProgressCallback& progress,
+                        const std::atomic<bool>* stop) {
+  const int steps = s.steps();
+  reset_run(run);
+  std::vector<Recorder> recorders;
+  std::vector<std::string> columns = run_columns(s, &recorders, PlantKind::kKinematic);
+  REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
+                 "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
+                     std::to_string(columns.size()) + " columns do not)");
   run.trajectory.reset(std::move(columns), static_cast<std::size_t>(steps) + 1);
   run.engines.reserve(4);
 
@@ -299,5 +312,7 @@ void simulate(Scenario& s, RunResult& run, const ProgressCallback& progress, con
   run.trajectory.publish();
   run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
+
+}  // namespace
 
 }  // namespace redres

@@ -73,7 +73,7 @@ std::string StartReport::text() const {
 StartError::StartError(StartReport report)
     : std::runtime_error("the start is not usable:\n" + report.text()), report_(std::move(report)) {}
 
-StartReport check_start(Scenario& s) {
+StartReport check_start(const Scenario& s) {
   const auto start = std::chrono::steady_clock::now();
   StartReport report;
   const RobotModel& robot = *s.robot;
@@ -142,7 +142,7 @@ StartReport check_start(Scenario& s) {
   return report;
 }
 
-void require_good_start(Scenario& s) {
+void require_good_start(const Scenario& s) {
   StartReport report = check_start(s);
   if (!report.ok()) throw StartError(std::move(report));
 }

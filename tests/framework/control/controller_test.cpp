@@ -316,7 +316,9 @@ TEST(OrientationReference, AngularAccelerationIsTheDerivativeOfTheAngularVelocit
       // r_d_dot's rows are the world angular velocity of r_d's rotation: R(t+h) R(t-h)^T = exp(2h [omega]).
       const Eigen::AngleAxisd step(rotation(rp) * rotation(rm).transpose());
       const Eigen::Vector3d omega = step.angle() * step.axis() / (2 * h);
-      worst_omega = std::max(worst_omega, (omega.tail(rest) - v.tail(rest)).cwiseAbs().maxCoeff());
+      for (int i = 0; i < rest; ++i) {  // the last `rest` entries of each (an element loop: GCC 12 misreads tail())
+        worst_omega = std::max(worst_omega, std::abs(omega(3 - rest + i) - v(v.size() - rest + i)));
+      }
     }
     // |a| <= |turn| 2 pi / T^2 (~0.16 rad/s^2 at most here); the differences' error is O(h^2) and roundoff ~1e-11.
     EXPECT_GT(peak, 0.9 * c.turn.tail(rest).cwiseAbs().maxCoeff() * 2.0 * M_PI / (T * T));

@@ -434,11 +434,6 @@ int run_cli(const std::string& args, const std::filesystem::path& out, const std
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 TEST(OnInfeasibleCli, TheDiagnosisGoesToStderrWithQuietAndTheExitCodeFollowsThePolicy) {
   const auto file = write_scenario("policy_cli", kStretched);
   const auto dir = file.parent_path();
@@ -446,7 +441,7 @@ TEST(OnInfeasibleCli, TheDiagnosisGoesToStderrWithQuietAndTheExitCodeFollowsTheP
   for (const char* policy : {"hold", "stop"}) {
     // The stretched start is singular for the task: refused before the run (exit 2), with a way out.
     int code = run_cli(base + " --set solver.on_infeasible=" + policy, dir / "stdout", dir / "stderr");
-    std::string err = slurp(dir / "stderr");
+    std::string err = read_text(dir / "stderr");
     EXPECT_EQ(code, 2) << policy << ": " << err;
     EXPECT_NE(err.find("is singular for the task"), std::string::npos) << err;
     EXPECT_NE(err.find("relax"), std::string::npos) << err;
@@ -454,17 +449,17 @@ TEST(OnInfeasibleCli, TheDiagnosisGoesToStderrWithQuietAndTheExitCodeFollowsTheP
     code = run_cli(
         base + " --set solver.on_infeasible=" + policy + " --set 'theta0=[0, 0.5, 0.5, 0.5]' --set duration=0.1",
         dir / "stdout", dir / "stderr");
-    err = slurp(dir / "stderr");
+    err = read_text(dir / "stderr");
     EXPECT_EQ(code, 1) << policy << ": " << err;
-    EXPECT_EQ(slurp(dir / "stdout"), "") << policy;
+    EXPECT_EQ(read_text(dir / "stdout"), "") << policy;
     EXPECT_NE(err.find("failed step"), std::string::npos) << err;
     EXPECT_NE(err.find("first failure: t = 0.02 s: infeasible"), std::string::npos) << err;
     EXPECT_NE(err.find("on_infeasible = \"" + std::string(policy) + "\""), std::string::npos) << err;
   }
   const int code = run_cli(base + " --set solver.on_infeasible=relax", dir / "stdout", dir / "stderr");
-  EXPECT_EQ(code, 0) << slurp(dir / "stderr");
-  EXPECT_EQ(slurp(dir / "stderr"), "");
-  EXPECT_EQ(slurp(dir / "stdout"), "");
+  EXPECT_EQ(code, 0) << read_text(dir / "stderr");
+  EXPECT_EQ(read_text(dir / "stderr"), "");
+  EXPECT_EQ(read_text(dir / "stdout"), "");
 }
 
 // Under relax, a robot without acceleration limits holds where the elastic QP fails too: it cannot brake (nothing

@@ -317,7 +317,9 @@ TEST(NoVelocityJump, EveryShippedScenarioAndForcedFailures) {
       SCOPED_TRACE(entry.path().filename().string() + (forced ? " (forced failures)" : ""));
       EXPECT_EQ(run.steps_over_acceleration_limit, 0);
       for (double v : run.max_joint_acceleration_violation) EXPECT_LE(v, 1e-9);
-      if (forced) EXPECT_GT(run.braked_steps, 0);
+      if (forced) {
+        EXPECT_GT(run.braked_steps, 0);
+      }
       ++checked;
     }
   }

@@ -45,8 +45,6 @@ Loop run_loop(Controller& ctrl, const Eigen::VectorXd& theta0, double tau, int s
   return loop;
 }
 
-std::unique_ptr<LviEngine> engine_like(const LviEngine& e) { return make_engine(std::string(e.name()), e.settings()); }
-
 void expect_bit_identical(const Loop& a, const Loop& b, const char* what) {
   ASSERT_EQ(a.values.size(), b.values.size()) << what;
   EXPECT_EQ(a.failures, b.failures) << what;
@@ -69,7 +67,7 @@ TEST_P(SharedScheme, TwoControllersInTwoThreadsGiveWhatOneGivesAlone) {
   if (std::string(GetParam()) == "paper_r_moving_obstacle") overrides.push_back("constraints.3.broadphase=\"never\"");
   Scenario s = load_scenario(source_path(std::string("configs/") + GetParam() + ".toml"), overrides);
   const int steps = 150;
-  const auto e0 = engine_like(*s.engine), e1 = engine_like(*s.engine), e2 = engine_like(*s.engine);
+  const auto e0 = s.engine.make(), e1 = s.engine.make(), e2 = s.engine.make();
 
   Controller alone(*s.robot, *s.scheme, *e0, s.path.get(), s.duration, s.tau);
   const Loop reference = run_loop(alone, s.theta0, s.tau, steps);

@@ -117,7 +117,9 @@ TEST(StepState, EachStepSeesTheCommandsHandedOutBeforeIt) {
       EXPECT_EQ(seen[k].prev, commands[k - 1]) << "step " << k;
       EXPECT_EQ(seen[k].status_prev, SolverStatus::kSolved);
     }
-    if (k >= 2) EXPECT_EQ(seen[k].prev2, commands[k - 2]) << "step " << k;
+    if (k >= 2) {
+      EXPECT_EQ(seen[k].prev2, commands[k - 2]) << "step " << k;
+    }
   }
   EXPECT_FALSE(commands[1].isZero(1e-12)) << "the arm moves, so the test can fail";
 

@@ -343,9 +343,9 @@ RC_GTEST_PROP(Tasks, TheCascadeAgreesWithAnIndependentLexicographicSolve, ()) {
       for (const LevelInfo& level : rig.out.levels) {
         m << "priority " << level.priority << " " << to_string(level.status) << " " << level.diagnosis << "\n";
       }
-      for (std::size_t k = 0; k < p.levels.size(); ++k) {
-        m << "level " << k << " mine " << level_value(p.levels[k], x) << " reference " << ref.residual[k] << " rows "
-          << p.levels[k].J.rows() << " + " << p.levels[k].G.rows() << "\n";
+      for (std::size_t q = 0; q < p.levels.size(); ++q) {
+        m << "level " << q << " mine " << level_value(p.levels[q], x) << " reference " << ref.residual[q] << " rows "
+          << p.levels[q].J.rows() << " + " << p.levels[q].G.rows() << "\n";
       }
       RC_FAIL(m.str());
     }

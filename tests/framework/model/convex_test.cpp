@@ -333,7 +333,9 @@ TEST(ConvexDistance, NearTouchingFacesKeepTheirSign) {
     Ta.translation() = Vector3d(0.03, -0.02, 0.1 + 0.2 + gap);
     const ShapeDistance d = q.distance(0, Ta, 1, Tb);
     ASSERT_TRUE(d.ok);
-    if (std::abs(gap) >= 1e-9) EXPECT_EQ(d.distance > 0.0, gap > 0.0) << gap;
+    if (std::abs(gap) >= 1e-9) {
+      EXPECT_EQ(d.distance > 0.0, gap > 0.0) << gap;
+    }
     EXPECT_NEAR(d.distance, gap, 1e-12) << gap;  // overlapping: a face normal is the contact's
   }
 }
@@ -630,7 +632,9 @@ TEST(ConvexDistance, AHullAgainstAPointCloud) {
     for (const auto& p : pts) nearest = std::min(nearest, inside_polytope(f, p) ? 0.0 : feature_distance(f, p));
     EXPECT_LE(d.distance, nearest + 1e-9) << "trial " << trial;
     EXPECT_GE(d.distance, nearest - std::sqrt(3.0) * edge - 1e-9) << "trial " << trial;
-    if (d.distance > 0.0) EXPECT_LE(surface_gap(f, d.point_a), 1e-9) << "trial " << trial;
+    if (d.distance > 0.0) {
+      EXPECT_LE(surface_gap(f, d.point_a), 1e-9) << "trial " << trial;
+    }
     reached += d.distance > 0.0 ? 0 : 1;
   }
   EXPECT_GT(reached, 0);  // some poses reach into the cloud

@@ -18,14 +18,15 @@ TEST(Baseline, ComputesTheFrameworksRunOfThePaperArm) {
     Scenario s = load_scenario(source_path("configs/paper_r_tvcmm.toml"),
                                {std::string("solver.engine=") + engine, "solver.tolerance=1e-10"});
     const baseline::Case c = baseline::paper_case(s);
+    const std::size_t cells = static_cast<std::size_t>(c.steps + 1) * 13;
     baseline::Record record;
-    record.rows.resize(static_cast<std::size_t>(c.steps + 1) * 13);
+    record.rows.assign(cells, 0.0);
     const baseline::Joints theta =
         baseline::run(c.arm, c.theta0, c.r_d.data(), c.r_d_dot.data(), c.steps, c.tau, record);
     EXPECT_EQ(record.failures, 0);
     // The run that evaluates the letter in its loop is the same run.
     baseline::Record in_loop;
-    in_loop.rows.resize(record.rows.size());
+    in_loop.rows.assign(cells, 0.0);
     const baseline::Joints theta_in_loop = baseline::run_letter_r(c.arm, c.letter, c.theta0, c.steps, c.tau, in_loop);
     EXPECT_EQ(in_loop.failures, 0);
     for (std::size_t j = 0; j < 6; ++j) EXPECT_NEAR(theta_in_loop[j], theta[j], 1e-9) << "joint " << j + 1;

@@ -41,7 +41,7 @@ TEST(PaperClaims, RunsUseTheSettingsOfThePaper) {
   const PaperRun& tv = cached("paper_r_tvcmm");
   EXPECT_EQ(tv.scenario.steps(), 4000);
   EXPECT_DOUBLE_EQ(tv.scenario.tau, 0.01);
-  EXPECT_EQ(tv.scenario.engine->name(), "projection");
+  EXPECT_EQ(tv.scenario.engine.type, "projection");
   EXPECT_EQ(tv.result.trajectory.size(), 4001u);
   EXPECT_EQ(tv.result.failures, 0) << tv.result.first_failure;
   EXPECT_LT((tv.scenario.theta0 - paper_theta0()).norm(), 1e-15);

@@ -49,15 +49,18 @@ class Controller {
   /// The controller makes its own data of every plugin (Scheme::make_data()), so several controllers can share one
   /// scheme, each in its own thread.
   Controller(const RobotModel& robot, const Scheme& scheme, LviEngine& engine, const Path* path, double T, double tau);
+  /// The same with an engine of its own (not null), e.g. EngineSpec::make()'s.
+  Controller(const RobotModel& robot, const Scheme& scheme, std::unique_ptr<LviEngine> engine, const Path* path,
+             double T, double tau);
   Controller(const Controller&) = delete;
   Controller& operator=(const Controller&) = delete;
 
-  /// The controller that simulate() runs for `scenario`: its robot, scheme, engine and path, T and tau, its
-  /// orientation turn, the kinematics the recorded run reads (w and its gradient), and, for `on_infeasible =
-  /// "relax"`, the elastic QP with the scenario's relax_weight. It steps with the scenario's own engine (and its warm
-  /// start), so one such controller runs a scenario at a time; the scenario must outlive it. (Defined in run/,
-  /// beside the scenario.)
-  [[nodiscard]] static std::unique_ptr<Controller> from_scenario(Scenario& scenario);
+  /// The controller that simulate() runs for `scenario`: its robot, scheme and path, T and tau, an engine of its own
+  /// made from the scenario's [solver] (with its own warm start), its orientation turn, the kinematics the recorded
+  /// run reads (w and its gradient), and its failure policy. The scenario is only read: any number of controllers of
+  /// one scenario may run at once, each in its own thread; the scenario must outlive them. (Defined in run/, beside
+  /// the scenario.)
+  [[nodiscard]] static std::unique_ptr<Controller> from_scenario(const Scenario& scenario);
 
   /// An output sized for this controller.
   [[nodiscard]] StepOutput make_output() const;
@@ -156,7 +159,8 @@ class Controller {
 
   const RobotModel* robot_;
   const Scheme* scheme_;
-  std::shared_ptr<SchemeData> data_;  // the plugins' per-controller data (never null)
+  std::shared_ptr<SchemeData> data_;       // the plugins' per-controller data (never null)
+  std::unique_ptr<LviEngine> own_engine_;  // the engine, when the controller owns it
   LviEngine* engine_;
   const Path* path_;
   KinematicsData kin_;

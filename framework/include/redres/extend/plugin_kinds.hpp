@@ -27,6 +27,7 @@ struct PluginEntryInfo {
 /// A plugin kind.
 struct PluginKind {
   std::string name;     //!< the kind in messages and conformance results: "objective", "velocity-limit law"
+  std::string id;       //!< the kind as an identifier: "objective", "velocity_limit" (Python's `plugins(kind)`)
   std::string plural;   //!< "objectives": `redres plugins --json`'s key, Python's `redres.<plural>`, plugins/<plural>/
   std::string heading;  //!< `redres plugins`' heading: where files name a plugin of this kind
   std::string common_json;     //!< `redres plugins --json`'s key of the keys every plugin of the kind takes ("": none)

@@ -28,6 +28,7 @@
 
 #include "redres/config/config.hpp"
 #include "redres/control/controller.hpp"
+#include "redres/control/engine_registry.hpp"
 #include "redres/model/collision.hpp"
 #include "redres/plant/plant.hpp"
 #include "redres/run/ik.hpp"
@@ -38,7 +39,9 @@ namespace redres {
 /// Integration of theta_dot.
 enum class Integrator { kEuler, kHeun };
 
-/// A loaded scenario. Owns everything a run needs.
+/// A loaded scenario: a value that runs only read. It owns the robot, the path and the scheme, which are immutable;
+/// everything a run writes (the controller, its engine and warm start, the plugins' data, the plant) is made by the
+/// run, so that runs of one scenario may go on at once in several threads.
 struct Scenario {
   std::string name;                   //!< scenario name
   std::string label;                  //!< the run's name in legends and tables (default: name)
@@ -53,7 +56,8 @@ struct Scenario {
   Integrator integrator = Integrator::kEuler;  //!< integrator
   std::unique_ptr<Path> path;                  //!< r_d(t)
   std::unique_ptr<Scheme> scheme;              //!< objectives and constraints
-  std::unique_ptr<LviEngine> engine;           //!< solver
+  /// [solver]: the engine, as a value; each run and each controller makes its own (EngineSpec::make()).
+  EngineSpec engine;
   /// [orientation] turn: the rotation (a world-frame rotation vector, rad; planar: its z) the end effector turns
   /// through over the run, from the orientation it has at t = 0 (Controller::set_orientation_turn); zero: hold it.
   Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();

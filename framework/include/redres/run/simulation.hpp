@@ -73,14 +73,15 @@ using ProgressCallback = std::function<void(double fraction, double t)>;
 /// The number of columns a run of `scenario` records (the standard ones and the plugins' own).
 [[nodiscard]] std::size_t trajectory_width(const Scenario& scenario);
 
-/// Runs a scenario from theta0 over [0, T] with step tau. Everything is allocated before the loop.
-[[nodiscard]] RunResult simulate(Scenario& scenario, const ProgressCallback& progress = {});
+/// Runs a scenario from theta0 over [0, T] with step tau. Everything is allocated before the loop. The scenario is
+/// only read (the run makes its controller, engine and plant), so runs of one scenario may go on in several threads.
+[[nodiscard]] RunResult simulate(const Scenario& scenario, const ProgressCallback& progress = {});
 
 /// The same into `run`, which is overwritten; its trajectory's storage is reused when it has room for this run, so
 /// that repeated runs (a sweep's worker, a benchmark) skip the allocation and the first touch of the table's pages.
 /// `stop`, when given, is read after each recorded step: once it is true the run ends there, with every row up to
 /// that step and `interrupted` set (a signal handler may set it).
-void simulate(Scenario& scenario, RunResult& run, const ProgressCallback& progress = {},
+void simulate(const Scenario& scenario, RunResult& run, const ProgressCallback& progress = {},
               const std::atomic<bool>* stop = nullptr);
 
 }  // namespace redres

@@ -33,18 +33,18 @@ struct StartProblem {
 
 /// What check_start() found.
 struct StartReport {
-  std::vector<StartProblem> problems;   //!< empty: the start is fine
-  double w = 0.0;                       //!< w(theta(0)) of the robot's manipulability measure det(JJ')
-  double sigma_min = 0.0;               //!< the smallest singular value of the task rows' Jacobian
-  double path_offset = 0.0;             //!< |r_d(0) - f(theta(0))| over the task's position rows (m)
-  double seconds = 0.0;                 //!< how long the check took
+  std::vector<StartProblem> problems;  //!< empty: the start is fine
+  double w = 0.0;                      //!< w(theta(0)) of the robot's manipulability measure det(JJ')
+  double sigma_min = 0.0;              //!< the smallest singular value of the task rows' Jacobian
+  double path_offset = 0.0;            //!< |r_d(0) - f(theta(0))| over the task's position rows (m)
+  double seconds = 0.0;                //!< how long the check took
   [[nodiscard]] bool ok() const noexcept { return problems.empty(); }
   /// Every problem, one per line: "theta(0) <message> (<suggestion>)".
   [[nodiscard]] std::string text() const;
 };
 
 /// Checks theta(0) of `s` (s.theta0). Allocates; takes well under a second.
-[[nodiscard]] StartReport check_start(Scenario& s);
+[[nodiscard]] StartReport check_start(const Scenario& s);
 
 /// A start that check_start() refused: what() holds every problem (StartReport::text()).
 class StartError : public std::runtime_error {
@@ -57,6 +57,6 @@ class StartError : public std::runtime_error {
 };
 
 /// check_start(), throwing StartError when it finds a problem.
-void require_good_start(Scenario& s);
+void require_good_start(const Scenario& s);
 
 }  // namespace redres

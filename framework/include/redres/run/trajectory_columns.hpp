@@ -15,10 +15,10 @@ namespace redres {
 
 /// How many columns a group has.
 enum class ColumnCount {
-  kOne,           //!< one column, named `name`
-  kPerJoint,      //!< n columns, `name`1 .. `name`n
-  kPerReference,  //!< one per reference row, `name`<row> (x, y, phi; x, y, z, wx, wy, wz)
-  kIfOrientation,  //!< one column, only for tasks with orientation rows
+  kOne,                          //!< one column, named `name`
+  kPerJoint,                     //!< n columns, `name`1 .. `name`n
+  kPerReference,                 //!< one per reference row, `name`<row> (x, y, phi; x, y, z, wx, wy, wz)
+  kIfOrientation,                //!< one column, only for tasks with orientation rows
   kPerJointIfAccelerationLimits  //!< n columns, only for robots with acceleration limits on every joint
 };
 

@@ -145,11 +145,11 @@ Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, doubl
   if (root.has("scheme")) {
     const TableReader t = root.table("scheme");
     const TableReader scheme(t.file_ptr(), t.raw(), "scheme");
-    level = scheme.choice("level", {"velocity", "acceleration"}, "velocity") == "velocity" ? SchemeLevel::kVelocity
-                                                                                           : SchemeLevel::kAcceleration;
-    const double eps = scheme.number("regularization", kDefaultRegularization);
-    if (!(eps > 0.0) || !(eps <= 1.0)) scheme.fail("regularization", "expected a number in (0, 1]");
+    SchemeTable table;
+    read_config(scheme, SchemeTable::schema(), table);
     scheme.finish();
+    level = table.level;
+    const double eps = table.regularization;
     try {
       Scheme out(robot, std::move(objectives), std::move(constraints), std::move(tasks), level);
       out.set_regularization(eps);
@@ -159,6 +159,20 @@ Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, doubl
     }
   }
   return Scheme(robot, std::move(objectives), std::move(constraints), std::move(tasks), level);
+}
+
+static_assert(SchemeTable{}.regularization == Scheme::kDefaultRegularization, "one default of the regularization");
+
+const Schema<SchemeTable>& SchemeTable::schema() {
+  using C = SchemeTable;
+  static const Schema<C> s{
+      {field(
+           "level", &C::level, "",
+           "what x is: \"velocity\" (x = theta_dot, the paper's) or \"acceleration\" (x = theta_ddot; docs/motion.md)"),
+       field("regularization", &C::regularization, "",
+             "the eps |x|^2 / 2 that every priority level adds to its QP (docs/tasks.md)",
+             rule<double>("a number in (0, 1]", [](double eps) { return eps > 0.0 && eps <= 1.0; }))}};
+  return s;
 }
 
 void Scheme::set_regularization(double eps) {

@@ -705,6 +705,8 @@ const std::vector<KeyTable>& scenario_key_tables() {
        describe_keys(Theta0Ik::schema())},
       {"scenario", "theta0.ik = { position, rpy, phi }", "the inverse kinematics' target, in the world frame",
        describe_keys(IkTable::schema())},
+      {"scenario", "[scheme]", "what x is, and the priority levels' regularization",
+       describe_keys(SchemeTable::schema())},
       {"scenario", "[plant]", "what the commands drive: the kinematic plant or MuJoCo (docs/plant.md)",
        describe_keys(PlantConfig::schema())},
       {"scenario", "[solver]", "the run's policy for a step that is not solved (the engine's keys: redres plugins)",

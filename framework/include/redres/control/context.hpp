@@ -2,6 +2,10 @@
 /// @file
 /// The Context: everything a plugin may read at one control step.
 
+#include <array>
+#include <string_view>
+#include <utility>
+
 #include <Eigen/Core>
 
 #include "redres/model/kinematics.hpp"
@@ -12,6 +16,11 @@ namespace redres {
 /// What a scheme's QP solves for ([scheme] level; docs/motion.md): x = theta_dot (the paper's velocity level) or
 /// x = theta_ddot (the acceleration level: theta_dot and theta are integrated from x).
 enum class SchemeLevel { kVelocity, kAcceleration };
+/// The names a scenario's [scheme] level takes.
+inline auto enum_names(SchemeLevel) {
+  return std::array{std::pair{SchemeLevel::kVelocity, std::string_view("velocity")},
+                    std::pair{SchemeLevel::kAcceleration, std::string_view("acceleration")}};
+}
 
 /// Everything a plugin may read at one control step. New inputs are added here, never to plugin signatures.
 struct Context {

@@ -25,6 +25,13 @@ struct SchemeLevelSpec {
   std::vector<int> tasks;
 };
 
+/// A scenario file's [scheme] table, read through its schema (and listed by `redres keys scenario`).
+struct SchemeTable {
+  SchemeLevel level = SchemeLevel::kVelocity;  //!< what x is: theta_dot (the paper's) or theta_ddot
+  double regularization = 1e-9;                //!< the eps |x|^2 / 2 of every priority level (Scheme::regularization())
+  static const Schema<SchemeTable>& schema();
+};
+
 /// Objectives and constraints assembled into one QP. Immutable after construction, so one scheme can serve several
 /// controllers at once (each with its own SchemeData, in its own thread); build() allocates nothing.
 class Scheme {

@@ -24,11 +24,12 @@ BrakeScale braking_scale(const BrakeInput& in) {
     s_min = std::max(s_min, s1);
     s_max = std::min(s_max, s2);
   };
-  const auto usable_joint = [&](Eigen::Index j) {
-    return b(j) != 0.0 && std::isfinite(b(j)) && std::isfinite(a_lo(j)) && std::isfinite(a_hi(j));
+  // A joint whose limits are not finite here (a law outside its range) or whose velocity is not finite sets nothing.
+  const auto usable_joint = [&](Eigen::Index j, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) {
+    return b(j) != 0.0 && std::isfinite(b(j)) && std::isfinite(lo(j)) && std::isfinite(hi(j));
   };
   for (Eigen::Index j = 0; j < n; ++j) {
-    if (!usable_joint(j)) continue;
+    if (!usable_joint(j, a_lo, a_hi)) continue;
     const double before = s_lo;
     within(j, a_lo(j), a_hi(j), s_lo, s_hi);
     if (s_lo > before) decides = static_cast<int>(j);
@@ -45,7 +46,7 @@ BrakeScale braking_scale(const BrakeInput& in) {
     double lo = s_lo, hi = s_hi;
     int jerk_decides = decides;
     for (Eigen::Index j = 0; j < n; ++j) {
-      if (!usable_joint(j)) continue;
+      if (!usable_joint(j, j_lo, j_hi)) continue;
       // The acceleration (s - 1) b_j / tau within a_prev + tau [j^-, j^+].
       const double a_prev = ((*in.previous)(j) - (*in.previous2)(j)) / tau;
       const double before = lo;

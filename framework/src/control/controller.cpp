@@ -13,15 +13,16 @@
 
 namespace redres {
 
+namespace {
+LviEngine& not_null(const std::unique_ptr<LviEngine>& engine) {
+  REDRES_REQUIRE(engine != nullptr, "Controller", "an engine (not null)");
+  return *engine;
+}
+}  // namespace
+
 Controller::Controller(const RobotModel& robot, const Scheme& scheme, std::unique_ptr<LviEngine> engine,
                        const Path* path, double T, double tau)
-    : Controller(
-          robot, scheme,
-          *[&]() -> LviEngine* {
-            REDRES_REQUIRE(engine != nullptr, "Controller", "an engine (not null)");
-            return engine.get();
-          }(),
-          path, T, tau) {
+    : Controller(robot, scheme, not_null(engine), path, T, tau) {
   own_engine_ = std::move(engine);
 }
 

@@ -55,12 +55,7 @@ EngineSpec read_engine_spec(const TableReader& solver) {
 std::unique_ptr<LviEngine> make_engine(const TableReader& solver) { return read_engine_spec(solver).make(); }
 
 std::unique_ptr<LviEngine> EngineSpec::make() const {
-  if (!config.has_value()) return make_engine(type, settings);
-  const auto* e = engine_registry().find(type);
-  if (e == nullptr) {
-    throw std::invalid_argument("EngineSpec::make: unknown engine '" + type +
-                                "'; known engines: " + engine_registry().names_like(type));
-  }
+  if (!config.has_value()) return make_engine(type, settings);  // the type's default Config
   return engine_registry().create(type, config, settings);
 }
 

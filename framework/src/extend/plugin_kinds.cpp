@@ -21,10 +21,6 @@ std::function<std::vector<PluginEntryInfo>()> listing(R& (*registry)()) {
   };
 }
 
-std::function<std::vector<KeyInfo>()> keys(const std::vector<KeyInfo>& (*of)()) {
-  return [of] { return of(); };
-}
-
 std::vector<KeyInfo> none() { return {}; }
 
 std::vector<KeyInfo> path_keys() { return describe_keys(PathPlacement::schema()); }
@@ -50,13 +46,13 @@ PluginKind kind(std::string name, std::string plural, std::string heading, std::
 std::vector<PluginKind> make_kinds() {
   std::vector<PluginKind> k;
   k.push_back(kind("objective", "objectives", "objectives ([[objectives]] tables in a scenario)",
-                   "objective_common_keys", "keys of every objective:", keys(objective_common_keys),
+                   "objective_common_keys", "keys of every objective:", objective_common_keys,
                    listing(objective_registry), kind_checks::objectives));
   k.push_back(kind("constraint", "constraints", "constraints ([[constraints]] tables in a scenario; hard, no weight)",
-                   "constraint_common_keys", "keys of every constraint:", keys(constraint_common_keys),
+                   "constraint_common_keys", "keys of every constraint:", constraint_common_keys,
                    listing(constraint_registry), kind_checks::constraints));
   k.push_back(kind("task", "tasks", "tasks ([[tasks]] tables in a scenario; docs/tasks.md)", "task_common_keys",
-                   "keys of every task:", keys(task_common_keys), listing(task_registry), kind_checks::tasks));
+                   "keys of every task:", task_common_keys, listing(task_registry), kind_checks::tasks));
   k.push_back(kind("velocity-limit law", "velocity_limits",
                    "velocity-limit laws ([joints.velocity_limit] in a robot file)", "", "", none,
                    listing(velocity_limit_registry), kind_checks::velocity_limits));
@@ -64,10 +60,10 @@ std::vector<PluginKind> make_kinds() {
                    "keys of every path (placement and timing):", path_keys, listing(path_registry),
                    kind_checks::paths));
   k.push_back(kind("engine", "engines", "LVI engines (the [solver] table of a scenario)", "solver_common_keys",
-                   "keys of every engine, and the run's policy for a step that is not solved:",
-                   keys(solver_common_keys), listing(engine_registry), kind_checks::engines));
+                   "keys of every engine, and the run's policy for a step that is not solved:", solver_common_keys,
+                   listing(engine_registry), kind_checks::engines));
   k.back().extra_json = "solver_policy_keys";
-  k.back().extra_keys = keys(solver_policy_keys);
+  k.back().extra_keys = solver_policy_keys;
   return k;
 }
 

@@ -179,6 +179,12 @@ void simulate_plant(const Scenario& s, RunResult& run, const ProgressCallback& p
                     const std::atomic<bool>* stop) {
   const int steps = s.steps();
   const int n = s.robot->dof();
+  std::vector<Recorder> recorders;
+  std::vector<std::string> columns = run_columns(s, &recorders);
+  const std::size_t plant_first = columns.size() - static_cast<std::size_t>(2 * n + 2);
+  REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
+                 "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
+                     std::to_string(columns.size()) + " columns do not)");
   PlantFacts facts;
   {
     // The same scenario on the kinematic plant, for the kinematic-vs-dynamic error.
@@ -186,12 +192,6 @@ void simulate_plant(const Scenario& s, RunResult& run, const ProgressCallback& p
     simulate_kinematic(s, kinematic, {}, stop);
     facts.kinematic_max_position_error = column_max(kinematic.trajectory, "position_error");
   }
-  std::vector<Recorder> recorders;
-  std::vector<std::string> columns = run_columns(s, &recorders);
-  const std::size_t plant_first = columns.size() - static_cast<std::size_t>(2 * n + 2);
-  REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
-                 "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
-                     std::to_string(columns.size()) + " columns do not)");
   run.trajectory.reset(std::move(columns), static_cast<std::size_t>(steps) + 1);
   run.engines.reserve(4);
 
@@ -263,12 +263,6 @@ void simulate_plant(const Scenario& s, RunResult& run, const ProgressCallback& p
 void simulate(const Scenario& s, RunResult& run, const ProgressCallback& progress, const std::atomic<bool>* stop) {
   if (s.plant.kind == PlantKind::kMujoco) {
     reset_run(run);
-    std::vector<Recorder> recorders;
-    const std::vector<std::string> columns = run_columns(s, &recorders);
-    const int steps = s.steps();
-    REDRES_REQUIRE((steps + 1.0) * static_cast<double>(columns.size()) * 8.0 <= kMaxTableBytes, "simulate",
-                   "the run's table fits in kMaxTableBytes (" + std::to_string(steps + 1) + " rows of " +
-                       std::to_string(columns.size()) + " columns do not)");
     simulate_plant(s, run, progress, stop);
     return;
   }

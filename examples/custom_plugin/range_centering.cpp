@@ -27,14 +27,19 @@ class RangeCentering final : public redres::Configured<redres::Objective, RangeC
         mid_((robot.upper_limits() + robot.lower_limits()) / 2.0),
         inv_half_sq_(((robot.upper_limits() - robot.lower_limits()) / 2.0).array().square().inverse().matrix()) {}
 
+  // One n-vector of workspace per controller (made at setup): no allocation on the per-step path.
+  [[nodiscard]] std::unique_ptr<redres::PluginData> make_data() const override {
+    return std::make_unique<redres::Workspace>(static_cast<int>(mid_.size()), 1);
+  }
+
   // The potential whose gradient zeta is; `redres plugins --check` compares the two by central differences.
   std::optional<double> potential(const redres::Context& ctx) const override {
     return 0.5 * config_.lambda * ((ctx.theta() - mid_).array().square() * inv_half_sq_.array()).sum();
   }
 
  private:
-  void add_to(const redres::Context& ctx, redres::QpBuilder& builder, redres::PluginData* /*data*/) const override {
-    Eigen::VectorXd& z = builder.scratch();  // workspace: no allocation on the per-step path
+  void add_to(const redres::Context& ctx, redres::QpBuilder& builder, redres::PluginData* data) const override {
+    Eigen::VectorXd& z = static_cast<redres::Workspace&>(*data)[0];
     z = config_.lambda * (ctx.theta() - mid_).cwiseProduct(inv_half_sq_);
     builder.add_linear(z);
   }

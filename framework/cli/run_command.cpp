@@ -84,16 +84,17 @@ Outcome run_one(Scenario scenario, const std::filesystem::path& out, bool quiet,
     std::cout << s.steps << " steps of " << s.tau << " s, engine " << s.solver.engine << ", max position error "
               << s.max_position_error << " m, w " << s.manipulability.initial << " -> " << s.manipulability.final
               << ", " << s.solver.failures << " failed steps, " << s.wall_time_s << " s -> " << out.string() << "\n";
-    if (s.plant_kind == "mujoco") {
+    if (o.run.plant) {
       const PlantFacts& p = s.plant;
+      const bool kinematic_comparison = o.scenario.plant.kinematic_comparison;
       double ratio = 0.0;
       for (std::size_t j = 0; j < p.max_torque.size(); ++j) {
         if (std::isfinite(p.effort_limit[j])) ratio = std::max(ratio, p.max_torque[j] / p.effort_limit[j]);
       }
       std::cout << "  MuJoCo plant (" << p.actuator << ", " << p.substeps << " steps of " << p.timestep
-                << " s per control step): max position error " << s.max_position_error << " m (kinematic plant "
-                << p.kinematic_max_position_error << " m), max torque " << 100.0 * ratio << " % of its limit, "
-                << p.max_contacts << " contacts at most";
+                << " s per control step): max position error " << s.max_position_error << " m";
+      if (kinematic_comparison) std::cout << " (kinematic plant " << p.kinematic_max_position_error << " m)";
+      std::cout << ", max torque " << 100.0 * ratio << " % of its limit, " << p.max_contacts << " contacts at most";
       if (!p.contact_pairs.empty()) std::cout << ", first at t = " << p.contact_pairs.front().first_time << " s";
       std::cout << "; " << 1e6 * p.controller_seconds / std::max(1L, p.control_steps) << " us per control step, "
                 << 1e6 * p.mujoco_seconds / std::max(1L, p.mujoco_steps) << " us per MuJoCo step\n";
@@ -220,7 +221,7 @@ int run_scenario(const RunOptions& options) {
     animator = find_plotter(opts->animate ? "--animate" : opts->scenarios.front() + ": [output] animate = true");
   }
   if (opts->film) {
-    if (scenario.plant.kind != PlantKind::kMujoco) {
+    if (scenario.plant.kind != "mujoco") {
       throw std::runtime_error("--film renders the MuJoCo scene: scenario '" + scenario.name +
                                "' runs on the kinematic plant; add --set plant.kind=mujoco");
     }
@@ -238,7 +239,7 @@ int run_scenario(const RunOptions& options) {
     }
   }
   if (opts->write_mjcf) {
-    if (scenario.plant.kind != PlantKind::kMujoco) {
+    if (scenario.plant.kind != "mujoco") {
       throw std::runtime_error("--write-mjcf: scenario '" + scenario.name +
                                "' runs on the kinematic plant; add --set plant.kind=mujoco");
     }
@@ -273,7 +274,7 @@ int validate_scenario(const RunOptions& options) {
             << s.path->description() << ", " << s.scheme->objectives().size() << " objective(s), "
             << s.scheme->constraints().size() << " constraint(s), engine " << s.engine.type << "\n";
   print_ik(s);
-  if (s.plant.kind == PlantKind::kMujoco) {
+  if (s.plant.kind == "mujoco") {
     const auto substeps = std::lround(s.tau / s.plant.timestep);
     std::cout << "plant: MuJoCo, " << enum_names(PlantActuator{})[static_cast<std::size_t>(s.plant.actuator)].second
               << (s.plant.gravity_compensation ? " with" : " without") << " gravity compensation, " << substeps

@@ -48,11 +48,24 @@ void JointAccelerationLimits::add_to(const Context& ctx, QpBuilder& builder, Plu
   auto& d = static_cast<Data&>(*data);
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
-  robot.acceleration_limits(theta, d.a_lo, d.a_hi);
+  // The laws at theta: as the Controller evaluated them for the step, or here where a caller's Context has none.
+  const Eigen::VectorXd* acc_lo = ctx.acceleration_lower;
+  const Eigen::VectorXd* acc_hi = ctx.acceleration_upper;
+  if (acc_lo == nullptr || acc_hi == nullptr) {
+    robot.acceleration_limits(theta, d.a_lo, d.a_hi);
+    acc_lo = &d.a_lo;
+    acc_hi = &d.a_hi;
+  }
   // With jerk limits, full deceleration is reached only after a ramp of |a| / |j|: the joint is taken to move on at v'
   // for that long too (conservative: it already decelerates on the ramp).
-  if (jerk_) robot.jerk_limits(theta, d.j_lo, d.j_hi);
-  const bool velocity_level = ctx.level == SchemeLevel::kVelocity;
+  const Eigen::VectorXd* jerk_lo = ctx.jerk_lower;
+  const Eigen::VectorXd* jerk_hi = ctx.jerk_upper;
+  if (jerk_ && (jerk_lo == nullptr || jerk_hi == nullptr)) {
+    robot.jerk_limits(theta, d.j_lo, d.j_hi);
+    jerk_lo = &d.j_lo;
+    jerk_hi = &d.j_hi;
+  }
+  const bool velocity_level = ctx.order == ControlOrder::kVelocity;
   // A Context without the state between steps (one a caller builds) reads as an arm at rest.
   const Eigen::VectorXd* state = velocity_level ? ctx.theta_dot_prev : ctx.theta_dot;
   const Eigen::VectorXd& v = state != nullptr ? *state : d.zero;
@@ -61,13 +74,13 @@ void JointAccelerationLimits::add_to(const Context& ctx, QpBuilder& builder, Plu
   // acceleration level's step moves at (v + v') / 2).
   const double c = velocity_level ? tau : 0.5 * tau;
   for (int j = 0; j < n_; ++j) {
-    const double a_lo = scale * d.a_lo(j), a_hi = scale * d.a_hi(j);
+    const double a_lo = scale * (*acc_lo)(j), a_hi = scale * (*acc_hi)(j);
     double lo = v(j) + tau * a_lo, hi = v(j) + tau * a_hi;
     if (config_.braking) {
       const double carry = velocity_level ? 0.0 : 0.5 * tau * v(j);
       const double up = robot.upper_limits()(j) - theta(j) - carry;
       const double down = theta(j) - robot.lower_limits()(j) + carry;
-      const double ramp_up = jerk_ ? -a_lo / d.j_hi(j) : 0.0, ramp_down = jerk_ ? a_hi / -d.j_lo(j) : 0.0;
+      const double ramp_up = jerk_ ? -a_lo / (*jerk_hi)(j) : 0.0, ramp_down = jerk_ ? a_hi / -(*jerk_lo)(j) : 0.0;
       hi = std::max(std::min(hi, stopping_speed(up, -a_lo, c + ramp_up)), lo);  // never more than a^- to brake
       lo = std::min(std::max(lo, -stopping_speed(down, a_hi, c + ramp_down)), hi);
     }

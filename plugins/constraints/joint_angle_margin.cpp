@@ -25,19 +25,27 @@ JointAngleMargin::JointAngleMargin(const Config& config, const RobotModel& robot
   }
 }
 
-void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
+std::unique_ptr<PluginData> JointAngleMargin::make_data() const {
+  return std::make_unique<Workspace>(static_cast<int>(margin_.size()), 2);
+}
+
+void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
+  REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
+  Workspace& w = static_cast<Workspace&>(*data);
+  Eigen::VectorXd& lo = w[0];
+  Eigen::VectorXd& hi = w[1];
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
   const double kappa = config_.kappa;
-  builder.scratch() = kappa * ((robot.lower_limits() + margin_) - theta);
-  builder.scratch2() = kappa * ((robot.upper_limits() - margin_) - theta);
-  if (ctx.level == SchemeLevel::kAcceleration) {  // the velocity after the step keeps them
+  lo = kappa * ((robot.lower_limits() + margin_) - theta);
+  hi = kappa * ((robot.upper_limits() - margin_) - theta);
+  if (ctx.order == ControlOrder::kAcceleration) {  // the velocity after the step keeps them
     for (int j = 0; j < robot.dof(); ++j) {
-      builder.scratch()(j) = ctx.velocity_to_x(builder.scratch()(j), j);
-      builder.scratch2()(j) = ctx.velocity_to_x(builder.scratch2()(j), j);
+      lo(j) = ctx.velocity_to_x(lo(j), j);
+      hi(j) = ctx.velocity_to_x(hi(j), j);
     }
   }
-  builder.intersect_bounds(builder.scratch(), builder.scratch2());
+  builder.intersect_bounds(lo, hi);
 }
 
 void JointAngleMargin::summarise(const RobotModel& robot, const Trajectory& run, const PluginData* /*data*/,

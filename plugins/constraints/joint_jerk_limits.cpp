@@ -32,15 +32,22 @@ std::unique_ptr<PluginData> JointJerkLimits::make_data() const { return std::mak
 void JointJerkLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
   auto& d = static_cast<Data&>(*data);
-  ctx.robot->jerk_limits(ctx.theta(), d.j_lo, d.j_hi);
+  // The laws at theta: as the Controller evaluated them for the step, or here where a caller's Context has none.
+  const Eigen::VectorXd* jerk_lo = ctx.jerk_lower;
+  const Eigen::VectorXd* jerk_hi = ctx.jerk_upper;
+  if (jerk_lo == nullptr || jerk_hi == nullptr) {
+    ctx.robot->jerk_limits(ctx.theta(), d.j_lo, d.j_hi);
+    jerk_lo = &d.j_lo;
+    jerk_hi = &d.j_hi;
+  }
   // A Context without the state between steps (one a caller builds) reads as an arm at rest.
   const Eigen::VectorXd& prev = ctx.theta_dot_prev != nullptr ? *ctx.theta_dot_prev : d.zero;
   const Eigen::VectorXd& prev2 = ctx.theta_dot_prev2 != nullptr ? *ctx.theta_dot_prev2 : d.zero;
-  const Eigen::VectorXd& v = ctx.level == SchemeLevel::kVelocity || ctx.theta_dot == nullptr ? prev : *ctx.theta_dot;
+  const Eigen::VectorXd& v = ctx.order == ControlOrder::kVelocity || ctx.theta_dot == nullptr ? prev : *ctx.theta_dot;
   const double tau = ctx.tau, scale = config_.scale;
   for (int j = 0; j < n_; ++j) {
     const double a_prev = (prev(j) - prev2(j)) / tau;
-    const double j_lo = scale * d.j_lo(j), j_hi = scale * d.j_hi(j);
+    const double j_lo = scale * (*jerk_lo)(j), j_hi = scale * (*jerk_hi)(j);
     // v' = v + tau a with a in a_prev + tau [j^-, j^+] ...
     double a_lo = a_prev + tau * j_lo, a_hi = a_prev + tau * j_hi;
     // ... and, towards a velocity limit, an acceleration that the jerk limit can still bring to zero before the

@@ -11,19 +11,23 @@ const Schema<JointVelocityLimitsConfig>& JointVelocityLimitsConfig::schema() {
   return s;
 }
 
-JointVelocityLimits::JointVelocityLimits(const Config& config, const RobotModel& /*robot*/)
-    : Configured(kType, config) {}
+JointVelocityLimits::JointVelocityLimits(const Config& config, const RobotModel& robot)
+    : Configured(kType, config), n_(robot.dof()) {}
 
-void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
+std::unique_ptr<PluginData> JointVelocityLimits::make_data() const { return std::make_unique<Workspace>(n_, 2); }
+
+void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   const double scale = config_.scale;
-  if (ctx.level == SchemeLevel::kVelocity && ctx.velocity_lower != nullptr && ctx.velocity_upper != nullptr) {
+  if (ctx.order == ControlOrder::kVelocity && ctx.velocity_lower != nullptr && ctx.velocity_upper != nullptr) {
     if (scale == 1.0) {
       builder.intersect_bounds(*ctx.velocity_lower, *ctx.velocity_upper);
       return;
     }
-    builder.scratch() = scale * *ctx.velocity_lower;
-    builder.scratch2() = scale * *ctx.velocity_upper;
-    builder.intersect_bounds(builder.scratch(), builder.scratch2());
+    REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
+    Workspace& w = static_cast<Workspace&>(*data);
+    w[0] = scale * *ctx.velocity_lower;
+    w[1] = scale * *ctx.velocity_upper;
+    builder.intersect_bounds(w[0], w[1]);
     return;
   }
   // Joint by joint: a caller's Context without the laws' values, or the acceleration level, where the velocity after

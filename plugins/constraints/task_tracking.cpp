@@ -44,8 +44,7 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*
   double e[6];
   for (Eigen::Index r = 0; r < rows; ++r) e[r] = r_d[r] - f[r];
   if (robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows()) {
-    const Eigen::AngleAxisd err(rotation_from_vector(ctx.r_d->tail<3>()) * k.ee_pose.linear().transpose());
-    const Eigen::Vector3d v = err.angle() * err.axis();
+    const Eigen::Vector3d v = orientation_error_vector(rotation_from_vector(ctx.r_d->tail<3>()), k.ee_pose.linear());
     e[3] = v.x();
     e[4] = v.y();
     e[5] = v.z();
@@ -55,7 +54,7 @@ void TaskTracking::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*
   const int* task_rows = robot.task_rows().data();
   const double* gain = gain_.data();
   const Eigen::Index task = gain_.size();
-  if (ctx.level == SchemeLevel::kVelocity) {
+  if (ctx.order == ControlOrder::kVelocity) {
     for (Eigen::Index i = 0; i < task; ++i) {
       const int r = task_rows[i];
       d[i] = r_d_dot[r] + gain[i] * e[r];

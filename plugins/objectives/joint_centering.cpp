@@ -18,8 +18,13 @@ std::optional<double> JointCentering::potential(const Context& ctx) const {
   return 0.5 * config_.lambda * (ctx.theta() - theta_ref_).squaredNorm();
 }
 
-void JointCentering::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
-  Eigen::VectorXd& z = builder.scratch();
+std::unique_ptr<PluginData> JointCentering::make_data() const {
+  return std::make_unique<Workspace>(static_cast<int>(theta_ref_.size()), 1);
+}
+
+void JointCentering::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
+  REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
+  Eigen::VectorXd& z = static_cast<Workspace&>(*data)[0];
   z = config_.lambda * (ctx.theta() - theta_ref_);
   builder.add_linear(z);
 }

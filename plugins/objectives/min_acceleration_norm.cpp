@@ -15,7 +15,7 @@ MinAccelerationNorm::MinAccelerationNorm(const Config& config, const RobotModel&
 void MinAccelerationNorm::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
   builder.add_identity();
   // A Context without the state between steps (one a caller builds) reads as an arm at rest: no linear term.
-  if (ctx.level == SchemeLevel::kAcceleration) {
+  if (ctx.order == ControlOrder::kAcceleration) {
     if (config_.damping > 0.0 && ctx.theta_dot != nullptr) builder.add_linear(config_.damping, *ctx.theta_dot);
     return;
   }

@@ -239,10 +239,7 @@ void FrameTask::compute(const Context& ctx, TaskData& data) const {
   const Eigen::Vector3d a = R * axis_;
   const Eigen::Vector3d a_d = axis_target_ ? *axis_target_ : own.a0;
   Eigen::Vector3d e_rot = Eigen::Vector3d::Zero();
-  if (has_orientation_rows()) {
-    const Eigen::AngleAxisd err(R_d * R.transpose());
-    e_rot = err.angle() * err.axis();
-  }
+  if (has_orientation_rows()) e_rot = orientation_error_vector(R_d, R);
   // u, v: an orthonormal basis of the plane normal to a.
   Eigen::Vector3d u = a.unitOrthogonal();
   Eigen::Vector3d v = a.cross(u);

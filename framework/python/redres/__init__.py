@@ -247,7 +247,7 @@ class _PythonPlugin:
     keys: dict[str, _Any] = {}  # key -> default value; its type fixes how a scenario file's value is read
     help: dict[str, str] = {}   # key -> one line of help
     summary = ""         # one line, for redres.plugins() and `redres plugins`
-    kinematics = "all"   # what contribute() reads: 'position', 'jacobian', 'gradient' (w, grad w), 'manipulability' (+ dJ) or 'all'
+    kinematics = "all"   # what contribute() reads: 'position', 'jacobian', 'measure' (w), 'gradient' (w, grad w), 'manipulability' (+ dJ) or 'all'
     name: str | None = None  # instance name in diagnoses (default: the type)
     active = True
 

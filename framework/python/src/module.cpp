@@ -368,7 +368,7 @@ std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::li
                                 std::to_string(*regularization));
   }
   c->scheme = std::make_unique<Scheme>(model, std::move(objs), std::move(cons), std::move(tasks_made),
-                                       level == "velocity" ? SchemeLevel::kVelocity : SchemeLevel::kAcceleration);
+                                       level == "velocity" ? ControlOrder::kVelocity : ControlOrder::kAcceleration);
   if (regularization) c->scheme->set_regularization(*regularization);
   if (py::isinstance<py::str>(engine)) {
     c->engine = make_engine(engine.cast<std::string>());

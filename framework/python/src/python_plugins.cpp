@@ -123,11 +123,12 @@ KinematicsLevel level_of(py::handle instance) {
       py::hasattr(instance, "kinematics") ? instance.attr("kinematics").cast<std::string>() : "all";
   if (level == "position") return KinematicsLevel::kPosition;
   if (level == "jacobian") return KinematicsLevel::kJacobian;
+  if (level == "measure") return KinematicsLevel::kMeasure;
   if (level == "gradient") return KinematicsLevel::kGradient;
   if (level == "manipulability") return KinematicsLevel::kManipulability;
   if (level == "all") return KinematicsLevel::kAll;
   throw std::invalid_argument("kinematics = '" + level +
-                              "': expected 'position', 'jacobian', 'gradient', 'manipulability' or 'all'");
+                              "': expected 'position', 'jacobian', 'measure', 'gradient', 'manipulability' or 'all'");
 }
 
 std::string type_of(py::handle instance) {

@@ -33,19 +33,21 @@ struct Cascade::Level {
   bool has_ls = false;          // below the first, with equality or inequality tasks: a least-squares retry
   // One QP (and its least-squares retry) per number of held rows, 0 to held_eq, each with its engine: the held rows'
   // rank is known only at the step, and a QP with fewer independent rows than rows would be degenerate.
-  struct Slot {
-    QpProblem qp, ls;
-    std::unique_ptr<LviEngine> engine, ls_engine;
-    SolverResult result, ls_result;
-  };
   std::vector<std::unique_ptr<Slot>> slots;
+};
+
+struct Cascade::Slot {
+  QpProblem qp, ls;
+  std::unique_ptr<LviEngine> own, ls_engine;  // the level's engines (the first level's is the controller's)
+  LviEngine* engine = nullptr;
+  SolverResult result, ls_result;
+  bool used_ls = false;  // the last step's answer came from the least-squares retry
 };
 
 Cascade::~Cascade() = default;
 
-Cascade::Cascade(const Scheme& scheme, const SchemeData& data, const LviEngine& engine)
-    : scheme_(&scheme), n_(scheme.robot().dof()), eps_(scheme.regularization()) {
-  REDRES_REQUIRE(scheme.cascaded(), "Cascade", "the scheme has several priority levels");
+Cascade::Cascade(const Scheme& scheme, const SchemeData& data, LviEngine& engine)
+    : scheme_(&scheme), n_(scheme.robot().dof()), eps_(scheme.regularization()), several_(scheme.levels().size() > 1) {
   scheme.setup_constraints(base_, data);
   obj_.resize(n_, 0, 0);
   const auto& tasks = scheme.tasks();
@@ -99,22 +101,33 @@ Cascade::Cascade(const Scheme& scheme, const SchemeData& data, const LviEngine& 
   held_d_ = Eigen::VectorXd::Zero(held_J_.rows());
   held_A_ = Eigen::MatrixXd::Zero(held_in, n_);
   held_b_ = Eigen::VectorXd::Zero(held_in);
-  const SolverSettings& lower = engine.settings();
-  for (std::size_t l = 1; l < levels_.size(); ++l) {
+  const SolverSettings& settings = engine.settings();
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
     Level& L = *levels_[l];
     for (int rank = 0; rank <= L.held_eq; ++rank) {
-      auto slot = std::make_unique<Level::Slot>();
+      auto slot = std::make_unique<Slot>();
       size_level(static_cast<int>(l), slot->qp, false, rank);
-      slot->engine = make_engine(std::string(engine.name()), lower);
+      if (l == 0) {
+        slot->engine = &engine;
+      } else {
+        slot->own = make_engine(std::string(engine.name()), settings);
+        slot->engine = slot->own.get();
+      }
       slot->engine->setup(slot->qp.n(), slot->qp.m_eq(), slot->qp.m_in(), slot->result);
       if (L.has_ls) {
         size_level(static_cast<int>(l), slot->ls, true, rank);
-        slot->ls_engine = make_engine(std::string(engine.name()), lower);
+        slot->ls_engine = make_engine(std::string(engine.name()), settings);
         slot->ls_engine->setup(slot->ls.n(), slot->ls.m_eq(), slot->ls.m_in(), slot->ls_result);
       }
       L.slots.push_back(std::move(slot));
     }
   }
+  info_.resize(levels_.size());
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
+    info_[l].priority = levels_[l]->priority;
+    info_[l].diagnosis.reserve(kDiagnosisCapacity);
+  }
+  used_slot_.assign(levels_.size(), 0);
   note_.reserve(kDiagnosisCapacity);
   prox_ = Eigen::VectorXd::Zero(n_);
   Eigen::Index widest = n_;
@@ -132,7 +145,7 @@ void Cascade::size_level(int l, QpProblem& qp, bool least_squares, int held_rows
   qp.variable_names = base_.variable_names;
   for (int s = 0; s < slack; ++s) qp.variable_names.push_back("slack " + std::to_string(s + 1));
   const int held_source = static_cast<int>(qp.source_names.size());
-  qp.source_names.push_back("the higher levels' optima, held");
+  if (several_) qp.source_names.push_back("the higher levels' optima, held");
   std::copy(base_.eq_source.begin(), base_.eq_source.end(), qp.eq_source.begin());
   std::copy(base_.in_source.begin(), base_.in_source.end(), qp.in_source.begin());
   int row = base_.m_eq();
@@ -149,11 +162,12 @@ void Cascade::size_level(int l, QpProblem& qp, bool least_squares, int held_rows
     qp.in_source[static_cast<std::size_t>(base_.m_in()) + r] =
         tag.held ? held_source : scheme_->task_source(static_cast<std::size_t>(tag.task));
   }
-  const std::function<void(int, TextSink&)>& constraints = base_.in_row_description;
-  const int m_in_c = base_.m_in();
-  qp.in_row_description = [this, l, m_in_c, &constraints](int r, TextSink& out) {
+  // The description of its inequality rows, capturing no more than std::function holds without allocating (a copy,
+  // such as the elastic QP's, allocates nothing).
+  qp.in_row_description = [this, l](int r, TextSink& out) {
+    const int m_in_c = base_.m_in();
     if (r < m_in_c) {
-      if (constraints) constraints(r, out);
+      if (base_.in_row_description) base_.in_row_description(r, out);
       return;
     }
     const RowTag& tag = levels_[static_cast<std::size_t>(l)]->in_tags[static_cast<std::size_t>(r - m_in_c)];
@@ -168,15 +182,29 @@ void Cascade::size_level(int l, QpProblem& qp, bool least_squares, int held_rows
   };
 }
 
-void Cascade::setup_first(QpProblem& qp) const { size_level(0, qp, false, 0); }
-
 void Cascade::reset() {
-  for (std::size_t l = 1; l < levels_.size(); ++l) {
-    for (auto& slot : levels_[l]->slots) {
+  for (auto& level : levels_) {
+    for (auto& slot : level->slots) {
       slot->engine->reset();
       if (slot->ls_engine) slot->ls_engine->reset();
     }
   }
+}
+
+const Cascade::Slot& Cascade::last_slot(int level) const {
+  REDRES_REQUIRE(level >= 0 && level < level_count(), "Cascade", "0 <= level < level_count()");
+  const std::size_t l = static_cast<std::size_t>(level);
+  return *levels_[l]->slots[static_cast<std::size_t>(used_slot_[l])];
+}
+
+const QpProblem& Cascade::problem(int level) const {
+  const Slot& s = last_slot(level);
+  return s.used_ls ? s.ls : s.qp;
+}
+
+const SolverResult& Cascade::result(int level) const {
+  const Slot& s = last_slot(level);
+  return s.used_ls ? s.ls_result : s.result;
 }
 
 void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_squares) {
@@ -197,44 +225,22 @@ void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_
   qp.hi.head(n) = base_.hi;
   std::copy_n(base_.lo_source.begin(), n, qp.lo_source.begin());
   std::copy_n(base_.hi_source.begin(), n, qp.hi_source.begin());
-  // The level's tasks.
-  int eq = me, in = mi, slack = n;
+  // The level's tasks, through the one writer of task rows.
+  int eq = me, in = mi, slack = least_squares ? n : -1;
+  QpBuilder builder(qp);
   for (int k : L.tasks) {
     const Task& t = *scheme_->tasks()[static_cast<std::size_t>(k)];
     const TaskTerms& terms = static_cast<const TaskData&>(*data.tasks[static_cast<std::size_t>(k)]).rows;
-    const int rows = t.rows();
-    switch (t.mode()) {
-      case TaskMode::kEquality:
-        if (least_squares) {
-          QpBuilder(qp).add_least_squares(terms.J, terms.d, t.weight());
-        } else {
-          qp.J.block(eq, 0, rows, n) = terms.J;
-          qp.d.segment(eq, rows) = terms.d;
-          eq += rows;
-        }
-        break;
-      case TaskMode::kSoft:
-        QpBuilder(qp).add_least_squares(terms.J, terms.d, t.weight());
-        for (int i = 0; i < n; ++i) qp.W(i, i) += t.weight() * terms.damping;
-        break;
-      case TaskMode::kInequality:
-        for (int r = 0; r < rows; ++r) {
-          for (int side = 0; side < 2; ++side) {
-            const bool upper = side == 0;
-            if (upper ? !t.has_upper(r) : !t.has_lower(r)) continue;
-            const double sign = upper ? 1.0 : -1.0;
-            qp.A.row(in).head(n) = sign * terms.J.row(r);
-            qp.b(in) = upper ? terms.hi(r) : -terms.lo(r);
-            if (least_squares) {
-              qp.A(in, slack) = -1.0;
-              qp.W(slack, slack) = t.weight();
-              ++slack;
-            }
-            ++in;
-          }
-        }
-        break;
-    }
+    const int eq_rows = t.mode() == TaskMode::kEquality && !least_squares ? t.rows() : 0;
+    const int in_rows = t.mode() == TaskMode::kInequality ? t.inequality_rows() : 0;
+    builder.begin(scheme_->task_source(static_cast<std::size_t>(k)), 1.0, eq, eq_rows, in, in_rows);
+    slack = write_task_terms(t, terms, builder, slack);
+    eq += eq_rows;
+    in += in_rows;
+  }
+  if (!several_) {  // one level: the scheme's one QP, as Scheme::build() writes it
+    least_squares_terms_ = false;
+    return;
   }
   // Scaled so that its largest diagonal entry is 1 (the same minimiser; a level of equality rows alone, W = 0, gets
   // W = I), plus eps I: the regularization is relative to the level's own terms.
@@ -320,10 +326,6 @@ double Cascade::task_error(int l, const SchemeData& data, const Eigen::VectorXd&
   return worst;
 }
 
-void Cascade::first_task_error(const SchemeData& data, const Eigen::VectorXd& x, LevelInfo& info) const {
-  info.task_error = task_error(0, data, x);
-}
-
 void Cascade::describe_level(int l, TextSink& out) const {
   const Level& L = *levels_[static_cast<std::size_t>(l)];
   out << "priority " << L.priority << " (";
@@ -361,39 +363,24 @@ void Cascade::refine(QpProblem& qp, LviEngine& engine, SolverResult& r, int& ite
   }
 }
 
-void Cascade::refine_first(QpProblem& qp, LviEngine& engine, SolverResult& r, int& iterations) {
-  // build_first() assembled level 0 last: the flags are its own.
-  if (least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone) refine(qp, engine, r, iterations);
-}
-
-void Cascade::build_first(const Context& ctx, SchemeData& data, QpProblem& qp) {
+bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eigen::VectorXd& x) {
+  REDRES_REQUIRE(x.size() == n_, "Cascade::solve", "x has n entries");
   scheme_->build_constraints(ctx, base_, data);
   scheme_->evaluate_tasks(ctx, data);
   held_eq_ = held_in_ = 0;
-  obj_w_ = scheme_->build_objectives(ctx, 0, obj_, data);
-  assemble(0, data, qp, false);
-}
-
-void Cascade::solve_rest(const Context& ctx, SchemeData& data, const Eigen::VectorXd& x0,
-                         std::vector<LevelInfo>& levels, Eigen::VectorXd& x) {
-  REDRES_REQUIRE(levels.size() == levels_.size() && x.size() == n_ && x0.size() == n_, "Cascade::solve_rest",
-                 "levels has one entry per level and x, x0 have n entries");
-  x = x0;
-  hold(0, data, x);
   // Why the levels below are skipped, once one is: -1 none, 0 nothing left to decide, 1 a level failed.
-  int skip = obj_w_ != QpBuilder::WrittenW::kNone || held_eq_ >= n_ ? 0 : -1;
+  int skip = -1;
   int decided_by = 0;
-  for (std::size_t l = 1; l < levels_.size(); ++l) {
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
     Level& L = *levels_[l];
-    LevelInfo& info = levels[l];
-    info.priority = L.priority;
-    info.status = SolverStatus::kNotRun;
-    info.iterations = 0;
-    info.residual = 0.0;
-    info.task_error = 0.0;
-    keep_diagnosis_capacity(info.diagnosis);
-    info.diagnosis.clear();
-    TextSink text(info.diagnosis);
+    LevelInfo& level = info_[l];
+    level.status = SolverStatus::kNotRun;
+    level.iterations = 0;
+    level.residual = 0.0;
+    level.task_error = 0.0;
+    keep_diagnosis_capacity(level.diagnosis);
+    level.diagnosis.clear();
+    TextSink text(level.diagnosis);
     text.precision(6);
     if (skip >= 0) {
       text << "skipped: ";
@@ -407,32 +394,52 @@ void Cascade::solve_rest(const Context& ctx, SchemeData& data, const Eigen::Vect
       continue;
     }
     obj_w_ = scheme_->build_objectives(ctx, static_cast<int>(l), obj_, data);
-    Level::Slot& S = *L.slots[static_cast<std::size_t>(held_eq_)];
+    used_slot_[l] = held_eq_;
+    Slot& S = *L.slots[static_cast<std::size_t>(held_eq_)];
+    S.used_ls = false;
     assemble(static_cast<int>(l), data, S.qp, false);
-    S.engine->solve_valid(S.qp, S.result);
-    info.iterations = S.result.info.iterations;
-    info.residual = S.result.info.residual;
-    info.status = S.result.info.status;
-    const Eigen::VectorXd* answer = nullptr;
+    S.engine->solve_valid(S.qp, S.result);  // assemble() wrote only checked entries
+    if (l == 0) info = S.result.info;       // the step's outcome, before any proximal step
+    level.iterations = S.result.info.iterations;
+    level.residual = S.result.info.residual;
+    level.status = S.result.info.status;
+    SolverResult* answer = nullptr;
     if (S.result.info.status == SolverStatus::kSolved) {
-      answer = &S.result.x;
+      answer = &S.result;
     } else if (L.has_ls) {
       assemble(static_cast<int>(l), data, S.ls, true);
       S.ls_engine->solve_valid(S.ls, S.ls_result);
-      info.iterations += S.ls_result.info.iterations;
+      level.iterations += S.ls_result.info.iterations;
       if (S.ls_result.info.status == SolverStatus::kSolved) {
-        answer = &S.ls_result.x;
-        info.residual = S.ls_result.info.residual;
+        answer = &S.ls_result;
+        S.used_ls = true;
+        level.residual = S.ls_result.info.residual;
         text << "its tasks cannot all be met below the higher levels (" << to_string(S.result.info.status)
              << "): solved in least squares";
-        info.status = SolverStatus::kRelaxed;
+        level.status = SolverStatus::kRelaxed;
       } else {
         note_.assign(S.ls_result.info.diagnosis);
       }
     }
+    if (answer == nullptr && l == 0) {
+      // The first level failed: the step's failure, for the controller's policy; the levels below are not tried.
+      text << "the step's QP (priority " << L.priority << ") failed";
+      for (std::size_t k = 1; k < levels_.size(); ++k) {
+        LevelInfo& below = info_[k];
+        below.status = SolverStatus::kNotRun;
+        below.iterations = 0;
+        below.residual = 0.0;
+        below.task_error = 0.0;
+        keep_diagnosis_capacity(below.diagnosis);
+        below.diagnosis.clear();
+        TextSink(below.diagnosis) << "skipped: priority " << L.priority << " failed";
+      }
+      return false;
+    }
     if (answer != nullptr && least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone) {
-      const bool first = answer == &S.result.x;
-      refine(first ? S.qp : S.ls, first ? *S.engine : *S.ls_engine, first ? S.result : S.ls_result, info.iterations);
+      const bool first = !S.used_ls;
+      refine(first ? S.qp : S.ls, first ? *S.engine : *S.ls_engine, *answer, level.iterations);
+      level.residual = answer->info.residual;
     }
     if (answer == nullptr) {
       describe_level(static_cast<int>(l), text);
@@ -442,14 +449,17 @@ void Cascade::solve_rest(const Context& ctx, SchemeData& data, const Eigen::Vect
       skip = 1;
       continue;
     }
-    x = answer->head(n_);
-    info.task_error = task_error(static_cast<int>(l), data, x);
+    x = answer->x.head(n_);
+    level.task_error = task_error(static_cast<int>(l), data, x);
     hold(static_cast<int>(l), data, x);
     if (obj_w_ != QpBuilder::WrittenW::kNone || held_eq_ >= n_) {
       skip = 0;
       decided_by = static_cast<int>(l);
     }
   }
+  info.iterations = 0;
+  for (const LevelInfo& level : info_) info.iterations += level.iterations;
+  return true;
 }
 
 }  // namespace redres

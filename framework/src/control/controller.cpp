@@ -44,8 +44,8 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
       pending_(Eigen::VectorXd::Zero(robot.dof())),
       measured_(Eigen::VectorXd::Zero(robot.dof())),
       v_(Eigen::VectorXd::Zero(robot.dof())),
-      lim_lo_(Eigen::VectorXd::Zero(robot.dof())),
-      lim_hi_(Eigen::VectorXd::Zero(robot.dof())),
+      acc_lo_(Eigen::VectorXd::Zero(robot.dof())),
+      acc_hi_(Eigen::VectorXd::Zero(robot.dof())),
       jerk_lo_(Eigen::VectorXd::Zero(robot.dof())),
       jerk_hi_(Eigen::VectorXd::Zero(robot.dof())) {
   REDRES_REQUIRE(&scheme.robot() == &robot, "Controller", "the scheme was built for this robot");
@@ -56,14 +56,8 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
                    "the path has one row per task position row (" + std::to_string(position_rows) + ")");
   }
   level_ = scheme.kinematics_level();
-  if (scheme.cascaded()) {
-    cascade_ = std::make_unique<Cascade>(scheme, *data_, engine);
-    cascade_->setup_first(qp_);
-    x_levels_ = Eigen::VectorXd::Zero(robot.dof());
-  } else {
-    scheme.setup(qp_, *data_);
-  }
-  engine.setup(qp_.n(), qp_.m_eq(), qp_.m_in(), result_);
+  cascade_ = std::make_unique<Cascade>(scheme, *data_, engine);  // every scheme is a list of levels (one QP each)
+  x_ = Eigen::VectorXd::Zero(robot.dof());
   ctx_.T = T;
   ctx_.tau = tau;
   ctx_.robot = &robot;
@@ -72,11 +66,19 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
   ctx_.r_d_dot = &r_d_dot_;
   ctx_.velocity_lower = &vlo_;
   ctx_.velocity_upper = &vhi_;
+  if (robot.has_acceleration_limits()) {
+    ctx_.acceleration_lower = &acc_lo_;
+    ctx_.acceleration_upper = &acc_hi_;
+  }
+  if (robot.has_jerk_limits()) {
+    ctx_.jerk_lower = &jerk_lo_;
+    ctx_.jerk_upper = &jerk_hi_;
+  }
   ctx_.theta_dot_prev = &prev_;
   ctx_.theta_dot_prev2 = &prev2_;
   ctx_.status_prev = SolverStatus::kNotRun;
-  ctx_.level = scheme.level();
-  if (ctx_.level == SchemeLevel::kAcceleration) {
+  ctx_.order = scheme.order();
+  if (ctx_.order == ControlOrder::kAcceleration) {
     ctx_.r_d_ddot = &r_d_ddot_;
     ctx_.theta_dot = &v_;
   }
@@ -89,19 +91,15 @@ StepOutput Controller::make_output() const {
   out.theta_dot = Eigen::VectorXd::Zero(robot_->dof());
   out.theta_ddot = Eigen::VectorXd::Zero(robot_->dof());
   out.info.diagnosis.reserve(kDiagnosisCapacity);  // a failed step's text is written here without allocating
-  if (cascade_) {
-    out.levels.resize(static_cast<std::size_t>(cascade_->level_count()));
-    for (std::size_t l = 0; l < out.levels.size(); ++l) {
-      out.levels[l].priority = scheme_->levels()[l].priority;
-      out.levels[l].diagnosis.reserve(kDiagnosisCapacity);
-    }
+  if (scheme_->cascaded()) {                       // one level: info says it all
+    out.levels = cascade_->levels();
+    for (LevelInfo& level : out.levels) level.diagnosis.reserve(kDiagnosisCapacity);
   }
   return out;
 }
 
 void Controller::reset() {
-  engine_->reset();
-  if (cascade_) cascade_->reset();
+  cascade_->reset();
   orientation_.forget_captured();
   prev_.setZero();
   prev2_.setZero();
@@ -123,7 +121,7 @@ void Controller::begin_step() {
     ++ctx_.step_index;
     have_pending_ = false;
   }
-  if (ctx_.level == SchemeLevel::kAcceleration) v_ = ctx_.theta_dot_measured != nullptr ? measured_ : prev_;
+  if (ctx_.order == ControlOrder::kAcceleration) v_ = ctx_.theta_dot_measured != nullptr ? measured_ : prev_;
 }
 
 void Controller::end_step(const StepOutput& out) {
@@ -170,7 +168,7 @@ void Controller::reevaluate(const Eigen::Ref<const Eigen::VectorXd>& theta, doub
   REDRES_REQUIRE(path_ != nullptr, "Controller::step", "a path was given (or pass r_d and r_d_dot)");
   compute_kinematics(*robot_, theta, kin_, level_);
   const int p = path_->dim();
-  if (ctx_.level == SchemeLevel::kVelocity) {
+  if (ctx_.order == ControlOrder::kVelocity) {
     path_->evaluate(t, r_d_.head(p), r_d_dot_.head(p));
     if (robot_->reference_dim() > p) orientation_.evaluate(*robot_, kin_, t, ctx_.T, p, r_d_, r_d_dot_);
   } else {
@@ -183,7 +181,7 @@ void Controller::reevaluate(const Eigen::Ref<const Eigen::VectorXd>& theta, doub
 void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
                       const Eigen::Ref<const Eigen::VectorXd>& r_d, const Eigen::Ref<const Eigen::VectorXd>& r_d_dot,
                       StepOutput& out) {
-  REDRES_REQUIRE(ctx_.level == SchemeLevel::kVelocity, "Controller::step",
+  REDRES_REQUIRE(ctx_.order == ControlOrder::kVelocity, "Controller::step",
                  "a velocity-level scheme (an acceleration-level one needs r_d_ddot too)");
   step(theta, t, r_d, r_d_dot, r_d_dot, out);  // r_d_ddot is not read at the velocity level
 }
@@ -202,14 +200,14 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
   compute_kinematics(*robot_, theta, kin_, level_);
   r_d_ = r_d;
   r_d_dot_ = r_d_dot;
-  if (ctx_.level == SchemeLevel::kAcceleration) r_d_ddot_ = r_d_ddot;
+  if (ctx_.order == ControlOrder::kAcceleration) r_d_ddot_ = r_d_ddot;
   solve(t, out);
   end_step(out);
 }
 
 void Controller::apply(const Eigen::VectorXd& x, StepOutput& out) {
   const double tau = ctx_.tau;
-  if (ctx_.level == SchemeLevel::kVelocity) {
+  if (ctx_.order == ControlOrder::kVelocity) {
     out.theta_dot = x;
     out.theta_ddot = (x - prev_) / tau;
   } else {
@@ -223,15 +221,17 @@ void Controller::solve(double t, StepOutput& out) {
                  "out was made by make_output() (theta_dot and theta_ddot have n entries)");
   ctx_.t = t;
   out.task_row_error = 0.0;
+  const bool several = scheme_->cascaded();
+  REDRES_REQUIRE(out.levels.size() == (several ? static_cast<std::size_t>(cascade_->level_count()) : 0),
+                 "Controller::step", "out was made by make_output() (one LevelInfo per priority level, if several)");
+  keep_diagnosis_capacity(out.info.diagnosis);  // a no-op unless the caller's output lost its reserve
+  bool solved = false;
   try {
+    // Every law once per step, read through the Context (and by braking, should the step fail).
+    if (ctx_.acceleration_lower != nullptr) robot_->acceleration_limits(kin_.theta, acc_lo_, acc_hi_);
+    if (ctx_.jerk_lower != nullptr) robot_->jerk_limits(kin_.theta, jerk_lo_, jerk_hi_);
     robot_->velocity_limits(kin_.theta, vlo_, vhi_);
-    if (cascade_) {
-      REDRES_REQUIRE(out.levels.size() == static_cast<std::size_t>(cascade_->level_count()), "Controller::step",
-                     "out was made by make_output() (one LevelInfo per priority level)");
-      cascade_->build_first(ctx_, *data_, qp_);
-    } else {
-      scheme_->build(ctx_, qp_, *data_);
-    }
+    solved = cascade_->solve(ctx_, *data_, out.info, x_);
   } catch (const std::invalid_argument& e) {
     // A plugin or a law gave NaN or inf at this state (a user formula that is NaN in a narrow window): a failed step
     // that moves nothing, not the end of the run. The controller's own calls meet build()'s other conditions.
@@ -259,29 +259,13 @@ void Controller::solve(double t, StepOutput& out) {
     give_up(out);
     return;
   }
-  engine_->solve_valid(qp_, result_);           // build() checked every entry it wrote
-  keep_diagnosis_capacity(out.info.diagnosis);  // a no-op unless the caller's output lost its reserve
-  out.info = result_.info;
-  if (result_.info.status == SolverStatus::kSolved) {
-    if (cascade_) {
-      solve_levels(out);
-      return;
-    }
-    apply(result_.x, out);
-    return;
+  if (several) {
+    for (std::size_t l = 0; l < out.levels.size(); ++l)
+      out.levels[l] = cascade_->levels()[l];  // reserved: no allocation
   }
-  if (cascade_) {
-    // Level 0 failed: the step's failure, for the policy; the levels below are not tried.
-    for (std::size_t l = 0; l < out.levels.size(); ++l) {
-      LevelInfo& level = out.levels[l];
-      level.status = l == 0 ? result_.info.status : SolverStatus::kNotRun;
-      level.iterations = l == 0 ? result_.info.iterations : 0;
-      level.residual = l == 0 ? result_.info.residual : 0.0;
-      level.task_error = 0.0;
-      keep_diagnosis_capacity(level.diagnosis);
-      level.diagnosis.clear();
-      TextSink(level.diagnosis) << (l == 0 ? "the step's QP (priority 0) failed" : "skipped: priority 0 failed");
-    }
+  if (solved) {
+    apply(x_, out);
+    return;
   }
   // The step failed: the policy decides (never the unconverged iterate).
   bool relaxed = false;
@@ -293,21 +277,6 @@ void Controller::solve(double t, StepOutput& out) {
     if (error > recover_error_) relaxed = relax(out);  // behind the target: catch up within the limits
   }
   if (!relaxed) give_up(out);
-}
-
-void Controller::solve_levels(StepOutput& out) {
-  LevelInfo& first = out.levels.front();
-  first.status = result_.info.status;
-  first.iterations = result_.info.iterations;
-  cascade_->refine_first(qp_, *engine_, result_, first.iterations);
-  out.info.iterations = first.iterations;
-  first.residual = result_.info.residual;
-  keep_diagnosis_capacity(first.diagnosis);
-  first.diagnosis.clear();
-  cascade_->first_task_error(*data_, result_.x, first);
-  cascade_->solve_rest(ctx_, *data_, result_.x, out.levels, x_levels_);
-  for (std::size_t l = 1; l < out.levels.size(); ++l) out.info.iterations += out.levels[l].iterations;
-  apply(x_levels_, out);
 }
 
 void Controller::give_up(StepOutput& out) {
@@ -356,13 +325,13 @@ void Controller::set_failure_policy(FailurePolicy policy, double relax_weight, d
     return;
   }
   note_.reserve(kDiagnosisCapacity);
-  if (!fallback_.ready()) fallback_.setup(qp_, *engine_);
+  if (!fallback_.ready()) fallback_.setup(cascade_->problem(0), *engine_);
 }
 
 bool Controller::relax(StepOutput& out) {
   // The elastic QP (qp/elastic.hpp): the rows become a penalty of weight rho; bounds and inequality rows stay.
   const double rho = relax_weight_;
-  const SolverResult& relaxed = fallback_.solve(qp_, rho);
+  const SolverResult& relaxed = fallback_.solve(cascade_->problem(0), rho);
   const SolverInfo& r = relaxed.info;
   if (r.status != SolverStatus::kSolved) {
     TextSink(out.info.diagnosis).precision(6) << "; the elastic QP (rows relaxed with weight " << rho
@@ -386,18 +355,15 @@ bool Controller::relax(StepOutput& out) {
 void Controller::brake(StepOutput& out) {
   // The braking law (control/brake.hpp): theta_dot = s b, b the velocity before the step.
   const Eigen::VectorXd& b = base();
-  robot_->acceleration_limits(kin_.theta, lim_lo_, lim_hi_);
+  // The laws at theta, as the step evaluated them (brake() runs only for a robot with acceleration limits).
   BrakeInput in;
   in.velocity = &b;
-  in.acceleration_lower = &lim_lo_;
-  in.acceleration_upper = &lim_hi_;
+  in.acceleration_lower = &acc_lo_;
+  in.acceleration_upper = &acc_hi_;
   in.velocity_lower = &vlo_;
   in.velocity_upper = &vhi_;
-  if (robot_->has_jerk_limits()) {
-    robot_->jerk_limits(kin_.theta, jerk_lo_, jerk_hi_);
-    in.jerk_lower = &jerk_lo_;
-    in.jerk_upper = &jerk_hi_;
-  }
+  in.jerk_lower = ctx_.jerk_lower;
+  in.jerk_upper = ctx_.jerk_upper;
   in.previous = &prev_;
   in.previous2 = &prev2_;
   in.tau = ctx_.tau;

@@ -8,29 +8,40 @@
 
 namespace redres {
 
+namespace {
+// The plugins, owned as const from here on.
+template <class T>
+std::vector<std::unique_ptr<const T>> frozen(std::vector<std::unique_ptr<T>> plugins) {
+  std::vector<std::unique_ptr<const T>> out;
+  out.reserve(plugins.size());
+  for (auto& p : plugins) out.push_back(std::move(p));
+  return out;
+}
+}  // namespace
+
 Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
-               std::vector<std::unique_ptr<Constraint>> constraints, SchemeLevel level)
-    : Scheme(robot, std::move(objectives), std::move(constraints), {}, level) {}
+               std::vector<std::unique_ptr<Constraint>> constraints, ControlOrder order)
+    : Scheme(robot, std::move(objectives), std::move(constraints), {}, order) {}
 
 Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
                std::vector<std::unique_ptr<Constraint>> constraints, std::vector<std::unique_ptr<Task>> tasks,
-               SchemeLevel level)
+               ControlOrder order)
     : robot_(&robot),
-      objectives_(std::move(objectives)),
-      constraints_(std::move(constraints)),
-      tasks_(std::move(tasks)),
-      scheme_level_(level) {
+      objectives_(frozen(std::move(objectives))),
+      constraints_(frozen(std::move(constraints))),
+      tasks_(frozen(std::move(tasks))),
+      order_(order) {
   std::set<std::string> names;
-  // Every plugin: present, uniquely named, working at the scheme's level; the scheme reads the deepest kinematics.
+  // Every plugin: present, uniquely named, working at the scheme's order; the scheme reads the deepest kinematics.
   const auto admit = [&](const Plugin* p, const char* kind) {
     REDRES_REQUIRE(p != nullptr, "Scheme", std::string("every ") + kind + " is non-null");
     REDRES_REQUIRE(names.insert(p->name()).second, "Scheme",
                    "plugin names are unique (two are named '" + p->name() + "'; rename one with set_name())");
-    level_ = std::max(level_, p->kinematics_level());
-    if (!p->active() || p->supports(level)) return;
+    kinematics_level_ = std::max(kinematics_level_, p->kinematics_level());
+    if (!p->active() || p->supports(order)) return;
     throw std::invalid_argument(std::string(kind) + " '" + p->name() + "' (type " + p->type() +
                                 ") does not work at the " +
-                                (level == SchemeLevel::kAcceleration ? "acceleration" : "velocity") +
+                                (order == ControlOrder::kAcceleration ? "acceleration" : "velocity") +
                                 " level ([scheme] level); docs/motion.md lists the plugins that do");
   };
   for (const auto& o : objectives_) admit(o.get(), "objective");
@@ -86,7 +97,9 @@ Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> 
     m_in_ += i;
   }
   // The acceleration level's task reads J_dot theta_dot = sum_i theta_dot_i dJ/dtheta_i theta_dot.
-  if (level == SchemeLevel::kAcceleration) level_ = std::max(level_, KinematicsLevel::kManipulability);
+  if (order == ControlOrder::kAcceleration) {
+    kinematics_level_ = std::max(kinematics_level_, KinematicsLevel::kManipulability);
+  }
 }
 
 Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, double duration, double step) {
@@ -141,24 +154,24 @@ Scheme Scheme::from_toml(const TableReader& root, const RobotModel& robot, doubl
   };
   if (robot.has_acceleration_limits() && !listed("joint_acceleration_limits")) add_default("joint_acceleration_limits");
   if (robot.has_jerk_limits() && !listed("joint_jerk_limits")) add_default("joint_jerk_limits");
-  SchemeLevel level = SchemeLevel::kVelocity;
+  ControlOrder order = ControlOrder::kVelocity;
   if (root.has("scheme")) {
     const TableReader t = root.table("scheme");
     const TableReader scheme(t.file_ptr(), t.raw(), "scheme");
     SchemeTable table;
     read_config(scheme, SchemeTable::schema(), table);
     scheme.finish();
-    level = table.level;
+    order = table.order;
     const double eps = table.regularization;
     try {
-      Scheme out(robot, std::move(objectives), std::move(constraints), std::move(tasks), level);
+      Scheme out(robot, std::move(objectives), std::move(constraints), std::move(tasks), order);
       out.set_regularization(eps);
       return out;
     } catch (const std::invalid_argument& e) {
       scheme.fail("level", e.what());
     }
   }
-  return Scheme(robot, std::move(objectives), std::move(constraints), std::move(tasks), level);
+  return Scheme(robot, std::move(objectives), std::move(constraints), std::move(tasks), order);
 }
 
 static_assert(SchemeTable{}.regularization == Scheme::kDefaultRegularization, "one default of the regularization");
@@ -167,7 +180,7 @@ const Schema<SchemeTable>& SchemeTable::schema() {
   using C = SchemeTable;
   static const Schema<C> s{
       {field(
-           "level", &C::level, "",
+           "level", &C::order, "",
            "what x is: \"velocity\" (x = theta_dot, the paper's) or \"acceleration\" (x = theta_ddot; docs/motion.md)"),
        field("regularization", &C::regularization, "",
              "the eps |x|^2 / 2 that every priority level adds to its QP (docs/tasks.md)",
@@ -291,7 +304,7 @@ QpBuilder::WrittenW Scheme::build_objectives(const Context& ctx, int level, QpPr
 void Scheme::check_inputs(const Context& ctx, const SchemeData& data) const {
   REDRES_REQUIRE(ctx.kinematics != nullptr && ctx.robot == robot_, "Scheme::build",
                  "ctx.robot is the scheme's robot and ctx.kinematics is set");
-  REDRES_REQUIRE(ctx.kinematics->level >= level_, "Scheme::build",
+  REDRES_REQUIRE(ctx.kinematics->level >= kinematics_level_, "Scheme::build",
                  "ctx.kinematics was computed at kinematics_level() or deeper");
   REDRES_REQUIRE(data.objectives.size() == objectives_.size() && data.constraints.size() == constraints_.size() &&
                      data.tasks.size() == tasks_.size(),

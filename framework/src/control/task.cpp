@@ -98,35 +98,48 @@ void Task::evaluate(const Context& ctx, TaskData& data) const {
   bad_rows(*this, "damping term", 0, -1, t.damping);
 }
 
-void write_task_terms(const Task& task, const TaskTerms& t, QpBuilder& builder) {
+int write_task_terms(const Task& task, const TaskTerms& t, QpBuilder& builder, int slack) {
+  const Eigen::Index n = t.J.cols();
+  const bool least_squares = slack >= 0;
   switch (task.mode()) {
-    case TaskMode::kEquality: {
-      auto J = builder.equality_matrix();
-      J = t.J;
-      builder.equality_rhs() = t.d;
+    case TaskMode::kEquality:
+      if (least_squares) {
+        builder.add_least_squares(t.J, t.d, task.weight());
+      } else {
+        builder.equality_matrix().leftCols(n) = t.J;
+        builder.equality_rhs() = t.d;
+      }
       break;
-    }
     case TaskMode::kInequality: {
       auto A = builder.inequality_matrix();
       auto b = builder.inequality_rhs();
       Eigen::Index row = 0;
       for (Eigen::Index r = 0; r < t.J.rows(); ++r) {
-        if (task.has_upper(static_cast<int>(r))) {
-          A.row(row) = t.J.row(r);
-          b(row++) = t.hi(r);
-        }
-        if (task.has_lower(static_cast<int>(r))) {
-          A.row(row) = -t.J.row(r);
-          b(row++) = -t.lo(r);
+        for (int side = 0; side < 2; ++side) {
+          const bool upper = side == 0;
+          if (upper ? !task.has_upper(static_cast<int>(r)) : !task.has_lower(static_cast<int>(r))) continue;
+          if (upper) {
+            A.row(row).head(n) = t.J.row(r);
+          } else {
+            A.row(row).head(n) = -t.J.row(r);
+          }
+          b(row) = upper ? t.hi(r) : -t.lo(r);
+          if (least_squares) {
+            A(row, slack) = -1.0;
+            builder.set_diagonal(slack, task.weight());
+            ++slack;
+          }
+          ++row;
         }
       }
       break;
     }
     case TaskMode::kSoft:
       builder.add_least_squares(t.J, t.d, task.weight());
-      if (t.damping > 0.0) builder.add_identity(task.weight() * t.damping);
+      if (t.damping > 0.0) builder.add_identity(task.weight() * t.damping, n);
       break;
   }
+  return slack;
 }
 
 double smallest_singular_value(const Eigen::Ref<const Eigen::MatrixXd>& J) {

@@ -334,14 +334,13 @@ struct KinematicsKernels {
     }
   }
 
-  // Planar kernel: w and grad w in O(m n) from the prefix and suffix sums of the class comment. M is the number of
-  // task rows m (1 to 3), fixed at compile time so that the loops over the rows unroll.
+  // Planar kernel: w = det(J J') (with adj(J J') for the gradient). M is the number of task rows m (1 to 3), fixed at
+  // compile time so that the loops over the rows unroll.
   template <int M>
-  static void gradient_planar(const RobotModel& model, KinematicsData& data) {
+  static void measure_planar(const RobotModel& model, KinematicsData& data) {
     const int n = model.dof();
     constexpr int m = M;
     const double* J = data.J.data();
-    const double* lin = data.linear_.data();
     // A = J J' (lower triangle summed, then mirrored).
     double A[3][3] = {};
     for (int j = 0; j < n; ++j) {
@@ -361,6 +360,16 @@ struct KinematicsKernels {
     } else {
       data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
     }
+  }
+
+  // Planar kernel: w (measure_planar<M>) and grad w in O(m n) from the prefix and suffix sums of the class comment.
+  template <int M>
+  static void gradient_planar(const RobotModel& model, KinematicsData& data) {
+    measure_planar<M>(model, data);
+    const int n = model.dof();
+    constexpr int m = M;
+    const double* J = data.J.data();
+    const double* lin = data.linear_.data();
     // W = adj(A) J in the x and y rows only (h is zero in the phi row).
     double adj_x[3] = {}, adj_y[3] = {};
     bool has_x = false, has_y = false;
@@ -479,6 +488,20 @@ struct KinematicsKernels {
     if (!planar) jacobian_general(model, data);
     data.level = KinematicsLevel::kJacobian;
     if (level == KinematicsLevel::kJacobian) return;
+    if (level == KinematicsLevel::kMeasure) {  // w alone, computed as the gradient's paths compute it
+      if (planar) {
+        switch (model.task_dim()) {
+          case 1: measure_planar<1>(model, data); break;
+          case 2: measure_planar<2>(model, data); break;
+          default: measure_planar<3>(model, data); break;
+        }
+      } else {
+        data.jjt_.noalias() = data.J * data.J.transpose();
+        data.w = symmetric_det_adjugate(data.jjt_, data.adj_, data.eig_);
+      }
+      data.level = KinematicsLevel::kMeasure;
+      return;
+    }
     if (planar) {
       switch (model.task_dim()) {
         case 1: gradient_planar<1>(model, data); break;

@@ -47,6 +47,9 @@ const Schema<PlantConfig>& PlantConfig::schema() {
   static const Schema<C> s{{
       field("kind", &C::kind, "",
             "what the commands drive: \"kinematic\" (theta <- theta + tau theta_dot) or \"mujoco\" (a physics plant)"),
+      field("kinematic_comparison", &C::kinematic_comparison, "",
+            "also run the scenario on the kinematic plant first, for `plant.kinematic_max_position_error` in the "
+            "summary (kind = \"mujoco\")"),
       field("timestep", &C::timestep, "s",
             "MuJoCo's time step; the scenario's `step` (the control period) must be a whole number of them (0: the "
             "smaller of 1 ms and `step`)",

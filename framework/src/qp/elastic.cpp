@@ -6,6 +6,7 @@ void ElasticQp::setup(const QpProblem& qp) {
   elastic_.resize(qp.n(), 0, qp.m_in());
   elastic_.source_names = qp.source_names;
   elastic_.variable_names = qp.variable_names;
+  elastic_.in_row_description = qp.in_row_description;  // once: a copy of a std::function may allocate
 }
 
 void ElasticQp::build(const QpProblem& qp, double rho) {
@@ -23,7 +24,6 @@ void ElasticQp::build(const QpProblem& qp, double rho) {
   elastic_.lo_source = qp.lo_source;
   elastic_.hi_source = qp.hi_source;
   elastic_.in_source = qp.in_source;
-  elastic_.in_row_description = qp.in_row_description;
 }
 
 }  // namespace redres

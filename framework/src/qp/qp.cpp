@@ -17,8 +17,6 @@ void QpProblem::resize(int n, int m_e, int m_i) {
   b.resize(m_i);
   lo.resize(n);
   hi.resize(n);
-  scratch.resize(n);
-  scratch2.resize(n);
   lo_source.assign(static_cast<std::size_t>(n), -1);
   hi_source.assign(static_cast<std::size_t>(n), -1);
   eq_source.assign(static_cast<std::size_t>(m_e), -1);

@@ -9,7 +9,7 @@ std::unique_ptr<Controller> Controller::from_scenario(const Scenario& s) {
                  "the scenario has a robot and a scheme (as load_scenario makes it)");
   auto ctrl = std::make_unique<Controller>(*s.robot, *s.scheme, s.engine.make(), s.path.get(), s.duration, s.tau);
   ctrl->set_orientation_turn(s.orientation_turn);
-  ctrl->set_kinematics_level(KinematicsLevel::kGradient);
+  ctrl->set_kinematics_level(KinematicsLevel::kMeasure);
   ctrl->set_failure_policy(s.on_infeasible, s.relax_weight, s.recover_error);
   return ctrl;
 }

@@ -192,8 +192,7 @@ class IkSolver {
       if (model_.kind() == ChainKind::kPlanar) {
         if (model_.tracks(2)) sr = std::pow(wrap_angle(phi_ - kin_->f(2)), 2);
       } else {
-        const Eigen::AngleAxisd err(*target_.rotation * kin_->ee_pose.linear().transpose());
-        const Eigen::Vector3d v = err.angle() * err.axis();
+        const Eigen::Vector3d v = orientation_error_vector(*target_.rotation, kin_->ee_pose.linear());
         for (int r = 0; r < 3; ++r) {
           if (model_.tracks(3 + r)) sr += v(r) * v(r);
         }

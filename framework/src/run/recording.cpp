@@ -27,12 +27,10 @@ Eigen::Vector3d continuous_rotation_vector(const Eigen::Vector3d& w, const Eigen
 
 }  // namespace
 
-std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders) {
-  return run_columns(s, recorders, s.plant.kind);
-}
-
-std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders, PlantKind plant) {
-  std::vector<std::string> columns = standard_trajectory_columns(*s.robot);
+RunColumns run_columns(const Scenario& s, const PlantType& plant) {
+  RunColumns out;
+  std::vector<std::string>& columns = out.names;
+  columns = standard_trajectory_columns(*s.robot);
   const auto add_recorder = [&](const Plugin& p, std::size_t objective, std::size_t constraint,
                                 std::size_t task = kNoPlugin) {
     if (!p.active()) return;
@@ -40,7 +38,7 @@ std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* r
     if (output == nullptr) return;
     const std::vector<std::string> own = output->recorded_columns();
     if (own.empty()) return;
-    if (recorders != nullptr) recorders->push_back({output, nullptr, columns.size(), objective, constraint, task});
+    out.recorders.push_back({output, nullptr, columns.size(), objective, constraint, task});
     for (const auto& c : own) {
       // Two plugins may record the same quantity (two obstacle sets): the second gets its name as a prefix.
       const bool taken = std::find(columns.begin(), columns.end(), c) != columns.end();
@@ -53,31 +51,24 @@ std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* r
   for (std::size_t k = 0; k < constraints.size(); ++k) add_recorder(*constraints[k], kNoPlugin, k);
   const auto& tasks = s.scheme->tasks();
   for (std::size_t k = 0; k < tasks.size(); ++k) add_recorder(*tasks[k], kNoPlugin, kNoPlugin, k);
+  out.levels_first = columns.size();
   if (s.scheme->cascaded()) {
     for (const SchemeLevelSpec& level : s.scheme->levels()) {
       columns.push_back("level_" + std::to_string(level.priority) + "_status");
       columns.push_back("level_" + std::to_string(level.priority) + "_iterations");
     }
   }
-  if (plant == PlantKind::kMujoco) {
-    for (auto& c : plant_columns(s.robot->dof())) columns.push_back(std::move(c));
+  out.plant_first = columns.size();
+  if (plant.columns) {
+    for (auto& c : plant.columns(s)) columns.push_back(std::move(c));
   }
-  return columns;
+  return out;
 }
 
-std::vector<std::string> plant_columns(int n) {
-  std::vector<std::string> columns;
-  for (int j = 1; j <= n; ++j) columns.push_back("measured_theta_dot_" + std::to_string(j));
-  for (int j = 1; j <= n; ++j) columns.push_back("torque_" + std::to_string(j));
-  columns.push_back("contacts");
-  columns.push_back("penetration");
-  return columns;
-}
-
-RowRecorder::RowRecorder(const Scenario& s, const Controller& ctrl, std::vector<Recorder> recorders, std::size_t width)
+RowRecorder::RowRecorder(const Scenario& s, const Controller& ctrl, RunColumns layout, std::size_t width)
     : robot_(s.robot.get()),
       ctrl_(&ctrl),
-      recorders_(std::move(recorders)),
+      recorders_(std::move(layout.recorders)),
       groups_(&trajectory_column_groups()),
       row_(width),
       n_(s.robot->dof()),
@@ -89,15 +80,9 @@ RowRecorder::RowRecorder(const Scenario& s, const Controller& ctrl, std::vector<
              : r.constraint != kNoPlugin ? data.constraints[r.constraint].get()
                                          : data.tasks[r.task].get();
   }
-  if (s.scheme->cascaded()) {
-    const std::vector<std::string> columns = run_columns(s, nullptr);
-    const std::string first = "level_" + std::to_string(s.scheme->levels().front().priority) + "_status";
-    levels_first_ = static_cast<std::size_t>(std::find(columns.begin(), columns.end(), first) - columns.begin());
-  }
+  levels_first_ = layout.levels_first;
   standard_columns_ = recorders_.empty() ? width : recorders_.front().first;
   orientation_rows_ = robot_->has_orientation_rows();
-  acc_lo_.resize(n_);
-  acc_hi_.resize(n_);
   acc_limits_ = robot_->has_acceleration_limits();
   spatial_orientation_ = orientation_rows_ && robot_->kind() == ChainKind::kSpatial;
   for (int r = 0; r < m_; ++r) (r < position_rows_ ? all_position_rows_ : all_orientation_rows_) &= robot_->tracks(r);
@@ -160,7 +145,8 @@ double* RowRecorder::write(int k, double t, const Eigen::VectorXd& theta, const 
         // R_d R' (from the rotations themselves). A subset of the orientation rows: the norm of those rows of the
         // rotation vector of R_d R'.
         if (spatial_orientation_) {
-          const Eigen::AngleAxisd err(rotation_from_vector(ctrl_->r_d().tail<3>()) * kin.ee_pose.linear().transpose());
+          const Eigen::AngleAxisd err =
+              orientation_error(rotation_from_vector(ctrl_->r_d().tail<3>()), kin.ee_pose.linear());
           row[c++] = all_orientation_rows_ ? err.angle() : tracked_norm(err.angle() * err.axis(), 3, 3);
         } else {
           row[c++] = std::abs(ctrl_->r_d()(2) - kin.f(2));
@@ -174,12 +160,10 @@ double* RowRecorder::write(int k, double t, const Eigen::VectorXd& theta, const 
       case StepValue::kStatus: row[c++] = static_cast<double>(static_cast<int>(out.info.status)); break;
       case StepValue::kThetaDdot: put(out.theta_ddot); break;
       case StepValue::kAccelerationLower:
-        if (!acc_limits_) break;
-        robot_->acceleration_limits(kin.theta, acc_lo_, acc_hi_);
-        put(acc_lo_);
+        if (acc_limits_) put(ctrl_->acceleration_lower());  // the laws at theta, as the step evaluated them
         break;
       case StepValue::kAccelerationUpper:
-        if (acc_limits_) put(acc_hi_);  // evaluated with the lower ones
+        if (acc_limits_) put(ctrl_->acceleration_upper());
         break;
     }
   }

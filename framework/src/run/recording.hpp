@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "redres/control/controller.hpp"
+#include "redres/run/plants.hpp"
 #include "redres/run/plugin_output.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
@@ -29,24 +30,25 @@ struct Recorder {
 };
 inline constexpr std::size_t kNoPlugin = static_cast<std::size_t>(-1);
 
-/// The columns a run of `s` records: the standard ones, then the plugins' own (a name that an earlier plugin took
-/// is "<plugin>.<column>"), with each recording plugin (its data not yet known) when `recorders` is given, then, for a
-/// scheme with several priority levels, level_<p>_status and level_<p>_iterations per level (priority p), then the
-/// MuJoCo plant's (plant_columns()) when the run is on it (`plant`, by default the scenario's).
-[[nodiscard]] std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders);
-[[nodiscard]] std::vector<std::string> run_columns(const Scenario& s, std::vector<Recorder>* recorders,
-                                                   PlantKind plant);
+/// The columns of a run's table, and where each part starts.
+struct RunColumns {
+  std::vector<std::string> names;   //!< every column, in order
+  std::vector<Recorder> recorders;  //!< the plugins that record columns (their data not yet known)
+  std::size_t levels_first = 0;     //!< the first level_<p>_status column (with several priority levels)
+  std::size_t plant_first = 0;      //!< the first of the plant's own columns (names.size() when it has none)
+};
 
-/// The columns the MuJoCo plant adds at the end of a row: measured_theta_dot_1..n, torque_1..n, contacts,
-/// penetration.
-[[nodiscard]] std::vector<std::string> plant_columns(int n);
+/// The columns a run of `s` on the plant `plant` records: the standard ones, then the plugins' own (a name that an
+/// earlier plugin took is "<plugin>.<column>"), then, for a scheme with several priority levels, level_<p>_status and
+/// level_<p>_iterations per level (priority p), then the plant's own (PlantType::columns).
+[[nodiscard]] RunColumns run_columns(const Scenario& s, const PlantType& plant);
 
 /// Writes one row per step into a buffer that stays in the cache (the table streams it in). Allocation-free after
 /// construction.
 class RowRecorder {
  public:
-  /// For a run of `s` by `ctrl` (its plugin data), with the recorders run_columns() found.
-  RowRecorder(const Scenario& s, const Controller& ctrl, std::vector<Recorder> recorders, std::size_t width);
+  /// For a run of `s` by `ctrl` (its plugin data), with the columns run_columns() laid out.
+  RowRecorder(const Scenario& s, const Controller& ctrl, RunColumns layout, std::size_t width);
   /// The row of step k at time t, after ctrl's step at theta gave `out` (width values).
   /// The row stays writable until the next write() (a plant's columns at its end).
   [[nodiscard]] double* write(int k, double t, const Eigen::VectorXd& theta, const StepOutput& out);
@@ -71,9 +73,8 @@ class RowRecorder {
   int n_ = 0, m_ = 0, position_rows_ = 0;
   bool orientation_rows_ = false, spatial_orientation_ = false, all_position_rows_ = true, all_orientation_rows_ = true;
   Eigen::Vector3d wd_prev_ = Eigen::Vector3d::Zero(), w_prev_ = Eigen::Vector3d::Zero();
-  Eigen::VectorXd acc_lo_, acc_hi_;  // the acceleration laws at theta (robots with acceleration limits)
-  bool acc_limits_ = false;          // the robot has them: the acc_lo_/acc_hi_ columns are recorded
-  std::size_t levels_first_ = 0;     // the first level_<p>_status column (a cascaded scheme)
+  bool acc_limits_ = false;       // the robot has acceleration limits: their columns are recorded
+  std::size_t levels_first_ = 0;  // the first level_<p>_status column (a cascaded scheme)
 };
 
 /// The run's log of step outcomes, kept in its RunResult.

@@ -132,8 +132,8 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   out.solver.max_relaxed_task_error = run.max_relaxed_task_error;
   out.solver.first_relaxed = run.first_relaxed;
   out.wall_time_s = run.wall_time_s;
+  out.plant_kind = s.plant.kind;
   if (run.plant) {
-    out.plant_kind = "mujoco";
     out.plant = *run.plant;
     out.plant.mjcf.clear();
   }
@@ -395,7 +395,8 @@ const std::vector<SummaryField>& summary_fields() {
          return SummaryValue(v);
        }},
       {"plant.kinematic_max_position_error", "number",
-       "the same scenario on the kinematic plant: its `max_position_error` (m), beside this run's (under dynamics)",
+       "with `[plant] kinematic_comparison = true`: the same scenario on the kinematic plant, its `max_position_error` "
+       "(m), beside this run's (under dynamics); 0 otherwise",
        [](const S& s) { return SummaryValue(s.plant.kinematic_max_position_error); }},
       {"plant.control_step_us", "number", "mean wall time of one controller step (us)",
        [](const S& s) {

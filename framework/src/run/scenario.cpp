@@ -14,6 +14,7 @@
 #include "redres/control/engine_registry.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/plant/mujoco_model.hpp"
+#include "redres/run/plants.hpp"
 #include "redres/run/plugin_output.hpp"
 #include "redres/run/simulation.hpp"
 
@@ -426,7 +427,7 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                  Scenario& s = c.s;
                  // Reads `constraints` too: one scheme holds both.
                  s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot, s.duration, s.tau));
-                 if (s.scheme->level() == SchemeLevel::kAcceleration && s.integrator == Integrator::kHeun) {
+                 if (s.scheme->order() == ControlOrder::kAcceleration && s.integrator == Integrator::kHeun) {
                    r.fail("integrator",
                           "an acceleration-level scheme ([scheme] level = \"acceleration\") integrates "
                           "its own way (constant acceleration over each step, exact); leave "
@@ -531,38 +532,16 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
   return keys;
 }
 
-// A [plant] table against the rest of the scenario: MuJoCo built in, the robot's mass properties, the gains' sizes,
-// the control period and the delay whole numbers of MuJoCo time steps (which becomes explicit), obstacles MuJoCo can
-// hold.
+// A [plant] table against the rest of the scenario: its kind one of the registered plants (run/plants.hpp), and
+// the rest of its keys as that plant checks them.
 void check_plant(const TableReader& r, Scenario& s) {
-  PlantConfig& p = s.plant;
-  if (p.kind != PlantKind::kMujoco) {
-    for (const char* key :
-         {"timestep", "integrator", "actuator", "gravity_compensation", "kv", "kp", "kd", "delay", "gravity"}) {
-      if (r.has(key)) r.fail(key, "is used only with kind = \"mujoco\" (kind is \"kinematic\")");
-    }
-    return;
+  const PlantType* type = plant_registry().find(s.plant.kind);
+  if (type == nullptr) {
+    std::string names;
+    for (const PlantType& t : plant_registry().types()) names += (names.empty() ? "\"" : ", \"") + t.name + "\"";
+    r.fail("kind", "unknown plant \"" + s.plant.kind + "\"; expected one of " + names);
   }
-  if (!mujoco_available()) r.fail("kind", "\"mujoco\": " + mujoco_missing());
-  const int n = s.robot->dof();
-  for (const auto& [key, gains] : {std::pair{"kv", &p.kv}, std::pair{"kp", &p.kp}, std::pair{"kd", &p.kd}}) {
-    try {
-      (void)gains->resolve(n, key);
-    } catch (const FieldError& e) {
-      r.fail(key, e.message());
-    }
-  }
-  try {
-    p.timestep = plant_timing(p, s.tau).timestep;
-  } catch (const FieldError& e) {
-    // A default time step that does not divide the period is the table's `kind` choice: reported there.
-    r.fail(e.key() == "timestep" && !r.has("timestep") ? "kind" : e.key(), e.message());
-  }
-  try {
-    (void)scenario_mjcf(s);
-  } catch (const std::invalid_argument& e) {
-    r.fail("kind", std::string("\"mujoco\": ") + e.what());
-  }
+  if (type->check) type->check(r, s);
 }
 
 // The largest `margin` of the scheme's active joint_angle_margin constraints, per joint (zeros without one).
@@ -673,7 +652,7 @@ std::vector<ShapeSpec> scenario_obstacles(const Scenario& s, bool inactive) {
 }
 
 std::string scenario_mjcf(const Scenario& s) {
-  if (s.plant.kind != PlantKind::kMujoco)
+  if (s.plant.kind != "mujoco")
     throw std::invalid_argument("scenario '" + s.name + "' runs on the kinematic plant: set [plant] kind = \"mujoco\"");
   MjcfOptions options;
   options.plant = s.plant;

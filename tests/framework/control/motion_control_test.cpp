@@ -47,7 +47,7 @@ struct NoConfig {
 class Blocker final : public Configured<Constraint, NoConfig> {
  public:
   Blocker(double from, double to) : Configured("test_blocker", NoConfig{}), from_(from), to_(to) {}
-  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
+  [[nodiscard]] bool supports(ControlOrder /*order*/) const override { return true; }
 
  private:
   void add_to(const Context& ctx, QpBuilder& b, PluginData* /*data*/) const override {

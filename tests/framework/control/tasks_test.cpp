@@ -563,6 +563,80 @@ TEST(Tasks, OneLevelIsOneQpWithTheTasksRowsAfterTheConstraints) {
   EXPECT_NEAR(rig.terms(1).error(0), 0.7 - 0.614782052, 1e-8);
 }
 
+// The controller runs a one-level scheme as a list of one level (control/cascade.hpp); the QP it solves is the one
+// Scheme::build() writes, entry for entry, with tasks in all three modes (the one writer of task rows) beside
+// constraints and an objective.
+TEST(Tasks, TheControllersOneLevelIsTheSchemesOneQpEntryForEntry) {
+  const RobotModel robot = load_robot(source_path("robots/franka_panda.toml"));
+  std::vector<std::unique_ptr<Task>> tasks;
+  FrameTaskConfig tool;
+  tool.reference = "fixed";
+  tool.position = {0.4, 0.1, 0.5};
+  tasks.push_back(frame_task(robot, "tool", tool, TaskMode::kEquality, 0));
+  FrameTaskConfig elbow;
+  elbow.frame = "panda_joint4";
+  elbow.rows = {"z"};
+  elbow.lower = std::vector<double>{0.7};
+  elbow.upper = std::vector<double>{0.9};
+  tasks.push_back(frame_task(robot, "elbow", elbow, TaskMode::kInequality, 0));
+  FrameTaskConfig wrist;
+  wrist.frame = "panda_joint6";
+  wrist.rows = {"x", "y"};
+  wrist.damping = 0.3;
+  wrist.damping_threshold = 10.0;  // damped at every state
+  tasks.push_back(frame_task(robot, "wrist", wrist, TaskMode::kSoft, 0, 0.5));
+  std::vector<std::unique_ptr<Objective>> objectives;
+  objectives.push_back(min_norm(robot, 0));
+  std::vector<std::unique_ptr<Constraint>> constraints;
+  constraints.push_back(std::make_unique<JointVelocityLimits>(JointVelocityLimits::Config{}, robot));
+  Rig rig(robot, std::move(objectives), std::move(constraints), std::move(tasks));
+  ASSERT_FALSE(rig.scheme->cascaded());
+  Eigen::VectorXd theta = robot.home();
+  theta(1) += 0.2;
+  theta(3) -= 0.1;
+  (void)rig.step(theta);
+  ASSERT_EQ(rig.out.info.status, SolverStatus::kSolved) << rig.out.info.diagnosis;
+  EXPECT_GT(rig.terms(2).damping, 0.0);
+
+  // The same scheme's one QP, built directly at the same state.
+  SchemeData data = rig.scheme->make_data();
+  rig.scheme->start(data);
+  QpProblem qp;
+  rig.scheme->setup(qp, data);
+  KinematicsData kin(robot);
+  compute_kinematics(robot, theta, kin, rig.scheme->kinematics_level());
+  const Eigen::VectorXd r = Eigen::VectorXd::Zero(robot.reference_dim());
+  Context ctx;
+  ctx.robot = &robot;
+  ctx.kinematics = &kin;
+  ctx.T = 10.0;
+  ctx.tau = 0.01;
+  ctx.r_d = &r;
+  ctx.r_d_dot = &r;
+  rig.scheme->build(ctx, qp, data);
+
+  const QpProblem& solved = rig.ctrl->qp();
+  ASSERT_EQ(solved.n(), qp.n());
+  ASSERT_EQ(solved.m_eq(), qp.m_eq());
+  ASSERT_EQ(solved.m_in(), qp.m_in());
+  EXPECT_EQ(solved.W, qp.W);
+  EXPECT_EQ(solved.zeta, qp.zeta);
+  EXPECT_EQ(solved.J, qp.J);
+  EXPECT_EQ(solved.d, qp.d);
+  EXPECT_EQ(solved.A, qp.A);
+  EXPECT_EQ(solved.b, qp.b);
+  EXPECT_EQ(solved.lo, qp.lo);
+  EXPECT_EQ(solved.hi, qp.hi);
+  EXPECT_EQ(solved.w_diagonal, qp.w_diagonal);
+  EXPECT_EQ(solved.eq_source, qp.eq_source);
+  EXPECT_EQ(solved.in_source, qp.in_source);
+  EXPECT_EQ(solved.lo_source, qp.lo_source);
+  EXPECT_EQ(solved.source_names, qp.source_names);
+  EXPECT_FALSE(qp.w_diagonal);  // the soft task's least squares filled W off its diagonal
+  EXPECT_EQ(qp.m_eq(), 3);      // the tool's rows
+  EXPECT_EQ(qp.m_in(), 2);      // the elbow's two bounds
+}
+
 TEST(Tasks, APostureThatCannotBeMetIsMetAsWellAsTheLimitsAllowAndTheStepDoesNotFail) {
   const RobotModel robot = load_robot(source_path("robots/franka_panda.toml"));
   FrameTaskConfig c;

@@ -66,17 +66,19 @@ struct GainConfig {
 class WrongGradient final : public Configured<Objective, GainConfig> {
  public:
   static constexpr const char* kType = "faulty_wrong_gradient";
-  WrongGradient(const Config& c, const RobotModel& /*robot*/) : Configured(kType, c) {}
+  WrongGradient(const Config& c, const RobotModel& robot) : Configured(kType, c), n_(robot.dof()) {}
   std::optional<double> potential(const Context& ctx) const override {
     return 0.5 * config_.gain * ctx.theta().squaredNorm();
   }
 
  private:
-  void add_to(const Context& ctx, QpBuilder& b, PluginData* /*data*/) const override {
-    Eigen::VectorXd& z = b.scratch();
+  std::unique_ptr<PluginData> make_data() const override { return std::make_unique<Workspace>(n_, 1); }
+  void add_to(const Context& ctx, QpBuilder& b, PluginData* data) const override {
+    Eigen::VectorXd& z = static_cast<Workspace&>(*data)[0];
     z = 2.0 * config_.gain * ctx.theta();
     b.add_linear(z);
   }
+  int n_;
 };
 
 // Writes a key its schema does not list, and a bound that is NaN.
@@ -86,7 +88,7 @@ class Undocumented final : public Constraint {
   Undocumented(const GainConfig& /*c*/, const RobotModel& /*robot*/) : Constraint(kType) {}
 
  private:
-  void add_to(const Context& /*ctx*/, QpBuilder& b, PluginData* /*data*/) const override { b.scratch().setZero(); }
+  void add_to(const Context& /*ctx*/, QpBuilder& /*b*/, PluginData* /*data*/) const override {}
   void write_config(toml::table& out) const override { out.insert("secret", 1.0); }
 };
 

@@ -195,6 +195,22 @@ RC_GTEST_PROP(KinematicsProperty, TheRevoluteGradientIsTheGeneralOne, ()) {
   }
 }
 
+// w alone (kMeasure, what a run records when no plugin needs its gradient) is w of the gradient's paths bit for bit,
+// on planar and spatial chains with prismatic joints too, and leaves grad w and dJ untouched.
+RC_GTEST_PROP(KinematicsProperty, TheMeasureAloneIsTheGradientsMeasureBitForBit, ()) {
+  const RobotModel model = random_model();
+  const Eigen::VectorXd theta = random_theta(model);
+  KinematicsData alone(model), full(model);
+  alone.grad_w.setConstant(7.0);
+  alone.dJ.setConstant(7.0);
+  compute_kinematics(model, theta, alone, KinematicsLevel::kMeasure);
+  compute_kinematics(model, theta, full, KinematicsLevel::kGradient);
+  RC_ASSERT(alone.level == KinematicsLevel::kMeasure);
+  RC_ASSERT(alone.w == full.w);
+  RC_ASSERT((alone.grad_w.array() == 7.0).all());  // no gradient
+  RC_ASSERT((alone.dJ.array() == 7.0).all());      // no Hessian
+}
+
 // mu and grad mu, whichever way compute_kinematics takes (sqrt(w) away from singularities, the singular value
 // decomposition near them), are those of the decomposition: mu = prod s_k, d mu = sum_k prod_{j != k} s_j u_k' dJ v_k.
 RC_GTEST_PROP(KinematicsProperty, YoshikawaIsThatOfTheSingularValues, ()) {

@@ -59,7 +59,8 @@ void expect_within_effort(const Ran& r) {
 }
 
 TEST(MujocoPlant, NominalPandaHelixTracksWithinAMillimetreUnderTheVelocityServo) {
-  const Ran r = run_config("configs/panda_helix.toml", {"plant.kind=mujoco", "step=0.001"});
+  const Ran r =
+      run_config("configs/panda_helix.toml", {"plant.kind=mujoco", "plant.kinematic_comparison=true", "step=0.001"});
   ASSERT_TRUE(r.run.plant.has_value());
   EXPECT_EQ(r.run.failures, 0);
   EXPECT_LT(r.summary.max_position_error, 1e-3);
@@ -116,8 +117,24 @@ TEST(MujocoPlant, TorquesAreClampedAtTheEffortLimitsWhenTheGainsAskForMore) {
   EXPECT_GT(r.run.plant->max_torque_rate[0], 0.0);
 }
 
+TEST(MujocoPlant, TheKinematicComparisonRunsOnlyWhenTheScenarioAsksForIt) {
+  const Ran without = run_config("configs/paper_r_mujoco.toml", {"plant.kinematic_comparison=false", "duration=4"});
+  const Ran with = run_config("configs/paper_r_mujoco.toml", {"duration=4"});
+  ASSERT_TRUE(without.run.plant.has_value() && with.run.plant.has_value());
+  EXPECT_EQ(without.run.plant->kinematic_max_position_error, 0.0);
+  // The comparison is the kinematic run's own figure, and it changes nothing of the MuJoCo run.
+  Scenario on_kinematic = load_scenario("configs/paper_r_mujoco.toml", {"duration=4"});
+  on_kinematic.plant.kind = "kinematic";
+  const RunResult kinematic = simulate(on_kinematic);
+  EXPECT_FALSE(kinematic.plant.has_value());
+  EXPECT_EQ(with.run.plant->kinematic_max_position_error, summarise(on_kinematic, kinematic).max_position_error);
+  EXPECT_EQ(with.summary.max_position_error, without.summary.max_position_error);
+  EXPECT_EQ(with.run.trajectory.size(), without.run.trajectory.size());
+}
+
 TEST(MujocoPlant, TheIdealVelocitySourceReproducesTheKinematicRun) {
-  const Ran r = run_config("configs/panda_helix.toml", {"plant.kind=mujoco", "plant.actuator=ideal_velocity"});
+  const Ran r = run_config("configs/panda_helix.toml",
+                           {"plant.kind=mujoco", "plant.kinematic_comparison=true", "plant.actuator=ideal_velocity"});
   ASSERT_TRUE(r.run.plant.has_value());
   EXPECT_EQ(r.run.plant->substeps, 10);  // 10 ms control period, 1 ms MuJoCo steps
   // Euler at 1 ms inside each 10 ms period moves exactly as theta += tau theta_dot.
@@ -131,7 +148,7 @@ TEST(MujocoPlant, TheControllerReadsTheStateOfDelayAgo) {
   // MuJoCo steps ago with delay = 3 ms.
   const RobotModel robot = load_robot("robots/franka_panda.toml");
   PlantConfig config;
-  config.kind = PlantKind::kMujoco;
+  config.kind = "mujoco";
   config.actuator = PlantActuator::kIdealVelocity;
   config.delay = 0.003;
   MujocoPlant plant(robot, config, 0.001, {}, robot.home());
@@ -228,7 +245,7 @@ inertia = { mass = 0.5, com = [-0.1, 0, 0], ixx = 0.01, iyy = 0.01, izz = 0.01 }
 
 TEST(MujocoPlant, MovingObstaclesAreMocapBodiesThatMoveAsTheScenarioSays) {
   PlantConfig config;
-  config.kind = PlantKind::kMujoco;
+  config.kind = "mujoco";
   const RobotModel robot = load_robot("robots/franka_panda.toml");
   ShapeSpec still, moving;
   still.shape = moving.shape = ShapeSpec::Kind::kSphere;
@@ -261,6 +278,9 @@ TEST(MujocoPlant, BadPlantTablesAreRefusedAtTheirKeys) {
   EXPECT_NE(message({"plant.kv=[1,2]"}).find("kv"), std::string::npos);
   EXPECT_NE(message({"plant.actuator=torque"}).find("velocity_servo"), std::string::npos);
   EXPECT_NE(message({"plant.kind=kinematic"}).find("only with kind = \"mujoco\""), std::string::npos);
+  const std::string unknown = message({"plant.kind=gazebo"});
+  EXPECT_NE(unknown.find("unknown plant \"gazebo\"; expected one of \"kinematic\", \"mujoco\""), std::string::npos)
+      << unknown;
   // A robot without mass properties: every such link named.
   const std::string iiwa = [] {
     try {

@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// Strict priorities (docs/tasks.md): a scheme whose objectives and tasks sit at several priority levels is solved
-/// one QP per level, highest first, by the scenario's LVI engine. Level l's QP is
+/// The priority levels of a scheme (docs/tasks.md), which the Controller runs for every scheme: one QP per level,
+/// highest first, each with an engine of the scenario's type and settings. A scheme with one level is one QP (the
+/// paper's), exactly as Scheme::build() writes it. With several, level l's QP is
 ///
 ///   minimise   x'(W_l + eps c I)x / 2 + zeta_l'x  (its objectives, its soft tasks' least squares, damping; c is
 ///                                                  W_l's largest diagonal entry, and W_l = 0 becomes I)
@@ -15,15 +16,16 @@
 /// held, so it decides nothing that a lower level wants. Each level's QP is scaled so that its W's largest diagonal
 /// entry is 1 (the same minimiser, a better conditioned problem for the engine). A least-squares level (soft tasks,
 /// or a retry) is solved twice more with eps |x - x_k|^2 / 2 about its last answer x_k (proximal steps), which takes
-/// eps's bias along the rows' weak directions from O(eps / sigma^2) to its cube. A level below the first whose tasks
-/// cannot all be met (its QP fails) is solved again in least squares: its equality tasks' rows become (weight / 2) |J x
-/// - d|^2 and its inequality rows get slack variables s with (weight / 2) |s|^2 (J_r x - s <= hi_r), so they are met as
-/// well as the higher levels allow; the level's status is then `relaxed`. A level that fails even so keeps the higher
-/// levels' answer: the step does not fail because a low-priority task cannot be met. A level whose objectives have a
-/// quadratic term (a velocity norm) decides every joint velocity left free, so the levels below it are skipped. Level 0
-/// is solved into the controller's own QP by its own engine, so that a failure there is the step's, handled by the
-/// failure policy.
+/// eps's bias along the rows' weak directions from O(eps / sigma^2) to its cube. A level whose tasks cannot all be met
+/// (its QP fails) is solved again in least squares when there is a level above it: its equality tasks' rows become
+/// (weight / 2) |J x - d|^2 and its inequality rows get slack variables s with (weight / 2) |s|^2 (J_r x - s <= hi_r),
+/// so they are met as well as the higher levels allow; the level's status is then `relaxed`. A level that fails even
+/// so keeps the higher levels' answer: the step does not fail because a low-priority task cannot be met. The first
+/// level has no level above it: its failure is the step's, which the controller's failure policy handles (on
+/// problem(0)). A level whose objectives have a quadratic term (a velocity norm) decides every joint velocity left
+/// free, so the levels below it are skipped.
 ///
+/// Every level's task rows are written by write_task_terms() (control/task.hpp), the one writer of task rows.
 /// Everything is sized at construction; a step allocates nothing.
 
 #include <memory>
@@ -49,31 +51,28 @@ struct LevelInfo {
   std::string diagnosis;    //!< why it was relaxed, skipped or failed (empty when solved)
 };
 
-/// The levels of a cascaded scheme, for one controller.
+/// The levels of a scheme, for one controller.
 class Cascade {
  public:
-  /// For `scheme` (cascaded()) and the controller's `data`; `engine` is the controller's (level 0's), and each lower
-  /// level gets an engine of its own of the same type and settings.
-  Cascade(const Scheme& scheme, const SchemeData& data, const LviEngine& engine);
+  /// For `scheme` and the controller's `data`: the first level is solved by `engine` (the controller's, which must
+  /// outlive the cascade), and each level below gets an engine of its own of the same type and settings.
+  Cascade(const Scheme& scheme, const SchemeData& data, LviEngine& engine);
   Cascade(const Cascade&) = delete;
   Cascade& operator=(const Cascade&) = delete;
   ~Cascade();
 
-  /// Sizes `qp` as level 0's QP and names its sources and rows.
-  void setup_first(QpProblem& qp) const;
-  /// Builds the constraints' rows, every task's rows and level 0's QP into `qp` (throws std::invalid_argument as
-  /// Scheme::build does, naming the plugin).
-  void build_first(const Context& ctx, SchemeData& data, QpProblem& qp);
-  /// After level 0 solved with answer x0: solves the levels below; writes levels[1..] (levels[0] is the
-  /// controller's) and x, the answer of the lowest level solved. Allocation-free.
-  void solve_rest(const Context& ctx, SchemeData& data, const Eigen::VectorXd& x0, std::vector<LevelInfo>& levels,
-                  Eigen::VectorXd& x);
-  /// Level 0 (solved by the caller into `qp` with `engine`, answer in `r`): when it is a least squares, its proximal
-  /// steps (below), each adding its iterations to `iterations`. Allocation-free.
-  void refine_first(QpProblem& qp, LviEngine& engine, SolverResult& r, int& iterations);
-  /// Writes level 0's tasks' error at x into levels[0].task_error.
-  void first_task_error(const SchemeData& data, const Eigen::VectorXd& x, LevelInfo& info) const;
-  /// Forgets the lower levels' engines' warm starts.
+  /// Solves one step: the constraints' and the tasks' rows once, then each level in turn. `info` becomes the first
+  /// level's engine's outcome, with the iterations of every level; levels() each level's; x the answer of the lowest
+  /// level solved. Returns whether the first level solved (when it did not, x is unchanged and no level below ran).
+  /// Throws std::invalid_argument as Scheme::build() does, naming the plugin that gave a non-finite entry.
+  /// Allocation-free.
+  bool solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eigen::VectorXd& x);
+  /// Each level's outcome at the last step, highest first.
+  [[nodiscard]] const std::vector<LevelInfo>& levels() const noexcept { return info_; }
+  /// The QP that level l solved last, and its engine's result (level 0: the step's QP, which a failure policy reads).
+  [[nodiscard]] const QpProblem& problem(int level) const;
+  [[nodiscard]] const SolverResult& result(int level) const;
+  /// Forgets every level's engine's warm start.
   void reset();
   /// The number of levels.
   [[nodiscard]] int level_count() const noexcept { return static_cast<int>(levels_.size()); }
@@ -81,23 +80,28 @@ class Cascade {
  private:
   struct Level;
   struct RowTag;
+  struct Slot;
   void size_level(int l, QpProblem& qp, bool least_squares, int held_rows) const;
   void assemble(int l, const SchemeData& data, QpProblem& qp, bool least_squares);
   void hold(int l, const SchemeData& data, const Eigen::VectorXd& x);
   [[nodiscard]] double task_error(int l, const SchemeData& data, const Eigen::VectorXd& x) const;
   void describe_level(int l, TextSink& out) const;
   void refine(QpProblem& qp, LviEngine& engine, SolverResult& r, int& iterations);
+  [[nodiscard]] const Slot& last_slot(int level) const;
 
   const Scheme* scheme_;
   int n_ = 0;
   double eps_ = 0.0;
-  QpProblem base_;  // the constraints' rows and bounds, once per step
-  QpProblem obj_;   // one level's objectives
+  bool several_ = false;  // several levels: each is scaled, regularized and holds the levels above
+  QpProblem base_;        // the constraints' rows and bounds, once per step
+  QpProblem obj_;         // one level's objectives
   QpBuilder::WrittenW obj_w_ = QpBuilder::WrittenW::kNone;
   std::vector<std::unique_ptr<Level>> levels_;
+  std::vector<LevelInfo> info_;
   Eigen::MatrixXd held_J_, held_A_;  // the higher levels' optima, as rows
   Eigen::VectorXd held_d_, held_b_;
   int held_eq_ = 0, held_in_ = 0;                    // rows held so far this step
+  std::vector<int> used_slot_;                       // the slot each level solved in at the last step
   std::vector<std::vector<std::string>> row_names_;  // each task's row names (for diagnoses)
   std::string note_;                                 // a failed try's text while the next writes
   bool least_squares_terms_ = false;                 // the last assembled level has terms in W (scaled)

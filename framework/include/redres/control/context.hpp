@@ -13,13 +13,15 @@
 
 namespace redres {
 
-/// What a scheme's QP solves for ([scheme] level; docs/motion.md): x = theta_dot (the paper's velocity level) or
-/// x = theta_ddot (the acceleration level: theta_dot and theta are integrated from x).
-enum class SchemeLevel { kVelocity, kAcceleration };
+/// The order of the derivative a scheme's QP solves for (the scenario's `[scheme] level`; docs/motion.md): x =
+/// theta_dot (the paper's velocity level) or x = theta_ddot (the acceleration level: theta_dot and theta are integrated
+/// from x).
+/// ("Level" alone, in the code, is a priority level.)
+enum class ControlOrder { kVelocity, kAcceleration };
 /// The names a scenario's [scheme] level takes.
-inline auto enum_names(SchemeLevel) {
-  return std::array{std::pair{SchemeLevel::kVelocity, std::string_view("velocity")},
-                    std::pair{SchemeLevel::kAcceleration, std::string_view("acceleration")}};
+inline auto enum_names(ControlOrder) {
+  return std::array{std::pair{ControlOrder::kVelocity, std::string_view("velocity")},
+                    std::pair{ControlOrder::kAcceleration, std::string_view("acceleration")}};
 }
 
 /// Everything a plugin may read at one control step. New inputs are added here, never to plugin signatures.
@@ -34,7 +36,7 @@ struct Context {
   /// Desired task acceleration r_d_ddot(t) (m_task): set at the acceleration level; null at the velocity level.
   const Eigen::VectorXd* r_d_ddot = nullptr;
   /// What x is: theta_dot (velocity level) or theta_ddot (acceleration level).
-  SchemeLevel level = SchemeLevel::kVelocity;
+  ControlOrder order = ControlOrder::kVelocity;
   /// The joint velocity at this step (n) at the acceleration level: the measured one when the caller passed it, else
   /// the previous step's command (theta_dot_prev). Null at the velocity level.
   const Eigen::VectorXd* theta_dot = nullptr;
@@ -42,6 +44,13 @@ struct Context {
   /// caller builds a Context without them (plugins then evaluate the laws themselves).
   const Eigen::VectorXd* velocity_lower = nullptr;
   const Eigen::VectorXd* velocity_upper = nullptr;
+  /// The robot's acceleration and jerk limits at theta (n each), evaluated once per step by the Controller when the
+  /// robot has them; null otherwise, or where a caller builds a Context without them (plugins then evaluate the laws
+  /// themselves).
+  const Eigen::VectorXd* acceleration_lower = nullptr;
+  const Eigen::VectorXd* acceleration_upper = nullptr;
+  const Eigen::VectorXd* jerk_lower = nullptr;
+  const Eigen::VectorXd* jerk_upper = nullptr;
 
   // State between steps (docs/motion.md), kept by the Controller; null where a caller builds a Context itself.
   /// The command of the previous step (n): what the arm was last asked for, as applied (Heun's average of its two
@@ -62,7 +71,7 @@ struct Context {
   /// Bounds lo <= v' <= hi on the joint velocity v' after this step, as bounds on x: (lo - theta_dot) / tau at the
   /// acceleration level, lo itself at the velocity level. For plugins that bound velocities at either level.
   [[nodiscard]] double velocity_to_x(double v_next, int j) const {
-    return level == SchemeLevel::kVelocity ? v_next : (v_next - (*theta_dot)(j)) / tau;
+    return order == ControlOrder::kVelocity ? v_next : (v_next - (*theta_dot)(j)) / tau;
   }
   /// Joint j's velocity-limit law at theta: as the Controller evaluated it once for the step (velocity_lower/upper),
   /// or from the law where a caller's Context carries none.

@@ -57,9 +57,9 @@ class Controller {
 
   /// The controller that simulate() runs for `scenario`: its robot, scheme and path, T and tau, an engine of its own
   /// made from the scenario's [solver] (with its own warm start), its orientation turn, the kinematics the recorded
-  /// run reads (w and its gradient), and its failure policy. The scenario is only read: any number of controllers of
-  /// one scenario may run at once, each in its own thread; the scenario must outlive them. (Defined in run/, beside
-  /// the scenario.)
+  /// run reads (w, without its gradient unless a plugin needs it), and its failure policy. The scenario is only read:
+  /// any number of controllers of one scenario may run at once, each in its own thread; the scenario must outlive
+  /// them. (Defined in run/, beside the scenario.)
   [[nodiscard]] static std::unique_ptr<Controller> from_scenario(const Scenario& scenario);
 
   /// An output sized for this controller.
@@ -122,7 +122,8 @@ class Controller {
 
   /// Kinematics, QP, desired values and the full solver result of the last step.
   [[nodiscard]] const KinematicsData& kinematics() const noexcept { return kin_; }
-  [[nodiscard]] const QpProblem& qp() const noexcept { return qp_; }
+  /// The QP of the first priority level (the step's: the paper's one QP when the scheme has one level).
+  [[nodiscard]] const QpProblem& qp() const { return cascade_->problem(0); }
   [[nodiscard]] const Eigen::VectorXd& r_d() const noexcept { return r_d_; }
   [[nodiscard]] const Eigen::VectorXd& r_d_dot() const noexcept { return r_d_dot_; }
   /// The last step's desired task acceleration (acceleration level; zeros at the velocity level).
@@ -132,7 +133,15 @@ class Controller {
   /// The velocity-limit laws at the last step's theta (n each).
   [[nodiscard]] const Eigen::VectorXd& velocity_lower() const noexcept { return vlo_; }
   [[nodiscard]] const Eigen::VectorXd& velocity_upper() const noexcept { return vhi_; }
-  [[nodiscard]] const SolverResult& result() const noexcept { return result_; }
+  /// The acceleration and jerk limits at the last step's theta (n each; zeros for a robot without them).
+  [[nodiscard]] const Eigen::VectorXd& acceleration_lower() const noexcept { return acc_lo_; }
+  [[nodiscard]] const Eigen::VectorXd& acceleration_upper() const noexcept { return acc_hi_; }
+  [[nodiscard]] const Eigen::VectorXd& jerk_lower() const noexcept { return jerk_lo_; }
+  [[nodiscard]] const Eigen::VectorXd& jerk_upper() const noexcept { return jerk_hi_; }
+  /// The first level's engine's result (the unconverged iterate of a failed step included).
+  [[nodiscard]] const SolverResult& result() const { return cascade_->result(0); }
+  /// Every priority level's QP and outcome at the last step (control/cascade.hpp).
+  [[nodiscard]] const Cascade& levels() const noexcept { return *cascade_; }
   [[nodiscard]] const RobotModel& robot() const noexcept { return *robot_; }
   /// The name of the engine it solves with.
   [[nodiscard]] std::string_view engine_name() const { return engine_->name(); }
@@ -146,7 +155,6 @@ class Controller {
 
  private:
   void solve(double t, StepOutput& out);
-  void solve_levels(StepOutput& out);    // a cascaded scheme's levels below the first
   void begin_step();                     // the previous step's command becomes theta_dot_prev
   void end_step(const StepOutput& out);  // this step's command and status, for the next
   bool relax(StepOutput& out);           // the elastic QP; false when it fails too
@@ -154,7 +162,7 @@ class Controller {
   void give_up(StepOutput& out);         // a step that stays failed: brakes (acceleration limits, not kHold) or holds
   void apply(const Eigen::VectorXd& x, StepOutput& out);        // x (the QP's) into theta_dot and theta_ddot
   [[nodiscard]] const Eigen::VectorXd& base() const noexcept {  // the velocity before this step
-    return ctx_.level == SchemeLevel::kVelocity ? prev_ : v_;
+    return ctx_.order == ControlOrder::kVelocity ? prev_ : v_;
   }
 
   const RobotModel* robot_;
@@ -164,8 +172,6 @@ class Controller {
   LviEngine* engine_;
   const Path* path_;
   KinematicsData kin_;
-  QpProblem qp_;
-  SolverResult result_;
   Eigen::VectorXd r_d_, r_d_dot_, r_d_ddot_;
   Eigen::VectorXd vlo_, vhi_;         // the velocity-limit laws at theta, once per step
   OrientationReference orientation_;  // the orientation rows of r_d and r_d_dot under a path
@@ -179,13 +185,13 @@ class Controller {
   bool have_pending_ = false;          // a step was made whose command is not yet theta_dot_prev
   bool started_ = false;               // the plugins were told that the run starts
   Eigen::VectorXd v_;                  // acceleration level: the joint velocity at this step
-  Eigen::VectorXd lim_lo_, lim_hi_;    // acceleration limits at theta, for braking
-  Eigen::VectorXd jerk_lo_, jerk_hi_;  // jerk limits at theta, for braking
+  Eigen::VectorXd acc_lo_, acc_hi_;    // the acceleration limits at theta, once per step (robots that have them)
+  Eigen::VectorXd jerk_lo_, jerk_hi_;  // the jerk limits at theta, once per step (robots that have them)
   FailurePolicy policy_ = FailurePolicy::kHold;
   double recover_error_ = 1e-3;       // kBrake: the position error above which the elastic QP goes first
   ElasticFallback fallback_;          // the elastic QP of kRelax and kBrake, with its engine
-  std::unique_ptr<Cascade> cascade_;  // a cascaded scheme's levels (null with one level)
-  Eigen::VectorXd x_levels_;          // the answer of the lowest level solved
+  std::unique_ptr<Cascade> cascade_;  // the scheme's priority levels, one QP each (never null)
+  Eigen::VectorXd x_;                 // the answer of the lowest level solved
 };
 
 }  // namespace redres

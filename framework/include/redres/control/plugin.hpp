@@ -48,6 +48,19 @@ class PluginData {
   virtual ~PluginData() = default;
 };
 
+/// Plugin data that is workspace only: `count` vectors of n entries, sized when it is made, their contents undefined
+/// at each step. A plugin whose add_to needs temporaries and keeps nothing between steps returns one from make_data()
+/// (std::make_unique<Workspace>(n, count)) and reads it as static_cast<Workspace&>(*data)[k]: no allocation per step,
+/// and nothing shared with another plugin or another controller.
+class Workspace final : public PluginData {
+ public:
+  Workspace(int n, int count) : vectors_(static_cast<std::size_t>(count), Eigen::VectorXd::Zero(n)) {}
+  [[nodiscard]] Eigen::VectorXd& operator[](std::size_t k) { return vectors_[k]; }
+
+ private:
+  std::vector<Eigen::VectorXd> vectors_;
+};
+
 /// Base of objectives and constraints: type, instance name, active flag and the configuration round trip.
 class Plugin {
  public:
@@ -74,9 +87,9 @@ class Plugin {
   /// Inactive plugins are built but contribute nothing.
   [[nodiscard]] bool active() const noexcept { return active_; }
   void set_active(bool active) noexcept { active_ = active; }
-  /// Whether this plugin works at a scheme level (Context::level). Default: the velocity level only; a plugin that
-  /// also serves the acceleration level reads Context::level and writes its terms for x = theta_ddot there.
-  [[nodiscard]] virtual bool supports(SchemeLevel level) const { return level == SchemeLevel::kVelocity; }
+  /// Whether this plugin works at a control order (Context::order). Default: the velocity level only; a plugin that
+  /// also serves the acceleration level reads Context::order and writes its terms for x = theta_ddot there.
+  [[nodiscard]] virtual bool supports(ControlOrder order) const { return order == ControlOrder::kVelocity; }
   /// The kinematics this plugin reads.
   [[nodiscard]] virtual KinematicsLevel kinematics_level() const { return KinematicsLevel::kPosition; }
   /// The full configuration (type, common keys and the plugin's own), readable by the same registry.

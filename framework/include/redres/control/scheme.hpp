@@ -27,8 +27,8 @@ struct SchemeLevelSpec {
 
 /// A scenario file's [scheme] table, read through its schema (and listed by `redres keys scenario`).
 struct SchemeTable {
-  SchemeLevel level = SchemeLevel::kVelocity;  //!< what x is: theta_dot (the paper's) or theta_ddot
-  double regularization = 1e-9;                //!< the eps |x|^2 / 2 of every priority level (Scheme::regularization())
+  ControlOrder order = ControlOrder::kVelocity;  //!< key `level`: what x is, theta_dot (the paper's) or theta_ddot
+  double regularization = 1e-9;  //!< the eps |x|^2 / 2 of every priority level (Scheme::regularization())
   static const Schema<SchemeTable>& schema();
 };
 
@@ -39,15 +39,14 @@ class Scheme {
   /// The default of regularization().
   static constexpr double kDefaultRegularization = 1e-9;
   /// Takes ownership of the plugins; sizes follow from the robot and the constraints' row counts.
-  /// Throws std::invalid_argument when an active plugin does not work at `level` (Plugin::supports).
+  /// Throws std::invalid_argument when an active plugin does not work at `order` (Plugin::supports).
   Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
-         std::vector<std::unique_ptr<Constraint>> constraints, SchemeLevel level = SchemeLevel::kVelocity);
-  /// The same with tasks (control/task.hpp). Active objectives and tasks are grouped by priority into levels(); with
-  /// one level, build() writes the tasks into the one QP (after the constraints' rows); with several, the Controller
-  /// solves the levels in turn (control/cascade.hpp) and build() is not used.
+         std::vector<std::unique_ptr<Constraint>> constraints, ControlOrder order = ControlOrder::kVelocity);
+  /// The same with tasks (control/task.hpp). Active objectives and tasks are grouped by priority into levels(), which
+  /// the Controller solves in turn, one QP each (control/cascade.hpp).
   Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> objectives,
          std::vector<std::unique_ptr<Constraint>> constraints, std::vector<std::unique_ptr<Task>> tasks,
-         SchemeLevel level = SchemeLevel::kVelocity);
+         ControlOrder order = ControlOrder::kVelocity);
 
   /// Reads `[[objectives]]`, `[[constraints]]` and `[[tasks]]` arrays of tables from `root`, and the `[scheme]` table's
   /// `level`. When the robot file gives every joint an acceleration (jerk) limit and no constraint of type
@@ -61,8 +60,10 @@ class Scheme {
   [[nodiscard]] SchemeData make_data() const;
   /// Tells every plugin that a run starts (Plugin::start), with its data in `data`.
   void start(SchemeData& data) const;
-  /// Sizes `qp` for this scheme (n, m_e, m_i) and names its sources; the descriptions of its inequality rows read
-  /// the plugins' data in `data` (which may be moved, but must outlive `qp`'s use).
+  /// A scheme of one level: its one QP, for a caller that solves it without a Controller (e.g. a benchmark or a test).
+  /// The Controller's Cascade writes the same QP from the parts below (objectives, constraints, tasks), with the same
+  /// entries. Sizes `qp` for this scheme (n, m_e, m_i) and names its sources; the descriptions of its inequality rows
+  /// read the plugins' data in `data` (which may be moved, but must outlive `qp`'s use).
   void setup(QpProblem& qp, const SchemeData& data) const;
   /// Clears `qp` and lets every active plugin contribute. `ctx.kinematics` must be at kinematics_level().
   /// The plugins write without checks; then one scan checks every entry they can have written (W, zeta, the
@@ -71,24 +72,25 @@ class Scheme {
   /// the entry. The QP it leaves is therefore valid (QpProblem::validate() would pass).
   void build(const Context& ctx, QpProblem& qp, SchemeData& data) const;
 
-  /// Cascade use: writes only the constraints' rows and bounds into `qp` (sized n, constraint_equality_rows(),
-  /// constraint_inequality_rows(); set up by setup_constraints()), with build()'s checks.
+  /// The parts of a priority level's QP, which the Cascade assembles. The constraints' part: writes their rows and
+  /// bounds into `qp` (sized n, constraint_equality_rows(), constraint_inequality_rows(); set up by
+  /// setup_constraints()), with build()'s checks.
   void build_constraints(const Context& ctx, QpProblem& qp, SchemeData& data) const;
-  /// Cascade use: sizes `qp` for the constraints alone and names every source (objectives, constraints, tasks).
+  /// Sizes `qp` for the constraints alone and names every source (objectives, constraints, tasks).
   void setup_constraints(QpProblem& qp, const SchemeData& data) const;
-  /// Cascade use: computes every active task's rows into its TaskData (checked: a non-finite entry throws
+  /// The tasks' part: computes every active task's rows into its TaskData (checked: a non-finite entry throws
   /// std::invalid_argument naming the task).
   void evaluate_tasks(const Context& ctx, SchemeData& data) const;
-  /// Cascade use: clears `qp` (sized n, 0, 0) and adds the objectives of levels()[level], checked; returns what they
-  /// wrote to W.
+  /// The objectives' part: clears `qp` (sized n, 0, 0) and adds the objectives of levels()[level], checked; returns
+  /// what they wrote to W.
   QpBuilder::WrittenW build_objectives(const Context& ctx, int level, QpProblem& qp, SchemeData& data) const;
 
   /// The priority levels of the active objectives and tasks, highest first (at least one).
   [[nodiscard]] const std::vector<SchemeLevelSpec>& levels() const noexcept { return levels_; }
-  /// Whether there are several levels (the Controller then solves one QP per level).
+  /// Whether there are several levels (StepOutput::levels then reports each).
   [[nodiscard]] bool cascaded() const noexcept { return levels_.size() > 1; }
-  /// The tasks.
-  [[nodiscard]] const std::vector<std::unique_ptr<Task>>& tasks() const noexcept { return tasks_; }
+  /// The tasks (const: a scheme's plugins do not change once it is built).
+  [[nodiscard]] const std::vector<std::unique_ptr<const Task>>& tasks() const noexcept { return tasks_; }
   /// The constraints' equality and inequality rows (without the tasks').
   [[nodiscard]] int constraint_equality_rows() const noexcept { return m_eq_c_; }
   [[nodiscard]] int constraint_inequality_rows() const noexcept { return m_in_c_; }
@@ -104,31 +106,33 @@ class Scheme {
   void set_regularization(double eps);
 
   /// The deepest kinematics any plugin reads.
-  [[nodiscard]] KinematicsLevel kinematics_level() const noexcept { return level_; }
+  [[nodiscard]] KinematicsLevel kinematics_level() const noexcept { return kinematics_level_; }
   /// What the QP's x is: theta_dot or theta_ddot.
-  [[nodiscard]] SchemeLevel level() const noexcept { return scheme_level_; }
+  [[nodiscard]] ControlOrder order() const noexcept { return order_; }
   /// Total equality and inequality rows of build()'s QP (the constraints' and, with one level, the tasks').
   [[nodiscard]] int equality_rows() const noexcept { return m_eq_; }
   [[nodiscard]] int inequality_rows() const noexcept { return m_in_; }
-  /// The plugins.
-  [[nodiscard]] const std::vector<std::unique_ptr<Objective>>& objectives() const noexcept { return objectives_; }
-  [[nodiscard]] const std::vector<std::unique_ptr<Constraint>>& constraints() const noexcept { return constraints_; }
+  /// The plugins (const: a scheme's plugins do not change once it is built, so that several controllers may share it).
+  [[nodiscard]] const std::vector<std::unique_ptr<const Objective>>& objectives() const noexcept { return objectives_; }
+  [[nodiscard]] const std::vector<std::unique_ptr<const Constraint>>& constraints() const noexcept {
+    return constraints_;
+  }
   /// The robot (not owned; must outlive the scheme).
   [[nodiscard]] const RobotModel& robot() const noexcept { return *robot_; }
 
  private:
   const RobotModel* robot_;
-  std::vector<std::unique_ptr<Objective>> objectives_;
-  std::vector<std::unique_ptr<Constraint>> constraints_;
-  std::vector<std::unique_ptr<Task>> tasks_;
+  std::vector<std::unique_ptr<const Objective>> objectives_;
+  std::vector<std::unique_ptr<const Constraint>> constraints_;
+  std::vector<std::unique_ptr<const Task>> tasks_;
   std::vector<SchemeLevelSpec> levels_;
   std::vector<int> eq_offset_, eq_rows_, in_offset_, in_rows_;
   std::vector<int> task_eq_offset_, task_eq_rows_, task_in_offset_, task_in_rows_;  // one level: the tasks' rows
   std::vector<bool> task_active_;  // active when the scheme was built (only those are in levels_ and the QP)
   int m_eq_ = 0, m_in_ = 0, m_eq_c_ = 0, m_in_c_ = 0;
   double regularization_ = kDefaultRegularization;
-  KinematicsLevel level_ = KinematicsLevel::kPosition;
-  SchemeLevel scheme_level_ = SchemeLevel::kVelocity;
+  KinematicsLevel kinematics_level_ = KinematicsLevel::kPosition;
+  ControlOrder order_ = ControlOrder::kVelocity;
   // Clears qp and lets every plugin write (checked: through contribute(), which throws naming a culprit); returns
   // whether a plugin wrote off W's diagonal.
   bool contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked,

@@ -123,10 +123,15 @@ TaskRegistry& task_registry();
 /// Builds a task from a [[tasks]] table; strict.
 [[nodiscard]] std::unique_ptr<Task> make_task(const TableReader& config, const RobotModel& robot);
 
-/// Writes a task's terms into the QP by its mode, with `builder` positioned on its rows (equality: rows(); inequality:
-/// inequality_rows()): equality rows J x = d; inequality rows J_r x <= hi_r and -J_r x <= -lo_r (each finite bound,
-/// in row order, upper first); soft: the least squares (weight / 2) |J x - d|^2 plus the damping term in W.
-void write_task_terms(const Task& task, const TaskTerms& terms, QpBuilder& builder);
+/// The one writer of a task's terms into a QP, at any priority level (Scheme::build's one QP and each level of a
+/// Cascade), with `builder` positioned on its rows (equality: rows(); inequality: inequality_rows()). By its mode:
+/// equality rows J x = d; inequality rows J_r x <= hi_r and -J_r x <= -lo_r (each finite bound, in row order, upper
+/// first); soft: the least squares (weight / 2) |J x - d|^2 plus its damping on the joints' diagonal of W.
+/// With `slack` >= 0 (a lower level that cannot meet its tasks, solved in least squares; control/cascade.hpp): an
+/// equality task's rows become the least squares (weight / 2) |J x - d|^2 and write no row, and each inequality row
+/// gets its own slack variable s, from column `slack` on (J_r x - s <= hi_r, W_ss = weight). Returns the next free
+/// slack column (`slack` when it used none). The joints are the QP's first J.cols() variables.
+int write_task_terms(const Task& task, const TaskTerms& terms, QpBuilder& builder, int slack = -1);
 
 /// The smallest singular value of a task's k x n rows J (k <= 6), from the eigenvalues of J J' (allocation-free).
 [[nodiscard]] double smallest_singular_value(const Eigen::Ref<const Eigen::MatrixXd>& J);

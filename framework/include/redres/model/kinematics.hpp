@@ -28,7 +28,8 @@ namespace redres {
 enum class KinematicsLevel {
   kPosition,        //!< f, end-effector pose, joint frames
   kJacobian,        //!< + J
-  kGradient,        //!< + w and q = grad w (dJ is not filled in)
+  kMeasure,         //!< + w (without its gradient: what a run records when no plugin needs more)
+  kGradient,        //!< + q = grad w (dJ is not filled in)
   kManipulability,  //!< + dJ/dtheta_i
   kAll,             //!< + Yoshikawa's mu and grad mu
 };
@@ -116,6 +117,19 @@ double symmetric_det_adjugate(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen:
 [[nodiscard]] inline Eigen::Matrix3d rotation_from_vector(const Eigen::Vector3d& w) {
   const double angle = w.norm();
   return angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+}
+
+/// The orientation error of a frame at rotation R against the desired rotation R_d: the rotation R_d R' that turns R
+/// into R_d, as an angle in [0, pi] and an axis. The one definition that every orientation row (the end-effector
+/// task, frame tasks), the recorded orientation error and the inverse kinematics use.
+[[nodiscard]] inline Eigen::AngleAxisd orientation_error(const Eigen::Matrix3d& R_d, const Eigen::Matrix3d& R) {
+  return Eigen::AngleAxisd(R_d * R.transpose());
+}
+
+/// Its rotation vector (angle times axis): what orientation rows feed back.
+[[nodiscard]] inline Eigen::Vector3d orientation_error_vector(const Eigen::Matrix3d& R_d, const Eigen::Matrix3d& R) {
+  const Eigen::AngleAxisd e = orientation_error(R_d, R);
+  return e.angle() * e.axis();
 }
 
 }  // namespace redres

@@ -5,19 +5,13 @@
 /// measured joint angles and velocities of a simulated arm with mass, actuators and contacts.
 
 #include <array>
+#include <string>
 #include <string_view>
 #include <utility>
 
 #include "redres/config/config.hpp"
 
 namespace redres {
-
-/// Which plant a run drives.
-enum class PlantKind { kKinematic, kMujoco };
-inline auto enum_names(PlantKind) {
-  return std::array{std::pair{PlantKind::kKinematic, std::string_view("kinematic")},
-                    std::pair{PlantKind::kMujoco, std::string_view("mujoco")}};
-}
 
 /// How the MuJoCo plant turns the controller's joint velocity command into joint torques (docs/plant.md, "Actuators"):
 /// - kVelocityServo ("velocity_servo", the default): tau = Kv (theta_dot_cmd - qdot) + g(q);
@@ -45,7 +39,11 @@ inline auto enum_names(PlantIntegrator) {
 
 /// A scenario's [plant] table.
 struct PlantConfig {
-  PlantKind kind = PlantKind::kKinematic;
+  /// Which plant a run drives, by its name in the plant registry (run/plants.hpp): "kinematic" or "mujoco".
+  std::string kind = "kinematic";
+  /// A run on another plant than the kinematic one also runs on the kinematic plant first, for the comparison of
+  /// their position errors (RunResult::plant's kinematic_max_position_error); off by default.
+  bool kinematic_comparison = false;
   /// MuJoCo's time step (s); the control period (the scenario's `step`) must be a whole number of them. 0: the
   /// smaller of 1 ms and the control period.
   double timestep = 0.0;

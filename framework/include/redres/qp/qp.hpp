@@ -45,8 +45,6 @@ struct QpProblem {
   std::vector<std::string> variable_names;  //!< joint names, for diagnoses (may be empty)
   std::vector<int> eq_source;               //!< source of each equality row
   std::vector<int> in_source;               //!< source of each inequality row
-  Eigen::VectorXd scratch;                  //!< n-vector a plugin may use as workspace while it contributes
-  Eigen::VectorXd scratch2;                 //!< a second one (e.g. upper bounds beside lower ones in scratch)
   /// Writes what inequality row r stands for at the last build (e.g. "link 'j3' shape 1 vs obstacle 2 at 0.012 m"),
   /// for diagnoses; may write nothing. Called only when a solve fails, into the diagnosis's reserved storage.
   std::function<void(int, TextSink&)> in_row_description;

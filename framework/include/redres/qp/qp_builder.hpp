@@ -26,6 +26,21 @@ class QpBuilder {
     for (Eigen::Index i = 0; i < n; ++i) W[i * (n + 1)] += add;
     wrote_w(WrittenW::kDiagonal);
   }
+  /// W_ii += weight * scale for the first `count` variables (e.g. the joints of a QP that has slack variables too).
+  void add_identity(double scale, Eigen::Index count) {
+    const double add = weight_ * scale;
+    const Eigen::Index n = qp_->W.rows();
+    if (count < 0 || count > n) bad_size("QpBuilder::add_identity", "0 <= count <= n");
+    double* W = qp_->W.data();
+    for (Eigen::Index i = 0; i < count; ++i) W[i * (n + 1)] += add;
+    wrote_w(WrittenW::kDiagonal);
+  }
+  /// W_ii = weight * value (a slack variable's own weight, which nothing else writes).
+  void set_diagonal(Eigen::Index i, double value) {
+    if (i < 0 || i >= qp_->W.rows()) bad_size("QpBuilder::set_diagonal", "0 <= i < n");
+    qp_->W(i, i) = weight_ * value;
+    wrote_w(WrittenW::kDiagonal);
+  }
   /// W += weight * diag(diagonal).
   void add_diagonal(const Eigen::Ref<const Eigen::VectorXd>& diagonal);
   /// W += weight * H (H symmetric); marks W as non-diagonal when H has off-diagonal entries.
@@ -101,10 +116,6 @@ class QpBuilder {
       qp_->hi_source[j] = source_;
     }
   }
-  /// An n-vector of workspace (contents undefined on entry), so that contributions need no allocation.
-  [[nodiscard]] Eigen::VectorXd& scratch() noexcept { return qp_->scratch; }
-  /// A second one.
-  [[nodiscard]] Eigen::VectorXd& scratch2() noexcept { return qp_->scratch2; }
   /// The plugin's weight.
   [[nodiscard]] double weight() const noexcept { return weight_; }
   /// The QP being built (read access).

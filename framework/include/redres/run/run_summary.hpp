@@ -102,7 +102,7 @@ struct RunSummary {
   RobotFacts robot;
   std::vector<PluginMetrics> metrics;    //!< per plugin that reports figures
   std::vector<ObstacleFacts> obstacles;  //!< every active plugin's obstacles, in the scenario's order
-  std::string plant_kind = "kinematic";  //!< [plant] kind: "kinematic" or "mujoco"
+  std::string plant_kind = "kinematic";  //!< [plant] kind: the plant's name (run/plants.hpp)
   PlantFacts plant;                      //!< the MuJoCo plant's figures (all empty on the kinematic plant; no mjcf)
 
   /// A plugin's metric by plugin instance name and metric name, or nullptr.

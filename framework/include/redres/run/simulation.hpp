@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// The simulation of a scenario: from theta(0), one Controller step per control step, integrated with Euler's or
-/// Heun's method, each step recorded into a Trajectory (columns in docs/output_formats.md).
+/// The simulation of a scenario: from theta(0), one Controller step per control step, applied to the scenario's plant
+/// (run/plants.hpp: the kinematic plant integrates with Euler's or Heun's method; the MuJoCo plant simulates the arm),
+/// each step recorded into a Trajectory (columns in docs/output_formats.md).
 
 #include <atomic>
 #include <functional>
@@ -28,7 +29,8 @@ struct PlantFacts {
   int max_contacts = 0;                         //!< the most contacts (involving the robot) at any MuJoCo step
   double deepest_penetration = 0.0;             //!< m
   std::vector<PlantContactPair> contact_pairs;  //!< every pair that touched, by first time
-  /// The same scenario on the kinematic plant: its largest position error (m), beside this run's (the summary's).
+  /// With `[plant] kinematic_comparison = true`: the same scenario on the kinematic plant, its largest position
+  /// error (m), beside this run's (the summary's); 0 otherwise.
   double kinematic_max_position_error = 0.0;
   double controller_seconds = 0.0;  //!< wall time in Controller::step over the run
   double mujoco_seconds = 0.0;      //!< wall time in MuJoCo's steps over the run
@@ -56,11 +58,13 @@ struct RunResult {
   std::vector<double> max_joint_acceleration, max_joint_jerk;
   std::vector<double> max_joint_acceleration_violation, max_joint_jerk_violation;
   int steps_over_acceleration_limit = 0, steps_over_jerk_limit = 0;
-  std::string first_relaxed;  //!< "t = ...: <diagnosis>" of the first relaxed step
-  bool interrupted = false;   //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
+  std::string first_relaxed;        //!< "t = ...: <diagnosis>" of the first relaxed step
+  double controller_seconds = 0.0;  //!< wall time in Controller::step over the run (s)
+  long control_steps = 0;           //!< the controller's steps
+  bool interrupted = false;         //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
   /// The plugins' data as the run's last step left it (what their summaries read, e.g. FCL's failures).
   std::shared_ptr<const SchemeData> plugin_data;
-  /// [plant] kind = "mujoco": what the physics plant recorded; empty on the kinematic plant.
+  /// What the plant recorded besides the table (the MuJoCo plant's figures); empty on the kinematic plant.
   std::optional<PlantFacts> plant;
 
   /// "projection", or "newton+projection" when a fallback ran.

@@ -34,7 +34,7 @@ class JointAccelerationLimits final : public Configured<Constraint, JointAcceler
   static constexpr const char* kType = "joint_acceleration_limits";
   /// Throws std::invalid_argument naming the first joint of `robot` without an acceleration limit.
   JointAccelerationLimits(const Config& config, const RobotModel& robot);
-  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
+  [[nodiscard]] bool supports(ControlOrder /*order*/) const override { return true; }
   [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
 
  private:

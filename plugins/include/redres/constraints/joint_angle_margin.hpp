@@ -25,11 +25,13 @@ class JointAngleMargin final : public Configured<Constraint, JointAngleMarginCon
   static constexpr const char* kType = "joint_angle_margin";
   JointAngleMargin(const Config& config, const RobotModel& robot);
   /// Both levels: at the acceleration level the bounds hold the velocity after the step (Context::velocity_to_x).
-  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
+  [[nodiscard]] bool supports(ControlOrder /*order*/) const override { return true; }
   /// The margin per joint.
   [[nodiscard]] const Eigen::VectorXd& margin() const noexcept { return margin_; }
   void summarise(const RobotModel& robot, const Trajectory& run, const PluginData* data,
                  std::vector<Metric>& out) const override;
+  /// Its workspace: the bounds of a step (a Workspace of two n-vectors).
+  [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
 
  private:
   void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;

@@ -28,7 +28,7 @@ class JointJerkLimits final : public Configured<Constraint, JointJerkLimitsConfi
   static constexpr const char* kType = "joint_jerk_limits";
   /// Throws std::invalid_argument naming the first joint of `robot` without a jerk limit.
   JointJerkLimits(const Config& config, const RobotModel& robot);
-  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
+  [[nodiscard]] bool supports(ControlOrder /*order*/) const override { return true; }
   [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
 
  private:

@@ -20,10 +20,14 @@ class JointVelocityLimits final : public Configured<Constraint, JointVelocityLim
   static constexpr const char* kType = "joint_velocity_limits";
   JointVelocityLimits(const Config& config, const RobotModel& robot);
   /// Both levels: at the acceleration level the laws bound the velocity after the step (Context::velocity_to_x).
-  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
+  [[nodiscard]] bool supports(ControlOrder /*order*/) const override { return true; }
+  /// Its workspace: the scaled bounds of a step (a Workspace of two n-vectors).
+  [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
 
  private:
   void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;
+
+  int n_;
 };
 
 }  // namespace redres

@@ -30,7 +30,7 @@ class TaskTracking final : public Configured<Constraint, TaskTrackingConfig>, pu
   static constexpr const char* kType = "task_tracking";
   TaskTracking(const Config& config, const RobotModel& robot);
   /// Both levels (the acceleration level's rows are in the file comment).
-  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
+  [[nodiscard]] bool supports(ControlOrder /*order*/) const override { return true; }
   [[nodiscard]] int equality_rows(const RobotModel& robot) const override { return robot.task_dim(); }
   [[nodiscard]] KinematicsLevel kinematics_level() const override { return KinematicsLevel::kJacobian; }
   void summarise(const RobotModel& robot, const Trajectory& run, const PluginData* data,

@@ -23,6 +23,8 @@ class JointCentering final : public Configured<Objective, JointCenteringConfig> 
   static constexpr const char* kType = "joint_centering";
   JointCentering(const Config& config, const RobotModel& robot);
   [[nodiscard]] std::optional<double> potential(const Context& ctx) const override;
+  /// Its workspace: the step's linear term (a Workspace of one n-vector).
+  [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
 
  private:
   void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;

@@ -64,7 +64,7 @@ class Manipulability final : public Configured<Objective, ManipulabilityConfig> 
 
   Manipulability(const Config& config, const RobotModel& robot);
   /// Both levels: zeta = -weight p(t) grad w pushes x (theta_dot or theta_ddot) up the gradient.
-  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
+  [[nodiscard]] bool supports(ControlOrder /*order*/) const override { return true; }
 
   /// The coefficient p(t).
   [[nodiscard]] double coefficient(double t, double T) const;

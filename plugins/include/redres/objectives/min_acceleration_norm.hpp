@@ -23,7 +23,7 @@ class MinAccelerationNorm final : public Configured<Objective, MinAccelerationNo
  public:
   static constexpr const char* kType = "min_acceleration_norm";
   MinAccelerationNorm(const Config& config, const RobotModel& robot);
-  [[nodiscard]] bool supports(SchemeLevel /*level*/) const override { return true; }
+  [[nodiscard]] bool supports(ControlOrder /*order*/) const override { return true; }
 
  private:
   void add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const override;

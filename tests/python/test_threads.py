@@ -1,5 +1,5 @@
-"""The GIL is released while a scenario runs: another Python thread runs meanwhile, and runs on several threads give
-the results of one thread."""
+"""The GIL is released while a scenario runs: another Python thread runs meanwhile, runs on several threads give
+the results of one thread, and one Scenario object runs on two threads at once."""
 
 import threading
 import time
@@ -37,3 +37,26 @@ def test_parallel_runs_give_the_results_of_sequential_runs():
     for a, b in zip(one.results, two.results):
         assert a.final_theta.tolist() == b.final_theta.tolist()
         assert (a.values == b.values).all()
+
+
+def test_one_scenario_runs_on_two_threads_at_once():
+    # The scenario is only read by its runs: the two runs overlap (each reports progress while the other does) and
+    # each gives what a run alone gives.
+    s = redres.Scenario.load(source("configs/paper_r_tvcmm.toml"), overrides={"step": 0.0005})
+    alone = s.run()
+    seen = [[], []]
+    results = [None, None]
+
+    def work(i):
+        results[i] = s.run(progress=lambda fraction, t: seen[i].append(time.perf_counter()))
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in (0, 1)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert seen[0] and seen[1]
+    assert seen[1][0] < seen[0][-1] and seen[0][0] < seen[1][-1], "the second run waited for the first"
+    for r in results:
+        assert (r.values == alone.values).all()
+        assert r.final_theta.tolist() == alone.final_theta.tolist()

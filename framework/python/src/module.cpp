@@ -128,11 +128,10 @@ class Hold {
   Exclusive& e_;
 };
 
-// redres.Scenario: a loaded scenario; one run at a time (the controllers made from it share its turn), any number
-// of Python threads.
+// redres.Scenario: a loaded scenario, only read by its runs (simulate() makes each run's controller, engine and
+// plant): any number of runs at once, on any number of Python threads.
 struct PyScenario {
   std::shared_ptr<Scenario> scenario;
-  std::shared_ptr<Exclusive> use = std::make_shared<Exclusive>();
 };
 
 // redres.Result: a finished run, its summary, and the scenario it came from (for write()).
@@ -151,6 +150,31 @@ py::array column_view(const Trajectory& tr, std::size_t col, py::handle owner) {
   return a;
 }
 
+// The scenarios this thread is running: a run takes no turn (several threads may run one scenario at once), but a
+// plugin that runs its own scenario from inside a step would recurse without end, so that is refused.
+class RunningHere {
+ public:
+  explicit RunningHere(const Scenario* s) {
+    for (const Scenario* r : running()) {
+      if (r == s) {
+        throw std::runtime_error(
+            "Scenario.run: called again from inside its own step (a plugin of it called it); a run of a scenario "
+            "cannot contain another run of it: use another scenario inside a plugin");
+      }
+    }
+    running().push_back(s);
+  }
+  ~RunningHere() { running().pop_back(); }
+  RunningHere(const RunningHere&) = delete;
+  RunningHere& operator=(const RunningHere&) = delete;
+
+ private:
+  static std::vector<const Scenario*>& running() {
+    thread_local std::vector<const Scenario*> list;
+    return list;
+  }
+};
+
 PyResult run_scenario(PyScenario& s, const py::object& progress) {
   // Calls the progress function (if any) and lets Ctrl-C stop a long run: both need the GIL, taken about 200
   // times per run.
@@ -161,8 +185,8 @@ PyResult run_scenario(PyScenario& s, const py::object& progress) {
   };
   PyResult out;
   {
+    const RunningHere here(s.scenario.get());
     py::gil_scoped_release release;
-    const Hold hold(*s.use, "Scenario.run");
     auto run = std::make_shared<RunResult>(simulate(*s.scenario, callback));
     out.summary = std::make_shared<RunSummary>(summarise(*s.scenario, *run));
     out.run = std::move(run);
@@ -280,7 +304,7 @@ struct PyController {
   std::unique_ptr<Path> path;
   std::unique_ptr<Controller> controller;
   StepOutput out;
-  std::shared_ptr<Exclusive> use = std::make_shared<Exclusive>();  // a scenario's controller shares its turn
+  std::shared_ptr<Exclusive> use = std::make_shared<Exclusive>();  // one step at a time
 };
 
 bool is_spec(py::handle item) { return py::hasattr(item, "_spec_table"); }
@@ -397,8 +421,7 @@ std::unique_ptr<PyController> make_controller(const PyRobot& robot, const py::li
 
 std::unique_ptr<PyController> controller_of(const PyScenario& s) {
   auto c = std::make_unique<PyController>();
-  c->scenario = s.scenario;
-  c->use = s.use;
+  c->scenario = s.scenario;  // kept alive; only read
   Scenario& sc = *s.scenario;
   c->robot = std::shared_ptr<const RobotModel>(s.scenario, sc.robot.get());
   c->controller = Controller::from_scenario(sc);  // what simulate() runs, the relax policy included

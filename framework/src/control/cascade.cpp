@@ -238,10 +238,6 @@ void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_
     eq += eq_rows;
     in += in_rows;
   }
-  if (!several_) {  // one level: the scheme's one QP, as Scheme::build() writes it
-    least_squares_terms_ = false;
-    return;
-  }
   // Scaled so that its largest diagonal entry is 1 (the same minimiser; a level of equality rows alone, W = 0, gets
   // W = I), plus eps I: the regularization is relative to the level's own terms.
   double scale = 0.0;
@@ -365,8 +361,10 @@ void Cascade::refine(QpProblem& qp, LviEngine& engine, SolverResult& r, int& ite
 
 bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eigen::VectorXd& x) {
   REDRES_REQUIRE(x.size() == n_, "Cascade::solve", "x has n entries");
-  scheme_->build_constraints(ctx, base_, data);
-  scheme_->evaluate_tasks(ctx, data);
+  if (several_) {  // the parts every level's QP is assembled from (one level: Scheme::build() writes its QP at once)
+    scheme_->build_constraints(ctx, base_, data);
+    scheme_->evaluate_tasks(ctx, data);
+  }
   held_eq_ = held_in_ = 0;
   // Why the levels below are skipped, once one is: -1 none, 0 nothing left to decide, 1 a level failed.
   int skip = -1;
@@ -393,11 +391,15 @@ bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eige
       }
       continue;
     }
-    obj_w_ = scheme_->build_objectives(ctx, static_cast<int>(l), obj_, data);
     used_slot_[l] = held_eq_;
     Slot& S = *L.slots[static_cast<std::size_t>(held_eq_)];
     S.used_ls = false;
-    assemble(static_cast<int>(l), data, S.qp, false);
+    if (several_) {
+      obj_w_ = scheme_->build_objectives(ctx, static_cast<int>(l), obj_, data);
+      assemble(static_cast<int>(l), data, S.qp, false);
+    } else {
+      scheme_->build(ctx, S.qp, data);  // the same QP, written in one pass (the paper's; the real-time path)
+    }
     S.engine->solve_valid(S.qp, S.result);  // assemble() wrote only checked entries
     if (l == 0) info = S.result.info;       // the step's outcome, before any proximal step
     level.iterations = S.result.info.iterations;
@@ -451,6 +453,7 @@ bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eige
     }
     x = answer->x.head(n_);
     level.task_error = task_error(static_cast<int>(l), data, x);
+    if (l + 1 == levels_.size()) break;  // nothing below to hold it for
     hold(static_cast<int>(l), data, x);
     if (obj_w_ != QpBuilder::WrittenW::kNone || held_eq_ >= n_) {
       skip = 0;

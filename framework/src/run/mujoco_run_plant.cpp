@@ -129,6 +129,7 @@ PlantType mujoco_plant_type() {
   };
   t.check = check_mujoco;
   t.make = [](const Scenario& s) -> std::unique_ptr<Plant> { return std::make_unique<MujocoRunPlant>(s); };
+  t.times_controller = true;  // its summary compares the controller's time with MuJoCo's
   return t;
 }
 

@@ -49,7 +49,9 @@ class MotionStats {
         a_lo_(Eigen::VectorXd::Zero(robot.dof())),
         a_hi_(Eigen::VectorXd::Zero(robot.dof())),
         j_lo_(Eigen::VectorXd::Zero(robot.dof())),
-        j_hi_(Eigen::VectorXd::Zero(robot.dof())) {
+        j_hi_(Eigen::VectorXd::Zero(robot.dof())),
+        acceleration_(robot.has_acceleration_limits()),
+        jerk_(robot.has_jerk_limits()) {
     const auto n = static_cast<std::size_t>(robot.dof());
     run.max_joint_acceleration.assign(n, 0.0);
     run.max_joint_jerk.assign(n, 0.0);
@@ -60,10 +62,14 @@ class MotionStats {
   // The limits at the step's theta, as its controller evaluated them (before a second stage evaluates them at
   // another state).
   void limits_of_step(const Controller& ctrl) {
-    a_lo_ = ctrl.acceleration_lower();
-    a_hi_ = ctrl.acceleration_upper();
-    j_lo_ = ctrl.jerk_lower();
-    j_hi_ = ctrl.jerk_upper();
+    if (acceleration_) {
+      a_lo_ = ctrl.acceleration_lower();
+      a_hi_ = ctrl.acceleration_upper();
+    }
+    if (jerk_) {
+      j_lo_ = ctrl.jerk_lower();
+      j_hi_ = ctrl.jerk_upper();
+    }
   }
 
   // `applied` is the command the arm followed over the step whose limits limits_of_step() took.
@@ -105,6 +111,7 @@ class MotionStats {
 
   Eigen::VectorXd prev_, acc_, acc_prev_;
   Eigen::VectorXd a_lo_, a_hi_, j_lo_, j_hi_;  // the step's limits
+  bool acceleration_, jerk_;                   // the robot has them
 };
 
 }  // namespace
@@ -188,17 +195,18 @@ void run_on(const Scenario& s, const PlantType& type, RunResult& run, const Prog
   std::string failure;
   const auto start = std::chrono::steady_clock::now();
   MotionStats motion(*s.robot, run);
+  const bool timed = type.times_controller;
 
   for (int k = 0; k <= steps; ++k) {
     const double t = k == steps ? s.duration : k * s.tau;
     const Eigen::VectorXd& theta = plant->theta();
-    const auto c0 = std::chrono::steady_clock::now();
+    const auto c0 = timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
     if (const Eigen::VectorXd* measured = plant->theta_dot()) {
       ctrl.step(theta, *measured, t, out);
     } else {
       ctrl.step(theta, t, out);
     }
-    run.controller_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
+    if (timed) run.controller_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
     ++run.control_steps;
     double* row = rows.write(k, t, theta, out);
     plant->record(row + static_cast<std::ptrdiff_t>(plant_first));

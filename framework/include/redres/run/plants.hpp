@@ -72,6 +72,8 @@ struct PlantType {
   std::function<void(const TableReader& table, Scenario& scenario)> check;
   /// The plant of a run of `scenario`, at its theta0.
   std::function<std::unique_ptr<Plant>(const Scenario& scenario)> make;
+  /// Whether the loop times each controller step for it (RunResult::controller_seconds; two clock reads per step).
+  bool times_controller = false;
 };
 
 /// The plants by name.

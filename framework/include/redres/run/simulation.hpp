@@ -59,7 +59,7 @@ struct RunResult {
   std::vector<double> max_joint_acceleration_violation, max_joint_jerk_violation;
   int steps_over_acceleration_limit = 0, steps_over_jerk_limit = 0;
   std::string first_relaxed;        //!< "t = ...: <diagnosis>" of the first relaxed step
-  double controller_seconds = 0.0;  //!< wall time in Controller::step over the run (s)
+  double controller_seconds = 0.0;  //!< wall time in Controller::step over the run (s), for plants that time it
   long control_steps = 0;           //!< the controller's steps
   bool interrupted = false;         //!< ended early because `stop` was set (SIGINT or SIGTERM in the CLI)
   /// The plugins' data as the run's last step left it (what their summaries read, e.g. FCL's failures).

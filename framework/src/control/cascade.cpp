@@ -359,6 +359,18 @@ void Cascade::refine(QpProblem& qp, LviEngine& engine, SolverResult& r, int& ite
   }
 }
 
+namespace {
+// A level's outcome before the step decides it: not run, nothing counted, no text (its reserve kept).
+void not_run(LevelInfo& level) {
+  level.status = SolverStatus::kNotRun;
+  level.iterations = 0;
+  level.residual = 0.0;
+  level.task_error = 0.0;
+  keep_diagnosis_capacity(level.diagnosis);
+  level.diagnosis.clear();
+}
+}  // namespace
+
 bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eigen::VectorXd& x) {
   REDRES_REQUIRE(x.size() == n_, "Cascade::solve", "x has n entries");
   if (several_) {  // the parts every level's QP is assembled from (one level: Scheme::build() writes its QP at once)
@@ -372,12 +384,7 @@ bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eige
   for (std::size_t l = 0; l < levels_.size(); ++l) {
     Level& L = *levels_[l];
     LevelInfo& level = info_[l];
-    level.status = SolverStatus::kNotRun;
-    level.iterations = 0;
-    level.residual = 0.0;
-    level.task_error = 0.0;
-    keep_diagnosis_capacity(level.diagnosis);
-    level.diagnosis.clear();
+    not_run(level);
     TextSink text(level.diagnosis);
     text.precision(6);
     if (skip >= 0) {
@@ -428,12 +435,7 @@ bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eige
       text << "the step's QP (priority " << L.priority << ") failed";
       for (std::size_t k = 1; k < levels_.size(); ++k) {
         LevelInfo& below = info_[k];
-        below.status = SolverStatus::kNotRun;
-        below.iterations = 0;
-        below.residual = 0.0;
-        below.task_error = 0.0;
-        keep_diagnosis_capacity(below.diagnosis);
-        below.diagnosis.clear();
+        not_run(below);
         TextSink(below.diagnosis) << "skipped: priority " << L.priority << " failed";
       }
       return false;

@@ -4,7 +4,7 @@
 /// (`urdf = "..."`, docs/robot_format.md). Only the chain between two links is read: its moving joints become joint
 /// frames (origin and axis, robot.hpp), fixed joints are folded into the next origin (or into the tip transform
 /// after the last moving joint), and the collision elements of the links the chain moves become collision shapes.
-/// urdfdom is included only by urdf.cpp.
+/// urdfdom is included only by urdf.cpp and urdf_elements.cpp.
 
 #include <array>
 #include <filesystem>

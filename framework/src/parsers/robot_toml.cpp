@@ -1,12 +1,15 @@
 #include "redres/parsers/robot_toml.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
-#include <set>
+#include <string>
+#include <vector>
 
 #include "common/text.hpp"
+#include "parsers/chain_build.hpp"
+#include "parsers/chain_description.hpp"
 #include "parsers/collision_exclusions.hpp"
-#include "parsers/robot_reading.hpp"
 #include "parsers/robot_toml_values.hpp"
 #include "parsers/toml_chain.hpp"
 #include "parsers/urdf.hpp"
@@ -16,6 +19,34 @@
 namespace redres {
 
 namespace {
+
+// A robot file's top level, read key by key in this order. A file that names a URDF (`urdf`, `base_link`,
+// `tip_link`) takes its chain from it (read_urdf_chain): `[[joints]]` entries, by joint name, may replace a joint's
+// `limits`, `velocity_limit` and the motion limits (acceleration, jerk, effort); `[[links]]` entries, by link name,
+// give collision shapes that replace
+// (`replace = true`, the default) or add to the URDF's.
+struct RobotReading {
+  RobotSpec spec;
+  ChainOptions options;  // `collision_model` (what a mesh collision element becomes; per link: [[links]]), `packages`
+  bool from_urdf = false;
+  std::filesystem::path urdf;
+  std::string base_link, tip_link;
+  ChainDescription chain;              // the URDF's, or the [[joints]] given joint by joint
+  std::map<std::string, double> held;  // `held_joints`
+  // Problems found while building the chain's joints and links, reported together (build_chain()).
+  std::vector<ConfigError> problems;
+  static const Schema<RobotReading>& schema();
+};
+
+// A chain given joint by joint, built as given: a problem of its own would be the `joints` key's.
+class AsGiven final : public ChainAmendments {
+ public:
+  explicit AsGiven(const TableReader& r) : r_(r) {}
+  [[noreturn]] void fail(const std::string& message) const override { r_.fail("joints", message); }
+
+ private:
+  const TableReader& r_;
+};
 
 // `key` of a robot file with a URDF only: refused in one without.
 void only_with_urdf(const TableReader& r, const RobotReading& c, const char* key, const char* instead) {
@@ -52,8 +83,6 @@ const Schema<RobotReading>& RobotReading::schema() {
                    if (e.where().line == 0) r.fail("urdf", e.what());  // missing, not a regular file, too large
                    throw;
                  }
-                 c.spec.end_effector = c.chain.tip;
-                 for (const UrdfHeldJoint& h : c.chain.held) c.spec.held_joints.emplace_back(h.name, h.value);
                }),
       entry<C>("base_link", "string", "", "none; required with `urdf`",
                "the URDF link the chain starts at (required with `urdf`)",
@@ -69,13 +98,13 @@ const Schema<RobotReading>& RobotReading::schema() {
                  only_with_urdf(r, c, "held_joints", "");
                  const TableReader t = r.table("held_joints");
                  std::string names;
-                 for (const UrdfHeldJoint& h : c.chain.held) names += (names.empty() ? "'" : ", '") + h.name + "'";
+                 for (const HeldJoint& h : c.chain.held) names += (names.empty() ? "'" : ", '") + h.name + "'";
                  for (const auto& entry : c.held) {  // read with `urdf`, which places the branches with them
                    // Named copies, not a structured binding: clang before 16 cannot capture a binding in a lambda.
                    const std::string& name = entry.first;
                    const double v = entry.second;
                    const auto it = std::find_if(c.chain.held.begin(), c.chain.held.end(),
-                                                [&](const UrdfHeldJoint& h) { return h.name == name; });
+                                                [&](const HeldJoint& h) { return h.name == name; });
                    if (it == c.chain.held.end()) {
                      t.fail(name, "no held joint named '" + name + "' (the joints of side branches off the chain " +
                                       "from '" + c.base_link + "' to '" + c.tip_link + "'" +
@@ -98,7 +127,7 @@ const Schema<RobotReading>& RobotReading::schema() {
                [](const TableReader& r, C& c) {
                  if (!r.has("collision_model")) return;
                  only_with_urdf(r, c, "collision_model", "");
-                 c.collision_model = r.choice("collision_model", {"capsule", "hull", "none"});
+                 c.options.collision_model = r.choice("collision_model", {"capsule", "hull", "none"});
                }),
       entry<C>("packages", "table { NAME = \"dir\" }", "", "none",
                "where a URDF's package://NAME/ paths are, relative to this file (before REDRES_PACKAGE_PATH, "
@@ -109,7 +138,7 @@ const Schema<RobotReading>& RobotReading::schema() {
                  const TableReader t = r.table("packages");
                  for (const auto& [key, value] : t.raw()) {
                    const std::string name(key.str());
-                   c.packages.named[name] = t.path(name);
+                   c.options.packages.named[name] = t.path(name);
                  }
                }),
       entry<C>("name", "string", "", "the URDF's; required without `urdf`", "the robot's name",
@@ -163,25 +192,22 @@ const Schema<RobotReading>& RobotReading::schema() {
                "the chain, base to tip (with `urdf`: overrides of `limits`, `velocity_limit`, `acceleration_limit`, "
                "`jerk_limit` and `effort_limit` by joint name)",
                [](const TableReader& r, C& c) {
+                 // The chain, from the URDF (amended by the [[joints]] and [[links]] entries) or given joint by joint,
+                 // built into the robot's joints, shapes, frames, inertias and visuals.
                  if (c.from_urdf) {
-                   read_urdf_joints(r, c);
+                   UrdfOverlay overlay(r, c.base_link, c.tip_link, c.problems);
+                   build_chain(c.chain, c.options, overlay, c.spec, c.problems);
                    return;
                  }
-                 std::set<std::string> names;
-                 const std::vector<TableReader> entries = r.tables("joints");
-                 if (entries.size() > kMaxJoints) {
-                   r.fail("joints", "expected at most " + std::to_string(kMaxJoints) + " joints, got " +
-                                        std::to_string(entries.size()));
-                 }
-                 for (const TableReader& entry : entries) {
-                   c.spec.joints.push_back(load_joint(entry, c.spec.kind, c.spec.convention, names));
-                 }
+                 c.chain = read_toml_chain(r, c.spec.kind, c.spec.convention);
+                 AsGiven as_given(r);
+                 build_chain(c.chain, c.options, as_given, c.spec, c.problems);
                }),
       entry<C>("links", "array of tables [[links]] (below)", "", "none",
                "collision shapes of the URDF's links (with `urdf` only)",
                [](const TableReader& r, C& c) {
+                 // With `urdf`, the entries are read with the chain (`joints`).
                  only_with_urdf(r, c, "links", " (a [[joints]] entry's `collision` gives its link's shapes)");
-                 if (c.from_urdf) read_urdf_links(r, c);
                }),
       entry<C>("end_effector", "table {xyz, rpy} (planar: {xyz, angle})", "", "the last joint's frame (a URDF's tip)",
                "the end effector's frame in the last joint's (after the URDF's tip link)",

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <utility>
+#include <vector>
 
 #include "common/text.hpp"
 #include "parsers/robot_toml_values.hpp"
@@ -145,6 +146,23 @@ JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention conv
   read_config(r, JointReading::schema(), reading);
   r.finish();
   return std::move(reading.jt);
+}
+
+ChainDescription read_toml_chain(const TableReader& r, ChainKind kind, DhConvention convention) {
+  ChainDescription chain;
+  chain.file = r.file().path;
+  std::set<std::string> names;
+  const std::vector<TableReader> entries = r.tables("joints");
+  if (entries.size() > kMaxJoints) {
+    r.fail("joints",
+           "expected at most " + std::to_string(kMaxJoints) + " joints, got " + std::to_string(entries.size()));
+  }
+  for (const TableReader& entry : entries) {
+    ChainJoint joint;
+    joint.spec = load_joint(entry, kind, convention, names);
+    chain.joints.push_back(std::move(joint));
+  }
+  return chain;
 }
 
 }  // namespace redres

@@ -1,9 +1,11 @@
 #pragma once
-// A robot file's chain given joint by joint: its [[joints]] entries, each read through JointReading's schema.
+// A robot file's chain given joint by joint: its [[joints]] entries, each read through JointReading's schema, as a
+// ChainDescription (its joints only: a joint's `collision` holds its link's shapes).
 
 #include <set>
 #include <string>
 
+#include "parsers/chain_description.hpp"
 #include "redres/config/config.hpp"
 #include "redres/model/robot.hpp"
 
@@ -22,5 +24,9 @@ struct JointReading {
 // The [[joints]] entry `entry` of a chain of `kind` and `convention`: its name (unique among `names`, which it joins)
 // first, then its keys in JointReading's order.
 JointSpec load_joint(const TableReader& entry, ChainKind kind, DhConvention convention, std::set<std::string>& names);
+
+// The [[joints]] entries of the robot file `r` (at least one, at most kMaxJoints, names unique), base to tip, in a
+// chain of `kind` and `convention`; file = the robot file.
+ChainDescription read_toml_chain(const TableReader& r, ChainKind kind, DhConvention convention);
 
 }  // namespace redres

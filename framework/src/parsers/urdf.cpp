@@ -62,11 +62,11 @@ struct Holder {
   const urdf::ModelInterface& model;
   const std::map<std::string, double>& given;
   const std::set<std::string>& chain_joints;  // the chain's moving joints
-  UrdfChain& out;
+  ChainDescription& out;
 
   // The position `j` is held at (recorded in out.held once, with a mimic's leader).
   double value(const urdf::Joint& j) {
-    UrdfHeldJoint h = describe(j);
+    HeldJoint h = describe(j);
     if (j.mimic) {
       const std::string& leader = j.mimic->joint_name;
       h.mimics = leader;
@@ -79,7 +79,7 @@ struct Holder {
       const urdf::JointConstSharedPtr l = model.getJoint(leader);
       if (!l)
         throw UrdfError(h.where + " is a mimic of joint '" + printable(leader) + "', which the file does not have");
-      UrdfHeldJoint lead = describe(*l);
+      HeldJoint lead = describe(*l);
       lead.value = own(*l);
       record(lead);
       h.value = j.mimic->multiplier * lead.value + j.mimic->offset;
@@ -92,8 +92,8 @@ struct Holder {
   }
 
  private:
-  UrdfHeldJoint describe(const urdf::Joint& j) const {
-    UrdfHeldJoint h;
+  HeldJoint describe(const urdf::Joint& j) const {
+    HeldJoint h;
     h.name = j.name;
     h.where = names.joint(j.name);
     h.limited = j.type != urdf::Joint::CONTINUOUS && j.limits != nullptr && movable(j);
@@ -109,8 +109,8 @@ struct Holder {
     if (j.type == urdf::Joint::CONTINUOUS || j.limits == nullptr || !movable(j)) return 0.0;
     return std::clamp(0.0, std::min(j.limits->lower, j.limits->upper), std::max(j.limits->lower, j.limits->upper));
   }
-  void record(const UrdfHeldJoint& h) {
-    for (const UrdfHeldJoint& e : out.held) {
+  void record(const HeldJoint& h) {
+    for (const HeldJoint& e : out.held) {
       if (e.name == h.name) return;
     }
     out.held.push_back(h);
@@ -118,11 +118,11 @@ struct Holder {
 };
 
 // The side branch below `joint`, hanging from a link that rides on chain joint `index` with its frame `at` in that
-// joint's link frame: each link of it a UrdfLink of its own, its movable joints held (Holder). Walked with a stack of
+// joint's link frame: each link of it a ChainLink of its own, its movable joints held (Holder). Walked with a stack of
 // its own, so that a branch of 10,000 fixed links is as safe as one of 3 (the graph is a tree: checked first).
 void add_branch(const Namer& names, const urdf::ModelInterface& model, const urdf::Joint& joint, int index,
                 const Eigen::Isometry3d& at, bool branch, Holder& holder, const std::string& messages,
-                UrdfChain& chain) {
+                ChainDescription& chain) {
   struct Item {
     const urdf::Joint* joint;
     Eigen::Isometry3d from;
@@ -145,7 +145,7 @@ void add_branch(const Namer& names, const urdf::ModelInterface& model, const urd
     const bool moves = movable(j) || j.mimic != nullptr;
     Eigen::Isometry3d frame = item.from * pose_of(j.parent_to_joint_origin_transform);
     if (moves) frame = frame * joint_motion(j, holder.value(j));
-    UrdfLink l;
+    ChainLink l;
     l.name = link->name;
     l.where = names.link(link->name);
     l.branch = item.branch || moves;
@@ -255,13 +255,14 @@ std::pair<std::string, std::string> default_urdf_chain(const std::filesystem::pa
   });
 }
 
-UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& base_link, const std::string& tip_link,
-                          const std::map<std::string, double>& held) {
+ChainDescription read_urdf_chain(const std::filesystem::path& file, const std::string& base_link,
+                                 const std::string& tip_link, const std::map<std::string, double>& held) {
   return with_parsed_urdf(file, [&](const urdf::ModelInterface& model_ref, const Namer& names,
                                     const std::string& messages) {
     const std::string where = file.string();
     const urdf::ModelInterface* model = &model_ref;
-    UrdfChain chain;
+    ChainDescription chain;
+    chain.file = file;
     chain.robot_name = model->getName();
     check_name(where + ": <robot>", chain.robot_name);
     for (const std::string& l : names.outline.link_order) chain.all_links.push_back(l);
@@ -323,44 +324,49 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
               throw UrdfError(who + ": the chain from '" + printable(base_link) + "' to '" + printable(tip_link) +
                               "' has more than " + std::to_string(kMaxJoints) + " moving joints, the most a robot has");
             }
-            UrdfJoint j;
-            j.name = joint->name;
+            ChainJoint j;
+            const bool prismatic = joint->type == urdf::Joint::PRISMATIC;
+            j.spec.name = joint->name;
+            j.spec.type = prismatic ? JointType::kPrismatic : JointType::kRevolute;
             j.where = who;
-            j.prismatic = joint->type == urdf::Joint::PRISMATIC;
             j.continuous = joint->type == urdf::Joint::CONTINUOUS;
-            j.origin = fixed * origin;
+            j.spec.origin = fixed * origin;
             fixed = Eigen::Isometry3d::Identity();
-            j.axis = Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
-            if (!j.axis.allFinite() || !(j.axis.norm() > 1e-9)) {
-              throw UrdfError(who + ": <axis> expected a finite, non-zero vector, got [" + num(j.axis.x()) + ", " +
-                              num(j.axis.y()) + ", " + num(j.axis.z()) + "]");
+            Eigen::Vector3d& axis = j.spec.axis;
+            axis = Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
+            if (!axis.allFinite() || !(axis.norm() > 1e-9)) {
+              throw UrdfError(who + ": <axis> expected a finite, non-zero vector, got [" + num(axis.x()) + ", " +
+                              num(axis.y()) + ", " + num(axis.z()) + "]");
             }
-            j.axis.normalize();
+            axis.normalize();
             if (joint->dynamics) {
-              j.damping = joint->dynamics->damping;
-              if (!(std::isfinite(j.damping) && j.damping >= 0.0 && j.damping <= 1e6)) {
-                throw UrdfError(who + ": <dynamics> damping expected 0 <= damping <= 1e6, got " + num(j.damping));
+              const double damping = joint->dynamics->damping;
+              if (!(std::isfinite(damping) && damping >= 0.0 && damping <= 1e6)) {
+                throw UrdfError(who + ": <dynamics> damping expected 0 <= damping <= 1e6, got " + num(damping));
               }
+              j.spec.damping = damping;
             }
             if (joint->limits) {
-              j.lower = joint->limits->lower;
-              j.upper = joint->limits->upper;
-              j.velocity = joint->limits->velocity;
-              j.effort = joint->limits->effort;
-              if (!(std::isfinite(j.effort) && j.effort >= 0.0 && j.effort <= 1e7)) {
-                throw UrdfError(who + ": <limit> effort expected 0 <= effort <= 1e7 " + (j.prismatic ? "N" : "N m") +
-                                ", got " + num(j.effort));
+              const double lower = joint->limits->lower, upper = joint->limits->upper;
+              const double velocity = joint->limits->velocity, effort = joint->limits->effort;
+              if (!(std::isfinite(effort) && effort >= 0.0 && effort <= 1e7)) {
+                throw UrdfError(who + ": <limit> effort expected 0 <= effort <= 1e7 " + (prismatic ? "N" : "N m") +
+                                ", got " + num(effort));
               }
-              const double bound = *physical_bound(j.prismatic ? "m" : "rad");
-              const char* unit = j.prismatic ? " m" : " rad";
-              if (!j.continuous && !(std::abs(j.lower) <= bound && std::abs(j.upper) <= bound)) {
+              const double bound = *physical_bound(prismatic ? "m" : "rad");
+              const char* unit = prismatic ? " m" : " rad";
+              if (!j.continuous && !(std::abs(lower) <= bound && std::abs(upper) <= bound)) {
                 throw UrdfError(who + ": <limit> lower and upper expected |x| <= " + num(bound) + unit +
-                                " (a physical range), got " + num(j.lower) + " and " + num(j.upper));
+                                " (a physical range), got " + num(lower) + " and " + num(upper));
               }
-              if (!(std::abs(j.velocity) <= *physical_bound("rad/s or m/s")) || j.velocity < 0.0) {
+              if (!(std::abs(velocity) <= *physical_bound("rad/s or m/s")) || velocity < 0.0) {
                 throw UrdfError(who + ": <limit> velocity expected 0 <= v <= " + num(*physical_bound("rad/s or m/s")) +
-                                (j.prismatic ? " m/s" : " rad/s") + ", got " + num(j.velocity));
+                                (prismatic ? " m/s" : " rad/s") + ", got " + num(velocity));
               }
+              j.spec.lower = lower;
+              j.spec.upper = upper;
+              j.velocity = velocity;
+              if (effort > 0.0) j.spec.effort_limit = effort;
             }
             chain.joints.push_back(j);
             break;
@@ -377,7 +383,7 @@ UrdfChain read_urdf_chain(const std::filesystem::path& file, const std::string& 
         add_visuals(names, *links[k], fixed, chain.base_visuals);
         continue;
       }
-      UrdfLink l;
+      ChainLink l;
       l.name = links[k]->name;
       l.where = names.link(links[k]->name);
       l.joint = static_cast<int>(chain.joints.size()) - 1;

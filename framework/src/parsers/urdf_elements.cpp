@@ -43,24 +43,24 @@ namespace {
 
 // A <collision> or <visual> element's geometry (`element`: "" or "<visual> ", for messages), checked: lengths
 // positive and physical, a mesh's scale positive.
-UrdfVisual read_geometry(const std::string& who, const std::string& element, const urdf::Geometry& geometry) {
-  UrdfVisual g;
+ChainVisual read_geometry(const std::string& who, const std::string& element, const urdf::Geometry& geometry) {
+  ChainVisual g;
   switch (geometry.type) {
     case urdf::Geometry::SPHERE:
-      g.kind = UrdfVisual::Kind::kSphere;
+      g.kind = ChainVisual::Kind::kSphere;
       g.radius = static_cast<const urdf::Sphere&>(geometry).radius;
       check_length(who, (element + "<sphere> radius").c_str(), g.radius, true);
       break;
     case urdf::Geometry::BOX: {
       const urdf::Vector3& d = static_cast<const urdf::Box&>(geometry).dim;
-      g.kind = UrdfVisual::Kind::kBox;
+      g.kind = ChainVisual::Kind::kBox;
       g.size = {d.x, d.y, d.z};
       for (double v : g.size) check_length(who, (element + "<box> size").c_str(), v, true);
       break;
     }
     case urdf::Geometry::CYLINDER: {
       const auto& cyl = static_cast<const urdf::Cylinder&>(geometry);
-      g.kind = UrdfVisual::Kind::kCylinder;
+      g.kind = ChainVisual::Kind::kCylinder;
       g.radius = cyl.radius;
       g.length = cyl.length;
       check_length(who, (element + "<cylinder> radius").c_str(), cyl.radius, true);
@@ -69,7 +69,7 @@ UrdfVisual read_geometry(const std::string& who, const std::string& element, con
     }
     case urdf::Geometry::MESH: {
       const auto& mesh = static_cast<const urdf::Mesh&>(geometry);
-      g.kind = UrdfVisual::Kind::kMesh;
+      g.kind = ChainVisual::Kind::kMesh;
       g.filename = mesh.filename;
       g.scale = Eigen::Vector3d(mesh.scale.x, mesh.scale.y, mesh.scale.z);
       if (!g.scale.allFinite() || (g.scale.array() <= 0.0).any()) {
@@ -84,7 +84,7 @@ UrdfVisual read_geometry(const std::string& who, const std::string& element, con
 }  // namespace
 
 void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometry3d& at, const std::string& messages,
-                UrdfLink& out) {
+                ChainLink& out) {
   const std::string who = names.link(link.name);
   // The mass properties ride with the shapes; a massless <inertial> (a frame with no body) adds nothing.
   if (link.inertial && link.inertial->mass != 0.0) {
@@ -109,8 +109,8 @@ void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometr
     }
     check_pose(who, "<collision> <origin>", c->origin);
     const Eigen::Isometry3d pose = at * pose_of(c->origin);
-    const UrdfVisual g = read_geometry(who, "", *c->geometry);
-    if (g.kind == UrdfVisual::Kind::kMesh) {
+    const ChainVisual g = read_geometry(who, "", *c->geometry);
+    if (g.kind == ChainVisual::Kind::kMesh) {
       out.meshes.push_back({g.filename, g.scale, pose});
       continue;
     }
@@ -118,11 +118,11 @@ void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometr
     s.xyz = {pose.translation().x(), pose.translation().y(), pose.translation().z()};
     s.rpy = rpy_of(pose.linear());
     switch (g.kind) {
-      case UrdfVisual::Kind::kSphere:
+      case ChainVisual::Kind::kSphere:
         s.shape = ShapeSpec::Kind::kSphere;
         s.radius = g.radius;
         break;
-      case UrdfVisual::Kind::kBox:
+      case ChainVisual::Kind::kBox:
         s.shape = ShapeSpec::Kind::kBox;
         s.size = g.size;
         break;
@@ -137,15 +137,15 @@ void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometr
 }
 
 void add_visuals(const Namer& names, const urdf::Link& link, const Eigen::Isometry3d& at,
-                 std::vector<UrdfVisual>& out) {
+                 std::vector<ChainVisual>& out) {
   const std::string who = names.link(link.name);
   for (const urdf::VisualSharedPtr& v : link.visual_array) {
     if (!v || !v->geometry) continue;  // urdfdom reports a visual it cannot read as it parses; nothing to draw
     check_pose(who, "<visual> <origin>", v->origin);
-    UrdfVisual u;
+    ChainVisual u;
     u.link = link.name;
     u.pose = at * pose_of(v->origin);
-    const UrdfVisual g = read_geometry(who, "<visual> ", *v->geometry);
+    const ChainVisual g = read_geometry(who, "<visual> ", *v->geometry);
     u.kind = g.kind;
     u.filename = g.filename;
     u.scale = g.scale;

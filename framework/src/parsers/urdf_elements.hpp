@@ -25,14 +25,14 @@ void check_length(const std::string& who, const char* what, double value, bool p
 
 void check_pose(const std::string& who, const char* what, const urdf::Pose& p);
 
-// The collision elements of `link`, whose frame is `at` in the frame of the UrdfLink `out` gathers shapes for.
+// The collision elements of `link`, whose frame is `at` in the frame of the ChainLink `out` gathers shapes for.
 void add_shapes(const Namer& names, const urdf::Link& link, const Eigen::Isometry3d& at, const std::string& messages,
-                UrdfLink& out);
+                ChainLink& out);
 
 // The visual elements of `link`, whose frame is `at` in the frame they are gathered in. Checked as the collision
 // elements are (a bad one is an error: the file is wrong), but a viewer alone uses them.
 void add_visuals(const Namer& names, const urdf::Link& link, const Eigen::Isometry3d& at,
-                 std::vector<UrdfVisual>& out);
+                 std::vector<ChainVisual>& out);
 
 // A name of the file (`who` names its element): UTF-8 without control characters, else UrdfError.
 void check_name(const std::string& who, const std::string& name);

@@ -1,12 +1,14 @@
 #pragma once
-// A URDF chain's joints and links as a robot file amends them: its [[joints]] entries override a joint's range and
-// limits by name, its [[links]] entries give a link's collision shapes, collision model and inertia by name.
+// A URDF chain as a robot file amends it: its [[joints]] entries override a joint's range and limits by name, its
+// [[links]] entries give a link's collision shapes, collision model and inertia by name (ChainAmendments, asked by
+// build_chain()). Nothing here depends on the chain coming from a URDF but the messages' words.
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "parsers/robot_reading.hpp"
+#include "parsers/chain_build.hpp"
 #include "redres/config/config.hpp"
 #include "redres/model/collision.hpp"
 #include "redres/model/robot.hpp"
@@ -23,12 +25,28 @@ struct LinkEntry {
   static const Schema<LinkEntry>& schema();
 };
 
-// The URDF's joints, with the [[joints]] overrides, into c.spec.joints. Every joint's problems are gathered in
-// c.problems.
-void read_urdf_joints(const TableReader& r, RobotReading& c);
+// The [[joints]] and [[links]] entries of the robot file `r` whose chain runs from `base_link` to `tip_link` (for
+// messages). An entry naming no joint or link of the chain, and every problem of an entry, is kept in `problems`
+// (reported together by build_chain()); a problem of the chain itself fails at the key `urdf`.
+class UrdfOverlay final : public ChainAmendments {
+ public:
+  UrdfOverlay(const TableReader& r, std::string base_link, std::string tip_link, std::vector<ConfigError>& problems)
+      : r_(r), base_link_(std::move(base_link)), tip_link_(std::move(tip_link)), problems_(problems) {}
+  void begin_joints(const ChainDescription& chain) override;
+  void begin_joint(const ChainJoint& joint) override;
+  bool range(const ChainJoint& joint, JointSpec& jt) override;
+  bool velocity_limit(const ChainJoint& joint, JointSpec& jt) override;
+  void end_joint(const ChainJoint& joint, JointSpec& jt) override;
+  void begin_links(const ChainDescription& chain) override;
+  void link(const ChainLink& link, LinkAmendment& amendment) override;
+  [[noreturn]] void fail(const std::string& message) const override;
 
-// The collision shapes, frames, inertias and visuals of the URDF's links, with the [[links]] entries, into c.spec;
-// then throws every problem gathered (the joints' too).
-void read_urdf_links(const TableReader& r, RobotReading& c);
+ private:
+  const TableReader& r_;
+  std::string base_link_, tip_link_;
+  std::vector<ConfigError>& problems_;
+  std::map<std::string, TableReader> joint_entries_, link_entries_;
+  std::optional<TableReader> joint_entry_;  // the entry of the joint being built
+};
 
 }  // namespace redres

@@ -11,8 +11,8 @@
 #include "parsers/chain_description.hpp"
 #include "redres/common/error.hpp"
 #include "redres/model/collision.hpp"
-#include "redres/model/mesh.hpp"
 #include "redres/model/robot.hpp"
+#include "redres/parsers/mesh_file.hpp"
 
 namespace redres {
 

@@ -12,7 +12,7 @@
 
 #include "redres/model/collision.hpp"
 #include "redres/model/convex.hpp"
-#include "redres/model/mesh.hpp"
+#include "redres/parsers/mesh_file.hpp"
 #include "test_util.hpp"
 
 namespace {

@@ -9,7 +9,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "redres/model/mesh.hpp"
+#include "redres/parsers/mesh_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 

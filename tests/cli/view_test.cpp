@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.hpp"
-#include "redres/model/mesh.hpp"
+#include "redres/parsers/mesh_file.hpp"
 #include "redres/run/view.hpp"
 #include "run_tables.hpp"
 

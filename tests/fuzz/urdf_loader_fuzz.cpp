@@ -66,19 +66,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string base = names.empty() ? "base_link" : names.front();
   const std::string tip = names.empty() ? "tool0" : names.back();
   try {
-    const redres::UrdfChain chain = redres::read_urdf_chain(file, base, tip);
+    const redres::ChainDescription chain = redres::read_urdf_chain(file, base, tip);
     if (!redres::is_utf8(base) || !redres::is_utf8(tip)) return 0;  // a TOML file cannot name them
     std::string robot = "urdf = \"input.urdf\"\nbase_link = " + toml_string(base) + "\ntip_link = " + toml_string(tip) +
                         "\nname = \"fuzzed\"\n";
-    for (const redres::UrdfJoint& j : chain.joints) {
+    for (const redres::ChainJoint& j : chain.joints) {
       // Continuous joints, and joints without limits or a velocity, get both, so that the chain loads.
-      if (!redres::is_utf8(j.name)) return 0;
-      if (j.continuous || !(j.lower < j.upper) || !(j.velocity > 0.0)) {
-        robot += "[[joints]]\nname = " + toml_string(j.name) +
+      if (!redres::is_utf8(j.spec.name)) return 0;
+      if (j.continuous || !(j.spec.lower < j.spec.upper) || !(j.velocity > 0.0)) {
+        robot += "[[joints]]\nname = " + toml_string(j.spec.name) +
                  "\nlimits = [-3.0, 3.0]\nvelocity_limit = { type = \"constant\", lower = -1.0, upper = 1.0 }\n";
       }
     }
-    for (const redres::UrdfLink& l : chain.links) {
+    for (const redres::ChainLink& l : chain.links) {
       // Mesh collision elements, which redres does not read, are replaced by none.
       if (!l.meshes.empty() && redres::is_utf8(l.name)) robot += "[[links]]\nname = " + toml_string(l.name) + "\n";
     }

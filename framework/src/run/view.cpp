@@ -18,6 +18,7 @@
 #include "redres/common/output_file.hpp"
 #include "redres/model/convex.hpp"
 #include "redres/model/mesh.hpp"
+#include "redres/parsers/mesh_file.hpp"
 #include "run/view_assets.hpp"
 
 namespace redres {

@@ -23,6 +23,7 @@
 #include "redres/model/collision.hpp"
 #include "redres/model/convex.hpp"
 #include "redres/model/mesh.hpp"
+#include "redres/parsers/mesh_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/run/scenario.hpp"
 #include "test_util.hpp"

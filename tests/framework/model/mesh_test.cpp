@@ -12,6 +12,7 @@
 
 #include "redres/model/kinematics.hpp"
 #include "redres/model/mesh.hpp"
+#include "redres/parsers/mesh_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
 

@@ -21,6 +21,7 @@
 #include "redres/model/velocity_limit.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -40,8 +41,7 @@ std::string first_line(const std::string& out) { return out.substr(0, out.find('
 const std::string kHead = "name = \"r\"\nkind = \"planar\"\n";
 
 TEST(HostileInput, KeysAndNestingTooDeepForTheParserAreErrorsNotCrashes) {
-  const auto dir = scratch("hostile_deep");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("hostile_deep");
   struct Case {
     const char* file;
     std::string text;
@@ -82,8 +82,7 @@ TEST(HostileInput, TomlWithDotsInStringsCommentsAndNumbersStillParses) {
 }
 
 TEST(HostileInput, InputsThatAreNotBoundedRegularFilesAreRefusedBeforeReading) {
-  const auto dir = scratch("hostile_files");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("hostile_files");
   const std::string fifo = (dir / "fifo.toml").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   const std::string big = (dir / "big.toml").string();
@@ -184,8 +183,7 @@ TEST(HostileInput, ValuesOutsidePhysicalOrSaneRangesAreRefusedAtTheirKey) {
   EXPECT_EQ(radius.code, 2) << radius.out;
   EXPECT_NE(radius.out.find("key 'radius': expected |x| <= 1000 m"), std::string::npos) << radius.out;
   // A link of 1e308 m in a robot file.
-  const auto dir = scratch("hostile_ranges");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("hostile_ranges");
   write(dir / "long.toml", kHead + "[[joints]]\nname = \"j1\"\nlength = 1e308\nlimits = [-1.0, 1.0]\n");
   const Cli robot = redres("robot '" + (dir / "long.toml").string() + "'");
   EXPECT_EQ(robot.code, 2) << robot.out;
@@ -198,16 +196,11 @@ TEST(HostileInput, ValuesOutsidePhysicalOrSaneRangesAreRefusedAtTheirKey) {
 // A schedule formula of t that is not finite at some step time of the run is refused at load, at its key, with the
 // first such time; before, the run stopped mid-way (or, later, failed every step with t < 1 s).
 TEST(HostileInput, AScheduleFormulaIsCheckedAtEveryStepTimeAtLoad) {
-  const auto dir = scratch("hostile_schedule");
-  std::filesystem::create_directories(dir);
-  const std::string text = read_text(source_path("configs/paper_r_fast.toml"));
-  const std::string robot_line = "robot = \"../robots/paper_pushrod_6dof.toml\"";
-  ASSERT_NE(text.find(robot_line), std::string::npos);
+  const auto dir = scratch_dir("hostile_schedule");
+  const std::string text = shipped_scenario_text("paper_r_fast.toml");
   for (const char* formula : {"sqrt(t-1)", "1/(t-1.2)", "log(2.4 - t)"}) {
     SCOPED_TRACE(formula);
     std::string scenario = text;
-    scenario.replace(scenario.find(robot_line), robot_line.size(),
-                     "robot = \"" + source_path("robots/paper_pushrod_6dof.toml").string() + "\"");
     const std::string schedule = "schedule = \"sine\"\n";
     ASSERT_NE(scenario.find(schedule), std::string::npos);
     scenario.replace(scenario.find(schedule), schedule.size(),
@@ -232,8 +225,7 @@ TEST(HostileInput, AScheduleFormulaIsCheckedAtEveryStepTimeAtLoad) {
 // it is a failed step (invalid_problem) whose diagnosis names the joint, its law and where the law was configured;
 // it moves nothing, and the run goes on to the end with every recorded value finite.
 TEST(HostileInput, ANonFiniteVelocityLimitMidRunIsAFailedStepNotTheEndOfTheRun) {
-  const auto dir = scratch("hostile_nan_law");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("hostile_nan_law");
   // Where joint 1 goes in the run, and a value it takes mid-run whose window misses every load-time sample.
   Scenario plain = load_scenario(source_path("configs/paper_r_fast.toml"));
   const RunResult base = simulate(plain);

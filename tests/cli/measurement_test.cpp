@@ -15,14 +15,11 @@
 #include "cli_util.hpp"
 #include "redres/control/controller.hpp"
 #include "redres/run/scenario.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
 namespace {
-
-nlohmann::json summary_of(const std::filesystem::path& dir) {
-  return nlohmann::json::parse(read_text(dir / "summary.json"));
-}
 
 TEST(Measurement, ARunThatNeverMeasuredAPairStatesItsDistance) {
   const auto dir = scratch("never_measured");
@@ -30,7 +27,7 @@ TEST(Measurement, ARunThatNeverMeasuredAPairStatesItsDistance) {
                        "' --set 'constraints.3.obstacles=[{shape=\"sphere\", radius=0.05, xyz=[5.0, 5.0, 0.0]}]' "
                        "--set 'constraints.3.broadphase=\"always\"'");
   EXPECT_EQ(r.code, 0) << r.out;
-  const nlohmann::json s = summary_of(dir / "out");
+  const nlohmann::json s = read_summary(dir / "out");
   const nlohmann::json& m = s["metrics"]["obstacle_avoidance"];
   EXPECT_EQ(m["steps_measured"].get<double>(), 0.0) << m;
   EXPECT_EQ(m["min_obstacle_distance"].get<double>(), m["influence_distance"].get<double>()) << m;
@@ -39,8 +36,7 @@ TEST(Measurement, ARunThatNeverMeasuredAPairStatesItsDistance) {
 }
 
 TEST(Measurement, SelfCollisionWithEveryPairLeftOutIsRefused) {
-  const auto dir = scratch("nothing_to_check");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("nothing_to_check");
   std::ofstream(dir / "two.toml") << R"(name = "two"
 kind = "planar"
 [[joints]]
@@ -56,19 +52,10 @@ limits = [-1, 1]
 velocity_limit = { type = "constant", lower = -1, upper = 1 }
 collision = [{ shape = "capsule", radius = 0.02 }]
 )";
-  std::ofstream(dir / "s.toml") << R"(robot = "two.toml"
-duration = 1.0
-step = 0.1
-[path]
-type = "line"
-delta = [0.01, 0.0]
-[[objectives]]
-type = "min_velocity_norm"
-[[constraints]]
-type = "task_tracking"
-[[constraints]]
-type = "self_collision"
-)";
+  std::ofstream(dir / "s.toml") << "robot = \"two.toml\"\nduration = 1.0\nstep = 0.1\n[path]\ntype = \"line\"\n"
+                                << "delta = [0.01, 0.0]\n"
+                                << objective_entry("min_velocity_norm") << constraint_entry("task_tracking")
+                                << constraint_entry("self_collision");
   const Cli r = redres("validate '" + (dir / "s.toml").string() + "'");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("robot 'two' has no pair of link shapes to check"), std::string::npos) << r.out;
@@ -76,9 +63,8 @@ type = "self_collision"
 }
 
 TEST(Measurement, TenThousandObstaclesShareMaxRowsRows) {
-  const auto dir = scratch("many_obstacles");
-  std::filesystem::create_directories(dir);
-  std::string text = read_text(source_path("configs/paper_r_obstacle.toml"));
+  const auto dir = scratch_dir("many_obstacles");
+  std::string text = shipped_scenario_text("paper_r_obstacle.toml");
   const std::string one = R"(obstacles = [{ shape = "sphere", radius = 0.02, xyz = [0.551, 0.492, 0.0] }])";
   ASSERT_NE(text.find(one), std::string::npos);
   std::string many = "obstacles = [" + one.substr(one.find('{'), one.rfind('}') - one.find('{') + 1);
@@ -89,9 +75,6 @@ TEST(Measurement, TenThousandObstaclesShareMaxRowsRows) {
             std::to_string(far(rng)) + ", 0.0] }";
   }
   text.replace(text.find(one), one.size(), many + "]");
-  const std::string robots = "\"" + source_path("robots").string() + "/";
-  for (std::size_t at = text.find("\"../robots/"); at != std::string::npos; at = text.find("\"../robots/"))
-    text.replace(at, 11, robots);
   std::ofstream(dir / "many.toml") << text;
   Scenario s = load_scenario(dir / "many.toml", {"duration=0.5"});
   const auto controller = Controller::from_scenario(s);
@@ -108,18 +91,17 @@ TEST(Measurement, ARunBeyondItsTaskErrorBoundIsNoSuccess) {
                        "' --set solver.max_task_error=1e-12");
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_NE(r.out.find("the task was not tracked: max position error"), std::string::npos) << r.out;
-  const nlohmann::json s = summary_of(dir / "out");
+  const nlohmann::json s = read_summary(dir / "out");
   EXPECT_TRUE(s["task_error_exceeded"].get<bool>());
   EXPECT_EQ(s["solver"]["failures"].get<int>(), 0) << "every step solved, and still no success";
   const Cli ok = redres("run configs/paper_r_fast.toml --quiet --out '" + (dir / "ok").string() + "'");
   EXPECT_EQ(ok.code, 0) << ok.out;
-  EXPECT_FALSE(summary_of(dir / "ok")["task_error_exceeded"].get<bool>());
+  EXPECT_FALSE(read_summary(dir / "ok")["task_error_exceeded"].get<bool>());
   std::filesystem::remove_all(dir);
 }
 
 TEST(Measurement, ASweepVariationBeyondItsTaskErrorBoundIsNotOk) {
-  const auto dir = scratch("sweep_task_error");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("sweep_task_error");
   std::ofstream(dir / "bound.toml") << "name = \"bound\"\nscenario = \""
                                     << source_path("configs/paper_r_fast.toml").string()
                                     << "\"\n[[vary]]\nkey = \"solver.max_task_error\"\nvalues = [1e-12, 1.0]\n";

@@ -82,8 +82,7 @@ TEST(OutputSafety, ASymbolicLinkWhereASweepWritesIsRefusedBeforeItRuns) {
 }
 
 TEST(OutputSafety, StagedFilesAreCreatedExclusivelyAndNeverThroughALink) {
-  const auto dir = scratch("staged_file");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("staged_file");
   std::ofstream(dir / "victim.txt") << "keep";
   {
     StagedFile a(dir / "x.csv"), b(dir / "x.csv");  // two at once get two temporaries

@@ -23,6 +23,7 @@
 #include "redres/run/run_output.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -41,23 +42,9 @@ std::filesystem::path short_scenario(const std::filesystem::path& dir, const std
   const auto path = dir / file;
   std::string quoted;  // the name as a TOML basic string's content
   for (const char c : name) quoted += c == '"' ? std::string("\\\"") : std::string(1, c);
-  std::ofstream(path) << "name = \"" << quoted << "\"\nrobot = \"" << source_path("robots/planar_4link.toml").string()
-                      << "\"\n"
-                      << R"(duration = 2.0
-step = 0.01
-[path]
-type = "circle"
-radius = 0.06
-[[objectives]]
-type = "min_velocity_norm"
-[[constraints]]
-type = "task_tracking"
-gain = 8.0
-[[constraints]]
-type = "joint_velocity_limits"
-[solver]
-engine = "newton"
-)";
+  std::ofstream(path) << "name = \"" << quoted << "\"\n"
+                      << robot_line("planar_4link.toml") << "duration = 2.0\nstep = 0.01\n"
+                      << circle_tracking("0.06", "engine = \"newton\"\n");
   return path;
 }
 
@@ -149,8 +136,8 @@ TEST(CompareCli, SameStemsGetTheirOwnDirectoriesAndNamesAreQuotedInTheCsv) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_TRUE(std::filesystem::exists(out / "x" / "summary.json"));
   EXPECT_TRUE(std::filesystem::exists(out / "x-2" / "summary.json"));
-  EXPECT_EQ(nlohmann::json::parse(read_text(out / "x" / "summary.json"))["name"], "circle, newton");
-  EXPECT_EQ(nlohmann::json::parse(read_text(out / "x-2" / "summary.json"))["name"], "circle \"b\"");
+  EXPECT_EQ(read_summary(out / "x")["name"], "circle, newton");
+  EXPECT_EQ(read_summary(out / "x-2")["name"], "circle \"b\"");
   const std::string csv = read_text(out / "comparison.csv");
   // The name, then the label (no `label` in the files: the name), quoted the same way.
   EXPECT_NE(csv.find("\n\"circle, newton\",\"circle, newton\",newton,"), std::string::npos) << csv;
@@ -207,23 +194,21 @@ int interrupt_after(const std::vector<std::string>& args, std::chrono::milliseco
 std::string long_run_set() { return "step=0.0001"; }
 
 TEST(SignalsCli, SigintEndsRunCompareAndSweepWithExitCode130) {
-  const auto dir = scratch("sigint");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("sigint");
   const std::string paper = source_path("configs/paper_r_tvcmm.toml").string();
   {
     const int code = interrupt_after({"run", paper, "--out", (dir / "run").string(), "--quiet", "--set", long_run_set(),
                                       "--set", "solver.engine=nlopt"},
                                      std::chrono::milliseconds(1500), dir / "run.log");
     EXPECT_EQ(code, 130) << read_text(dir / "run.log");
-    EXPECT_EQ(nlohmann::json::parse(read_text(dir / "run" / "summary.json"))["status"], "interrupted");
+    EXPECT_EQ(read_summary(dir / "run")["status"], "interrupted");
   }
   {
     const int code = interrupt_after({"compare", paper, paper, "--out", (dir / "compare").string(), "--quiet",
                                       "--no-plots", "--set", long_run_set(), "--set", "solver.engine=nlopt"},
                                      std::chrono::milliseconds(1500), dir / "compare.log");
     EXPECT_EQ(code, 130) << read_text(dir / "compare.log");
-    EXPECT_EQ(nlohmann::json::parse(read_text(dir / "compare" / "paper_r_tvcmm" / "summary.json"))["status"],
-              "interrupted");
+    EXPECT_EQ(read_summary(dir / "compare" / "paper_r_tvcmm")["status"], "interrupted");
     EXPECT_FALSE(std::filesystem::exists(dir / "compare" / "paper_r_tvcmm-2")) << "the second run started";
     EXPECT_TRUE(std::filesystem::exists(dir / "compare" / "comparison.csv"));
   }

@@ -30,7 +30,7 @@ TEST(PlantCommand, AMujocoScenarioRunsOrNamesThePackageToInstall) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("MuJoCo plant (velocity_servo, 10 steps of 0.001 s per control step)"), std::string::npos)
       << r.out;
-  const nlohmann::json s = nlohmann::json::parse(read_text(out / "summary.json"));
+  const nlohmann::json s = read_summary(out);
   EXPECT_EQ(s["plant"]["kind"], "mujoco");
   EXPECT_EQ(s["plant"]["max_torque"].size(), 6U);
   EXPECT_GT(s["plant"]["mujoco_step_us"].get<double>(), 0.0);

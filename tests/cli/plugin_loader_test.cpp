@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "cli_util.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -18,26 +19,13 @@ const std::string kPlugin = REDRES_TEST_PLUGIN;
 // A scenario in `dir` that uses the test plugin's objective and constraint; `plugins` is the TOML array text.
 std::filesystem::path write_scenario(const std::filesystem::path& dir, const std::string& plugins) {
   std::filesystem::create_directories(dir);
-  std::ofstream(dir / "scenario.toml") << "plugins = " << plugins << "\n"
-                                       << "robot = \"" << source_path("robots/paper_pushrod_6dof.toml").string()
-                                       << "\"\n"
-                                       << R"(theta0 = ["pi/4", "pi/12", "pi/12", "pi/12", "pi/36", "pi/36"]
-duration = 2.0
-step = 0.01
-[path]
-type = "line"
-delta = [-0.02, 0.0]
-[[objectives]]
-type = "test_damping"
-gain = 2.0
-[[constraints]]
-type = "task_tracking"
-[[constraints]]
-type = "test_cap"
-cap = 0.2
-[solver]
-engine = "newton"
-)";
+  std::ofstream(dir / "scenario.toml")
+      << "plugins = " << plugins << "\n"
+      << robot_line("paper_pushrod_6dof.toml")
+      << "theta0 = [\"pi/4\", \"pi/12\", \"pi/12\", \"pi/12\", \"pi/36\", \"pi/36\"]\nduration = 2.0\nstep = 0.01\n"
+      << "[path]\ntype = \"line\"\ndelta = [-0.02, 0.0]\n"
+      << objective_entry("test_damping", "gain = 2.0\n") << constraint_entry("task_tracking")
+      << constraint_entry("test_cap", "cap = 0.2\n") << "[solver]\nengine = \"newton\"\n";
   return dir / "scenario.toml";
 }
 

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -34,8 +35,7 @@ TEST(CliScenario, RunWritesTheTrajectoryAndSummaryOfOutputFormats) {
   }
   expected += ",rd_x,rd_y,r_x,r_y,position_error,manipulability,solver_iterations,solver_residual";
   EXPECT_EQ(first_line(dir / "trajectory.csv").rfind(expected, 0), 0u) << first_line(dir / "trajectory.csv");
-  std::ifstream js(dir / "summary.json");
-  const nlohmann::json s = nlohmann::json::parse(js);
+  const nlohmann::json s = read_summary(dir);
   for (const char* k :
        {"steps", "tau", "duration", "max_position_error", "final_position_error", "initial_joint_velocity_norm",
         "final_joint_velocity_norm", "manipulability", "max_joint_angle_violation", "max_joint_velocity_violation",
@@ -68,8 +68,7 @@ std::size_t line_count(const std::filesystem::path& file) {
 TEST(CliScenario, RecordKeepsEveryNthRowOrNoneWhileTheSummaryUsesEveryStep) {
   const auto dir = scratch("record");
   const auto summary_of = [&dir] {
-    std::ifstream js(dir / "summary.json");
-    nlohmann::json s = nlohmann::json::parse(js);
+    nlohmann::json s = read_summary(dir);
     s.erase("wall_time_s");
     return s;
   };
@@ -116,22 +115,20 @@ TEST(CliScenario, SetOverridesValuesAndValidateChecksWithoutRunning) {
 }
 
 TEST(CliScenario, BadScenarioFilesReportFileLineColumn) {
-  const auto dir = scratch("bad");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("bad");
   const auto write = [&](const std::string& name, const std::string& text) {
     std::ofstream(dir / name) << text;
     return (dir / name).string();
   };
-  const std::string robot = source_path("robots/paper_pushrod_6dof.toml").string();
-  const std::string base = "robot = \"" + robot +
-                           "\"\nduration = 4.0\nstep = 0.01\n[path]\ntype = \"letter_r\"\n"
-                           "[[objectives]]\ntype = \"min_velocity_norm\"\n";
-  const std::string typo = write("typo.toml", base + "[[constraints]]\ntype = \"task_tracking\"\ngian = 8.0\n");
+  const std::string robot = robot_line("paper_pushrod_6dof.toml");
+  const std::string base =
+      robot + "duration = 4.0\nstep = 0.01\n[path]\ntype = \"letter_r\"\n" + objective_entry("min_velocity_norm");
+  const std::string typo = write("typo.toml", base + constraint_entry("task_tracking", "gian = 8.0\n"));
   Cli r = redres("validate '" + typo + "'");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.out.rfind(typo + ":10:1: unknown key 'gian'", 0), 0u) << r.out;
   EXPECT_NE(r.out.find("gain"), std::string::npos) << r.out;  // the known keys are listed
-  const std::string step = write("step.toml", "robot = \"" + robot + "\"\nduration = 4.0\nstep = 0.03\n");
+  const std::string step = write("step.toml", robot + "duration = 4.0\nstep = 0.03\n");
   r = redres("validate '" + step + "'");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.out.rfind(step + ":3:8:", 0), 0u) << r.out;
@@ -151,8 +148,7 @@ TEST(CliScenario, FailedStepsGiveExitCodeOne) {
   const Cli r =
       redres("run configs/paper_r_tvcmm.toml --out '" + dir.string() + "' --quiet --set duration=0.5 --set step=0.01");
   EXPECT_EQ(r.code, 1) << r.out;
-  std::ifstream js(dir / "summary.json");
-  const nlohmann::json s = nlohmann::json::parse(js);
+  const nlohmann::json s = read_summary(dir);
   EXPECT_GT(s["solver"]["failures"].get<int>(), 0);
   EXPECT_NE(s["solver"]["first_failure"].get<std::string>().find("infeasible"), std::string::npos);
   std::filesystem::remove_all(dir);

@@ -94,8 +94,7 @@ TEST(CliSceneOutput, RunWritesFramesAndObstacles) {
   EXPECT_DOUBLE_EQ(frames.rows.back()[ft], 40.0);
 
   // summary.json: the two obstacles as configured (the box's rotation is Rz(0.5)), and the links' capsules.
-  std::ifstream js(dir / "summary.json");
-  const nlohmann::json s = nlohmann::json::parse(js);
+  const nlohmann::json s = read_summary(dir);
   ASSERT_EQ(s["obstacles"].size(), 2u) << s["obstacles"].dump(2);
   const nlohmann::json& sphere = s["obstacles"][0];
   EXPECT_EQ(sphere["plugin"], "obstacle_avoidance");
@@ -136,8 +135,7 @@ TEST(CliSceneOutput, NoObstaclesAndShortRunsKeepEveryRow) {
   const Cli r = redres("run configs/planar_4link_circle.toml --out '" + dir.string() +
                        "' --quiet --set duration=1 --set step=0.01");
   ASSERT_EQ(r.code, 0) << r.out;
-  std::ifstream js(dir / "summary.json");
-  const nlohmann::json s = nlohmann::json::parse(js);
+  const nlohmann::json s = read_summary(dir);
   ASSERT_TRUE(s["obstacles"].is_array());
   EXPECT_TRUE(s["obstacles"].empty());
   EXPECT_EQ(read_csv(dir / "frames.csv").rows.size(), 101u);

@@ -183,8 +183,7 @@ TEST(ScenarioCorpus, EveryBadFileIsRefusedAtItsLineAndLeavesTheOutputDirectoryAs
   std::atomic<std::size_t> next{0};
   std::vector<std::thread> pool;
   for (unsigned w = 0; w < workers; ++w) {
-    work[w] = scratch("scenario_corpus_" + std::to_string(w));
-    fs::create_directories(work[w]);
+    work[w] = scratch_dir("scenario_corpus_" + std::to_string(w));
     pool.emplace_back([&, w] {
       for (std::size_t i = next++; i < c.size(); i = next++) results[i] = check(c[i], work[w]);
     });

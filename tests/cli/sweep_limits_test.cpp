@@ -13,6 +13,7 @@
 #include "cli_util.hpp"
 #include "redres/common/error.hpp"
 #include "redres/run/sweep.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -91,12 +92,8 @@ TEST(SweepLimits, MoreJobsThanTheSystemGivesThreadsRunOnTheThreadsItGets) {
 // are done, so the table is the one a sweep with memory to spare writes. One that runs out of memory even alone is
 // an error row that says so. (The test plugin's objective throws on its first N contributions.)
 TEST(SweepLimits, AVariationThatRunsOutOfMemoryRunsAgainAloneAndTheTableIsTheSame) {
-  const auto dir = scratch("sweep_memory");
-  std::filesystem::create_directories(dir);
-  std::string text = read_text(source_path("configs/paper_r_fast.toml"));
-  const std::size_t robot = text.find("\"../robots/");
-  ASSERT_NE(robot, std::string::npos);
-  text.replace(robot, 11, "\"" + source_path("robots").string() + "/");
+  const auto dir = scratch_dir("sweep_memory");
+  std::string text = shipped_scenario_text("paper_r_fast.toml");
   text = "plugins = [\"" + std::string(REDRES_TEST_PLUGIN_MEMORY) + "\"]\n" + text +
          "\n[[objectives]]\ntype = \"test_out_of_memory\"\n";
   std::ofstream(dir / "scenario.toml") << text;

@@ -87,7 +87,7 @@ std::vector<double> recorded_ee(const RunTable& traj, double t) {
 }
 
 std::size_t bodies_in(const fs::path& run) {
-  const json s = json::parse(read_text(run / "summary.json"));
+  const json s = read_summary(run);
   return s["robot"]["link_shapes"].size() + s["obstacles"].size();
 }
 

@@ -202,8 +202,7 @@ TEST_F(View, AComparisonHoldsEveryRun) {
 
 TEST_F(View, WhatCannotBeViewedSaysWhy) {
   // Not a run.
-  const fs::path empty = scratch("view_empty");
-  fs::create_directories(empty);
+  const fs::path empty = scratch_dir("view_empty");
   Cli r = redres("view '" + empty.string() + "'");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("not a run's directory"), std::string::npos) << r.out;
@@ -230,8 +229,7 @@ TEST_F(View, WhatCannotBeViewedSaysWhy) {
 }
 
 TEST_F(View, ASweepRowIsViewedFromTheRunTheSweepKept) {
-  const fs::path dir = scratch("view_sweep");
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir("view_sweep");
   std::ofstream(dir / "two.toml") << "scenario = \"" << source_path("configs/paper_r_tvcmm.toml").string()
                                   << "\"\n[[vary]]\nkey = \"objectives.1.p\"\nvalues = [0.0, 1.0]\n"
                                      "[output]\nruns = true\nrecord = \"every=10\"\n";

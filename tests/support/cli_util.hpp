@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "test_util.hpp"
 
 namespace redres {
@@ -34,5 +36,10 @@ inline Cli redres_env(const std::string& env, const std::string& args) {
 
 // The same without extra environment.
 inline Cli redres(const std::string& args) { return redres_env("", args); }
+
+// The summary.json that a run wrote into `dir`.
+inline nlohmann::json read_summary(const std::filesystem::path& dir) {
+  return nlohmann::json::parse(read_text(dir / "summary.json"));
+}
 
 }  // namespace redres

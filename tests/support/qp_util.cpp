@@ -5,6 +5,7 @@
 #include <Eigen/QR>
 
 #include "redres/parsers/robot_toml.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres::testing {
@@ -101,8 +102,7 @@ type = "joint_velocity_limits"
 std::unique_ptr<PaperStep> make_paper_step(const std::string& scheme_toml) {
   auto s = std::make_unique<PaperStep>();
   s->robot = std::make_unique<RobotModel>(load_robot(source_path("robots/paper_pushrod_6dof.toml")));
-  const auto file = parse_toml_string(scheme_toml.empty() ? kPaperSchemeToml : scheme_toml, "<scheme>");
-  s->scheme = std::make_unique<Scheme>(Scheme::from_toml(TableReader::root(file), *s->robot));
+  s->scheme = scheme_from_text(scheme_toml.empty() ? kPaperSchemeToml : scheme_toml, *s->robot, "<scheme>");
   s->kin = std::make_unique<KinematicsData>(*s->robot);
   s->r_d = Eigen::VectorXd::Zero(2);
   s->r_d_dot = Eigen::VectorXd::Zero(2);

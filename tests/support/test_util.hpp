@@ -34,6 +34,13 @@ inline std::filesystem::path scratch(const std::string& name) {
   return dir;
 }
 
+/// scratch(name), made: an empty directory for one test's files.
+inline std::filesystem::path scratch_dir(const std::string& name) {
+  const auto dir = scratch(name);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
 /// theta(0) of the paper, section 4.
 inline Eigen::VectorXd paper_theta0() {
   Eigen::VectorXd t(6);

@@ -27,6 +27,7 @@
 #include "redres/run/run_summary.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -197,32 +198,14 @@ RC_GTEST_PROP(FailureDiagnosis, FeasibleQpsAreNeverCalledInfeasible, ()) {
 
 // Scenario files for the runs below, in a scratch directory; the robot is the repository's planar 4R arm.
 std::filesystem::path write_scenario(const std::string& test, const std::string& body) {
-  const auto dir = scratch(test);
-  std::filesystem::create_directories(dir);
-  const auto file = dir / "scenario.toml";
-  std::ofstream(file) << "name = \"" << test << "\"\nrobot = \"" << source_path("robots/planar_4link.toml").string()
-                      << "\"\n"
-                      << body;
+  const auto file = scratch_dir(test) / "scenario.toml";
+  std::ofstream(file) << "name = \"" << test << "\"\n" << robot_line("planar_4link.toml") << body;
   return file;
 }
 
 // The issue's reproducer: the 4R arm starting fully stretched. Step 1 sits at the singularity.
-const char* const kStretched = R"(duration = 2.0
-step = 0.01
-theta0 = [0, 0, 0, 0]
-[path]
-type = "circle"
-radius = 0.06
-[[objectives]]
-type = "min_velocity_norm"
-[[constraints]]
-type = "task_tracking"
-gain = 8.0
-[[constraints]]
-type = "joint_velocity_limits"
-[solver]
-engine = "newton"
-)";
+const std::string kStretched =
+    "duration = 2.0\nstep = 0.01\ntheta0 = [0, 0, 0, 0]\n" + circle_tracking("0.06", "engine = \"newton\"\n");
 
 TEST(FailureDiagnosis, AStretchedArmIsASingularConfigurationNotAnInfeasibleStep) {
   const auto file = write_scenario("stretched", kStretched);
@@ -250,7 +233,7 @@ double theta_step(const Trajectory& tr, std::size_t k, int n) {
 
 TEST(OnInfeasible, HoldNeverIntegratesAFailedStep) {
   // The projection engine capped at 40 iterations fails often on this circle; the runs go on to T.
-  const auto file = write_scenario("hold", std::string(kStretched) + "max_iterations = 40\n");
+  const auto file = write_scenario("hold", kStretched + "max_iterations = 40\n");
   for (const char* policy : {"hold", "continue"}) {
     Scenario s = load_scenario(file, {"theta0=[0.3, 0.6, 0.6, 0.4]", "solver.engine=\"projection\"",
                                       "solver.on_infeasible=\"" + std::string(policy) + "\""});
@@ -278,8 +261,7 @@ TEST(OnInfeasible, HoldNeverIntegratesAFailedStep) {
 TEST(OnInfeasible, AManyJointArmWithFailedStepsStaysNearItsCircle) {
   // 1000 joints of 1 mm: the projection engine capped at 30 iterations fails steps; before, each failed step
   // integrated its unconverged iterate and the arm ended metres away from a 5 cm circle.
-  const auto dir = scratch("many_joints");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("many_joints");
   std::ofstream robot(dir / "robot.toml");
   robot << "name = \"chain1000\"\nkind = \"planar\"\ntask = \"position\"\n";
   for (int j = 0; j < 1000; ++j) {
@@ -293,21 +275,7 @@ TEST(OnInfeasible, AManyJointArmWithFailedStepsStaysNearItsCircle) {
         std::string s = "0.5";
         for (int j = 1; j < 1000; ++j) s += ", 0.002";
         return s;
-      }() << "]\n"
-                                       << R"([path]
-type = "circle"
-radius = 0.05
-[[objectives]]
-type = "min_velocity_norm"
-[[constraints]]
-type = "task_tracking"
-gain = 8.0
-[[constraints]]
-type = "joint_velocity_limits"
-[solver]
-engine = "projection"
-max_iterations = 30
-)";
+      }() << "]\n" << circle_tracking("0.05", "engine = \"projection\"\nmax_iterations = 30\n");
   Scenario s = load_scenario(dir / "scenario.toml");
   const RunResult run = simulate(s);
   EXPECT_GT(run.failures, 5);
@@ -387,7 +355,7 @@ TEST(OnInfeasible, AControllerFromTheScenarioRunsWhatSimulateRuns) {
 TEST(OnInfeasible, RelaxOnATooFastCircleYieldsInsideTheLimitsAndReportsTheMiss) {
   // 6 cm in 0.2 s is beyond what the velocity limits allow: every step fails under hold; under relax each step
   // moves as far along as the limits allow, and the rows' miss is reported.
-  const std::string body = std::string(kStretched) + "on_infeasible = \"relax\"\n";
+  const std::string body = kStretched + "on_infeasible = \"relax\"\n";
   const auto file = write_scenario("relax_fast", body);
   Scenario s = load_scenario(file, {"theta0=[0.3, 0.6, 0.6, 0.4]", "duration=0.2", "path.radius=0.06"});
   const RunResult run = simulate(s);

@@ -22,6 +22,7 @@
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -29,12 +30,6 @@ namespace {
 
 std::unique_ptr<RobotModel> panda() {
   return std::make_unique<RobotModel>(load_robot(source_path("robots/franka_panda.toml")));
-}
-
-// The plugins of `text` ([[objectives]], [[constraints]], optional [scheme]) for `robot`.
-std::unique_ptr<Scheme> scheme_of(const std::string& text, const RobotModel& robot) {
-  auto file = parse_toml_string(text, "scheme.toml");
-  return std::make_unique<Scheme>(Scheme::from_toml(TableReader::root(file), robot));
 }
 
 // A constraint that makes every step with t in [from, to) infeasible (an empty box for joint 1): forced failures.
@@ -74,17 +69,12 @@ Eigen::VectorXd accel_limit(const RobotModel& robot, const Eigen::VectorXd& thet
   return upper ? hi : lo;
 }
 
-const char* const kPlain = R"(
-[[objectives]]
-type = "min_velocity_norm"
-[[constraints]]
-type = "joint_acceleration_limits"
-)";
+const std::string kPlain = objective_entry("min_velocity_norm") + constraint_entry("joint_acceleration_limits");
 
 TEST(AccelerationLimits, BoundsComeFromThePreviousCommandAndEveryJointCanStillStop) {
   const auto robot = panda();
   const int n = robot->dof();
-  const auto scheme = scheme_of(kPlain, *robot);
+  const auto scheme = scheme_from_text(kPlain, *robot);
   auto engine = make_engine("newton");
   const double tau = 0.01;
   Controller ctrl(*robot, *scheme, *engine, nullptr, 1.0, tau);
@@ -130,7 +120,7 @@ TEST(AccelerationLimits, BoundsComeFromThePreviousCommandAndEveryJointCanStillSt
 TEST(AccelerationLimits, ARobotWithoutThemIsRefusedWithTheJointNamed) {
   const auto robot = std::make_unique<RobotModel>(load_robot(source_path("robots/paper_pushrod_6dof.toml")));
   try {
-    (void)scheme_of(kPlain, *robot);
+    (void)scheme_from_text(kPlain, *robot);
     FAIL() << "expected an error";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("acceleration_limit"), std::string::npos) << e.what();
@@ -141,16 +131,9 @@ TEST(AccelerationLimits, ARobotWithoutThemIsRefusedWithTheJointNamed) {
 TEST(JerkLimits, BoundTheChangeOfAccelerationFromTheLastTwoCommands) {
   const auto robot = panda();
   const int n = robot->dof();
-  const auto scheme = scheme_of(R"(
-[[objectives]]
-type = "min_velocity_norm"
-[[constraints]]
-type = "joint_jerk_limits"
-[[constraints]]
-type = "joint_acceleration_limits"
-active = false
-)",
-                                *robot);
+  const auto scheme = scheme_from_text(objective_entry("min_velocity_norm") + constraint_entry("joint_jerk_limits") +
+                                           constraint_entry("joint_acceleration_limits", "active = false\n"),
+                                       *robot);
   auto engine = make_engine("newton");
   const double tau = 0.001;
   Controller ctrl(*robot, *scheme, *engine, nullptr, 1.0, tau);
@@ -226,23 +209,10 @@ TEST(Brake, AFailedStepDeceleratesAlongThePreviousCommandWithinTheLimits) {
 void expect_recovery(const std::string& policy) {
   Scenario s = load_scenario(source_path("configs/panda_helix.toml"),
                              {"duration=6.0", "solver.on_infeasible=\"" + policy + "\""});
-  s.scheme = with_blocker(R"(
-[[objectives]]
-type = "min_velocity_norm"
-[[constraints]]
-type = "task_tracking"
-gain = 8.0
-[[constraints]]
-type = "joint_angle_margin"
-kappa = 4.0
-margin = 0.05
-[[constraints]]
-type = "joint_velocity_limits"
-[[constraints]]
-type = "joint_acceleration_limits"
-[[constraints]]
-type = "joint_jerk_limits"
-)",
+  s.scheme = with_blocker(objective_entry("min_velocity_norm") + constraint_entry("task_tracking", "gain = 8.0\n") +
+                              constraint_entry("joint_angle_margin", "kappa = 4.0\nmargin = 0.05\n") +
+                              constraint_entry("joint_velocity_limits") +
+                              constraint_entry("joint_acceleration_limits") + constraint_entry("joint_jerk_limits"),
                           *s.robot, 2.0, 2.5);
   const RunResult run = simulate(s);
   EXPECT_EQ(run.braked_steps, 50) << policy;
@@ -344,20 +314,10 @@ TEST(AccelerationLevel, TheTaskHoldsOnASmoothPath) {
 }
 
 // An acceleration-level scheme of the task rows alone (the robot's motion limits off).
-const char* const kTaskOnly = R"(
-[scheme]
-level = "acceleration"
-[[objectives]]
-type = "min_acceleration_norm"
-[[constraints]]
-type = "task_tracking"
-[[constraints]]
-type = "joint_acceleration_limits"
-active = false
-[[constraints]]
-type = "joint_jerk_limits"
-active = false
-)";
+const std::string kTaskOnly = "[scheme]\nlevel = \"acceleration\"\n" + objective_entry("min_acceleration_norm") +
+                              constraint_entry("task_tracking") +
+                              constraint_entry("joint_acceleration_limits", "active = false\n") +
+                              constraint_entry("joint_jerk_limits", "active = false\n");
 
 // J_dot v by central differences of the task rows' J along v.
 Eigen::VectorXd jdot_v(const RobotModel& robot, const Eigen::VectorXd& theta, const Eigen::VectorXd& v) {
@@ -373,7 +333,7 @@ Eigen::VectorXd jdot_v(const RobotModel& robot, const Eigen::VectorXd& theta, co
 TEST(AccelerationLevel, JdotThetaDotMatchesCentralDifferences) {
   const auto robot = panda();
   const int n = robot->dof();
-  const auto scheme = scheme_of(kTaskOnly, *robot);
+  const auto scheme = scheme_from_text(kTaskOnly, *robot);
   auto engine = make_engine("newton");
   std::mt19937 rng(25);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -406,7 +366,7 @@ TEST(AccelerationLevel, JdotThetaDotOfASubsetTaskReadsItsOwnRows) {
   text.replace(text.find(position), position.size(), "task = [\"x\", \"z\"]");
   const RobotModel robot = load_robot(TableReader::root(parse_toml_string(text, "panda_xz.toml")));
   ASSERT_EQ(robot.task_dim(), 2);
-  const auto scheme = scheme_of(kTaskOnly, robot);
+  const auto scheme = scheme_from_text(kTaskOnly, robot);
   auto engine = make_engine("newton");
   std::mt19937 rng(52);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -437,20 +397,11 @@ TEST(AccelerationLevel, JdotThetaDotOfASubsetTaskReadsItsOwnRows) {
 TEST(AccelerationLevel, MinimumAccelerationNormAgreesWithAnIndependentSolve) {
   const auto robot = panda();
   const int n = robot->dof();
-  const auto scheme = scheme_of(R"(
-[scheme]
-level = "acceleration"
-[[objectives]]
-type = "min_acceleration_norm"
-damping = 2.0
-[[constraints]]
-type = "task_tracking"
-[[constraints]]
-type = "joint_velocity_limits"
-[[constraints]]
-type = "joint_acceleration_limits"
-)",
-                                *robot);
+  const auto scheme = scheme_from_text(
+      "[scheme]\nlevel = \"acceleration\"\n" + objective_entry("min_acceleration_norm", "damping = 2.0\n") +
+          constraint_entry("task_tracking") + constraint_entry("joint_velocity_limits") +
+          constraint_entry("joint_acceleration_limits"),
+      *robot);
   auto engine = make_engine("newton");
   auto nlopt = make_engine("nlopt");
   std::mt19937 rng(2025);

@@ -29,13 +29,6 @@
 namespace redres {
 namespace {
 
-// A fresh directory for one test's files.
-std::filesystem::path made(const std::string& name) {
-  const auto dir = scratch(name);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
 // What read_points says of a file `name` in `dir` holding `text` ("no error" when it reads it).
 std::string read_error(const std::filesystem::path& dir, const std::string& name, const std::string& text) {
   std::ofstream(dir / name, std::ios::binary) << text;
@@ -171,7 +164,7 @@ double capsule_cube(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r
 TEST(Clouds, EveryFormatReadsTheSamePoints) {
   std::mt19937 rng(1);
   const auto pts = sample_cloud(rng, 500);
-  const auto dir = made("cloud_formats");
+  const auto dir = scratch_dir("cloud_formats");
   write_xyz(dir / "c.xyz", pts);
   write_pcd(dir / "a.pcd", pts, false);
   write_pcd(dir / "b.pcd", pts, true);
@@ -188,7 +181,7 @@ TEST(Clouds, EveryFormatReadsTheSamePoints) {
 }
 
 TEST(Clouds, BadFilesAreReportedWithTheFileAndTheLine) {
-  const auto dir = made("cloud_bad");
+  const auto dir = scratch_dir("cloud_bad");
   const auto message = [&](const std::string& name, const std::string& text) { return read_error(dir, name, text); };
   EXPECT_NE(message("a.xyz", "0 0 0\n1 2\n").find("a.xyz:2: expected the numbers x y z"), std::string::npos)
       << message("a.xyz", "0 0 0\n1 2\n");
@@ -269,7 +262,7 @@ TEST(Clouds, CapsuleDistancesMatchFclAndBruteForce) {
   std::mt19937 rng(7);
   const double res = 0.02;
   const auto pts = sample_cloud(rng, 3000);
-  const auto dir = made("cloud_distances");
+  const auto dir = scratch_dir("cloud_distances");
   write_xyz(dir / "c.xyz", pts);
   for (const double grow : {0.0, 0.015}) {
     ShapeSpec cloud = cloud_spec(dir / "c.xyz", res, grow);
@@ -341,7 +334,7 @@ TEST(Clouds, CapsuleDistancesMatchFclAndBruteForce) {
 TEST(Clouds, AnOctreeFileMeasuresAsThePointsItWasBuiltFrom) {
   std::mt19937 rng(8);
   const auto pts = sample_cloud(rng, 2000);
-  const auto dir = made("cloud_octree");
+  const auto dir = scratch_dir("cloud_octree");
   write_xyz(dir / "c.xyz", pts);
   ShapeSpec points = cloud_spec(dir / "c.xyz", 0.025, 0.01);
   load_cloud(points);
@@ -368,7 +361,7 @@ TEST(Clouds, BoxLinksAndPointsAreMeasuredOnTheNearSide) {
   std::mt19937 rng(9);
   const double res = 0.02;
   const auto pts = sample_cloud(rng, 1500);
-  const auto dir = made("cloud_box");
+  const auto dir = scratch_dir("cloud_box");
   write_xyz(dir / "c.xyz", pts);
   ShapeSpec cloud = cloud_spec(dir / "c.xyz", res, 0.0);
   load_cloud(cloud);
@@ -417,7 +410,7 @@ TEST(Clouds, TheSearchAllocatesNothing) {
   }
   std::mt19937 rng(10);
   const auto pts = sample_cloud(rng, 5000);
-  const auto dir = made("cloud_alloc");
+  const auto dir = scratch_dir("cloud_alloc");
   write_xyz(dir / "c.xyz", pts);
   ShapeSpec box;
   box.shape = ShapeSpec::Kind::kBox;
@@ -441,7 +434,7 @@ TEST(Clouds, TheSearchAllocatesNothing) {
 }
 
 TEST(Clouds, ARobotLinkCannotBeACloud) {
-  const auto dir = made("cloud_link");
+  const auto dir = scratch_dir("cloud_link");
   std::string robot = read_text(source_path("robots/franka_panda.toml"));
   const auto at = robot.find("collision = [");
   ASSERT_NE(at, std::string::npos);
@@ -460,7 +453,7 @@ TEST(Clouds, ARobotLinkCannotBeACloud) {
 // A point inside the cloud is its own nearest point (as for any shape), so a box corner inside gets no row that would
 // push it deeper.
 TEST(Clouds, APointInsideIsItsOwnNearestPoint) {
-  const auto dir = made("cloud_inside");
+  const auto dir = scratch_dir("cloud_inside");
   std::ofstream(dir / "c.xyz") << "0.5 0.5 0.5\n0.52 0.5 0.5\n";
   ShapeSpec cloud = cloud_spec(dir / "c.xyz", 0.02, 0.01);
   load_cloud(cloud);
@@ -489,7 +482,7 @@ TEST(Clouds, APointInsideIsItsOwnNearestPoint) {
 TEST(Clouds, OctreeFilesAreCheckedBeforeOctoMapReadsThem) {
   std::mt19937 rng(11);
   const auto pts = sample_cloud(rng, 800);
-  const auto dir = made("cloud_octree_files");
+  const auto dir = scratch_dir("cloud_octree_files");
   octomap::OcTree tree(0.03);
   for (const auto& p : pts) tree.updateNode(octomap::point3d(p.x(), p.y(), p.z()), true);
   tree.updateInnerOccupancy();
@@ -525,7 +518,7 @@ TEST(Clouds, OctreeFilesAreCheckedBeforeOctoMapReadsThem) {
 }
 
 TEST(Clouds, MalformedPcdHeadersAreRefusedNotRead) {
-  const auto dir = made("cloud_bad_pcd");
+  const auto dir = scratch_dir("cloud_bad_pcd");
   const auto message = [&](const std::string& name, const std::string& text) { return read_error(dir, name, text); };
   // DATA as the last bytes, without a newline, and no data: nothing is read past the end.
   EXPECT_NE(message("a.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 3\nDATA binary").find("holds 0 bytes"),

@@ -26,6 +26,7 @@
 #include "redres/parsers/mesh_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/run/scenario.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -584,14 +585,11 @@ TEST(ConvexHull, AScenarioCannotWriteAConvexShape) {
   }
   EXPECT_THROW(DistanceQuery({s}), std::invalid_argument);
   // In a scenario file: refused at the obstacle, with the same message.
-  const fs::path dir = scratch("hull_scenario");
-  fs::create_directories(dir);
-  std::string text = read_text(source_path("configs/panda_hulls_table_pole.toml"));
+  const fs::path dir = scratch_dir("hull_scenario");
+  std::string text = shipped_scenario_text("panda_hulls_table_pole.toml");
   const std::string pole = "{ shape = \"capsule\", radius = 0.03, from = [0.25, -0.2, 0.4], to = [0.25, -0.2, 1.0] }";
   ASSERT_NE(text.find(pole), std::string::npos);
   text.replace(text.find(pole), pole.size(), "{ shape = \"convex\", file = \"pole.obj\" }");
-  const std::string robot = "\"../robots/franka_panda_hulls.toml\"";
-  text.replace(text.find(robot), robot.size(), "\"" + source_path("robots/franka_panda_hulls.toml").string() + "\"");
   std::ofstream(dir / "s.toml") << text;
   try {
     (void)load_scenario(dir / "s.toml");
@@ -608,8 +606,7 @@ TEST(ConvexDistance, AHullAgainstAPointCloud) {
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   std::vector<Vector3d> pts;
   for (int k = 0; k < 2000; ++k) pts.emplace_back(u(rng), u(rng), 0.3 * u(rng));
-  const fs::path dir = scratch("hull_cloud");
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir("hull_cloud");
   {
     std::ofstream o(dir / "c.xyz");
     o.precision(17);
@@ -669,8 +666,7 @@ const char* kArm = R"(<robot name="arm">
 </robot>)";
 
 fs::path write_arm(const std::string& name, const std::string& l2_mesh, const std::string& model) {
-  const fs::path dir = scratch(name);
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir(name);
   std::ofstream(dir / "two_vhacd.obj") << cube_obj("a", Vector3d(0, 0, 0), 0) << cube_obj("b", Vector3d(5, 0, 0), 8);
   std::ofstream(dir / "one.obj") << cube_obj("c", Vector3d(0, 0, 1), 0);
   std::ofstream(dir / "flat.obj") << "o flat\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
@@ -742,8 +738,7 @@ TEST(ConvexHull, TheShippedMeshRobotsMakeHulls) {
     EXPECT_TRUE(inside_polytope(f, p) || feature_distance(f, p) < 1e-9);
   }
   // The xArm6 with hulls: as many as its decompositions have pieces.
-  const fs::path dir = scratch("hull_xarm6");
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir("hull_xarm6");
   std::ofstream(dir / "xarm6.toml") << "urdf = \"" << source_path("robots/xarm6_description/xarm6_robot.urdf").string()
                                     << "\"\nbase_link = \"link_base\"\ntip_link = \"link6\"\n"
                                        "collision_model = \"hull\"\n";

@@ -110,8 +110,7 @@ TEST(Inertia, TheUrdfsInertialsRideWithTheirMovingLink) {
 }
 
 TEST(Inertia, TheRobotFileGivesThemPerJointAndRefusesImpossibleOnes) {
-  const auto dir = scratch("inertia_file");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("inertia_file");
   const std::string head = R"(name = "two"
 kind = "planar"
 [[joints]]
@@ -193,8 +192,7 @@ TEST(Inertia, TheTomlPandaCarriesFrankasFiguresInItsOwnFrames) {
 // A [[links]] entry's `inertia` replaces one URDF link's <inertial> (here the xArm6's impossible link 2 tensor, whose
 // warning goes with it); the other links keep the URDF's, and an impossible one given here is an error.
 TEST(Inertia, ALinksEntryReplacesAUrdfLinksInertial) {
-  const auto dir = scratch("inertia_links");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("inertia_links");
   const RobotModel shipped = load_robot(source_path("robots/xarm6.toml"));
   const std::string head = "urdf = \"" + source_path("robots/xarm6_description/xarm6_robot.urdf").string() +
                            "\"\nbase_link = \"link_base\"\ntip_link = \"link6\"\ncollision_model = \"none\"\n";

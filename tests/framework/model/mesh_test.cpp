@@ -102,8 +102,7 @@ std::string cube_obj(const std::string& name, const Eigen::Vector3d& c, int firs
 }
 
 TEST(Mesh, ReadThroughAssimpScaledWithItsPieces) {
-  const fs::path dir = scratch("mesh_read");
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir("mesh_read");
   std::ofstream(dir / "two.obj") << cube_obj("a", Eigen::Vector3d(0, 0, 0), 0)
                                  << cube_obj("b", Eigen::Vector3d(5, 0, 0), 8);
   const MeshData m = read_mesh(dir / "two.obj", Eigen::Vector3d(0.5, 1.0, 2.0));
@@ -153,8 +152,7 @@ TEST(Mesh, PackagePathsAreSearchedInOrderAndAMissingMeshSaysWhere) {
 }
 
 TEST(Mesh, EveryUnusableMeshIsReportedAtOnce) {
-  const fs::path dir = scratch("mesh_many");
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir("mesh_many");
   std::ofstream(dir / "arm.urdf") << R"(<robot name="arm">
   <link name="base"/>
   <link name="l1"><collision><geometry><mesh filename="package://gone/l1.stl"/></geometry></collision></link>
@@ -201,8 +199,7 @@ TEST(Mesh, TheMakersPandaHasCapsulesAroundItsMeshesAndTheSameKinematics) {
     for (const auto& p : piece) EXPECT_LE(to_segment(p, a, b), *s.spec.radius + 1e-12);
   }
   // The published URDF with pi/2 in full (and no meshes: kinematics only).
-  const fs::path dir = scratch("mesh_panda_pi");
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir("mesh_panda_pi");
   std::string urdf = read_text(source_path("robots/franka_panda_description/panda.urdf"));
   for (std::size_t at = urdf.find("1.57079632679"); at != std::string::npos; at = urdf.find("1.57079632679", at + 18)) {
     urdf.replace(at, 13, "1.5707963267948966");
@@ -263,8 +260,7 @@ namespace {
 // Visual elements (drawn by `redres view` only): the base's links and the chain's, posed in their frames, their
 // materials' colours, and a visual mesh that cannot be found is noted, never an error (nothing is computed from it).
 TEST(Mesh, VisualElementsArePosedInTheirFramesAndAMissingOneIsOnlyNoted) {
-  const fs::path dir = scratch("mesh_visuals");
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir("mesh_visuals");
   std::ofstream(dir / "cube.obj") << cube_obj("a", Eigen::Vector3d(0, 0, 0), 0);
   std::ofstream(dir / "arm.urdf") << R"(<robot name="arm">
   <material name="red"><color rgba="1 0 0 1"/></material>

@@ -63,8 +63,7 @@ TEST(MotionLimits, ARobotWithoutThemIsUnbounded) {
 
 TEST(MotionLimits, LawsOtherThanConstantsWork) {
   // An acceleration limit that follows the position, as a push-rod joint's velocity limit does.
-  const auto dir = scratch("motion_limits_law");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("motion_limits_law");
   std::ofstream(dir / "robot.toml") << R"toml(name = "two"
 kind = "planar"
 [[joints]]

@@ -29,6 +29,7 @@
 #include "redres/run/ik.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/start_check.hpp"
+#include "scenario_text.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -347,24 +348,14 @@ TEST(Ik, BadArgumentsAreRefused) {
 // Writes a Panda scenario whose theta0 line (line 4) is `theta0`, with `extra` at the end; returns its path.
 std::filesystem::path panda_scenario(const std::string& name, const std::string& theta0, const std::string& path,
                                      const std::string& extra = "", const std::string& robot = "franka_panda.toml") {
-  const std::filesystem::path dir = scratch("ik_" + name);
-  std::filesystem::create_directories(dir);
-  const std::filesystem::path file = dir / "s.toml";
-  std::ofstream out(file);
-  out << "robot = \"" << source_path("robots/" + robot).string() << "\"\n"
-      << "duration = 1.0\n"
-      << "step = 0.01\n"
-      << theta0 << "\n"
-      << "[path]\n"
-      << path << "\n"
-      << "[[objectives]]\n"
-      << "type = \"min_velocity_norm\"\n"
-      << "[[constraints]]\n"
-      << "type = \"task_tracking\"\n"
-      << "[[constraints]]\n"
-      << "type = \"joint_angle_margin\"\n"
-      << "margin = 0.05\n"
-      << extra;
+  const std::filesystem::path file = scratch_dir("ik_" + name) / "s.toml";
+  std::ofstream(file) << robot_line(robot) << "duration = 1.0\n"
+                      << "step = 0.01\n"
+                      << theta0 << "\n"
+                      << "[path]\n"
+                      << path << "\n"
+                      << objective_entry("min_velocity_norm") << constraint_entry("task_tracking")
+                      << constraint_entry("joint_angle_margin", "margin = 0.05\n") << extra;
   return file;
 }
 
@@ -414,15 +405,11 @@ TEST(IkScenario, IkPathAimsAtAnAbsolutePathsStart) {
 }
 
 TEST(IkScenario, APlanarScenarioTakesXYAndPhi) {
-  const std::filesystem::path dir = scratch("ik_planar");
-  std::filesystem::create_directories(dir);
-  const std::filesystem::path file = dir / "s.toml";
-  std::ofstream(file) << "robot = \"" << source_path("robots/paper_pushrod_6dof.toml").string() << "\"\n"
-                      << "duration = 1.0\nstep = 0.01\n"
+  const std::filesystem::path file = scratch_dir("ik_planar") / "s.toml";
+  std::ofstream(file) << robot_line("paper_pushrod_6dof.toml") << "duration = 1.0\nstep = 0.01\n"
                       << "theta0 = { ik = { position = [0.45, 1.1], phi = 1.9 } }\n"
                       << "[path]\ntype = \"line\"\ndelta = [0.01, 0.0]\n"
-                      << "[[objectives]]\ntype = \"min_velocity_norm\"\n"
-                      << "[[constraints]]\ntype = \"task_tracking\"\n";
+                      << objective_entry("min_velocity_norm") << constraint_entry("task_tracking");
   Scenario s = load_scenario(file);
   ASSERT_TRUE(s.ik.has_value());
   KinematicsData k(*s.robot);

@@ -58,8 +58,7 @@ TEST(Sweep, AZippedGridWithSampledTheta0) {
 
 TEST(Sweep, TheTableDoesNotDependOnTheThreadsAndFailuresAreRows) {
   const SweepSpec spec = load_sweep(data_path("sweeps/small.toml"));
-  const auto dir = scratch("sweep_threads");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("sweep_threads");
   const SweepTable one = run_sweep(spec, {}, 1, dir);
   const SweepTable two = run_sweep(spec, {}, 2, dir);
   write_sweep_csv(one, dir / "one.csv");
@@ -96,8 +95,7 @@ TEST(Sweep, TheTableDoesNotDependOnTheThreadsAndFailuresAreRows) {
 
 TEST(Sweep, ShardsMergeIntoTheWholeTable) {
   const SweepSpec spec = load_sweep(data_path("sweeps/small.toml"));
-  const auto dir = scratch("sweep_shards");
-  std::filesystem::create_directories(dir);
+  const auto dir = scratch_dir("sweep_shards");
   const SweepTable whole = run_sweep(spec, {}, 2, dir);
   std::vector<SweepTable> parts;
   for (std::size_t i : {2U, 0U, 1U}) {

@@ -135,14 +135,14 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
   task_row_.assign(kinds_.size(), -1);
   reference_row_.assign(kinds_.size(), -1);
   if (reference_ == Reference::kPath && frame_ == robot.find_frame("end_effector") && point_.isZero(0.0)) {
-    const std::vector<std::string>& names = robot.task_names();
+    const std::vector<std::string>& tracked = robot.task_names();
     for (std::size_t r = 0; r < kinds_.size(); ++r) {
       const int kind = static_cast<int>(kinds_[r]);
       if (kind >= 6) continue;  // the axis rows
       const std::string name = robot.kind() == ChainKind::kPlanar && kinds_[r] == Row::kWz ? "phi" : kRowNames[kind];
-      const auto it = std::find(names.begin(), names.end(), name);
-      if (it == names.end()) continue;
-      task_row_[r] = static_cast<int>(it - names.begin());
+      const auto it = std::find(tracked.begin(), tracked.end(), name);
+      if (it == tracked.end()) continue;
+      task_row_[r] = static_cast<int>(it - tracked.begin());
       reference_row_[r] = robot.task_rows()[static_cast<std::size_t>(task_row_[r])];
     }
   }

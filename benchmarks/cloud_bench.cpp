@@ -17,6 +17,7 @@
 #include <octomap/OcTree.h>
 
 #include "redres/model/collision.hpp"
+#include "redres/parsers/cloud_file.hpp"
 #include "test_util.hpp"
 
 namespace {

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "redres/parsers/cloud_file.hpp"
+
 namespace redres {
 
 // One controller's data: the query (and its tree), the distances, and a step's scratch: the witness point's

@@ -131,6 +131,23 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
       if (k == Row::kZ) throw FieldError("rows", "a planar robot's path has no z row");
     }
   }
+  // The rows that are the robot's own task rows (the end-effector task; see the header).
+  task_row_.assign(kinds_.size(), -1);
+  reference_row_.assign(kinds_.size(), -1);
+  if (reference_ == Reference::kPath && frame_ == robot.find_frame("end_effector") && point_.isZero(0.0)) {
+    const std::vector<std::string>& tracked = robot.task_names();
+    for (std::size_t r = 0; r < kinds_.size(); ++r) {
+      const int kind = static_cast<int>(kinds_[r]);
+      if (kind >= 6) continue;  // the axis rows
+      const std::string name = robot.kind() == ChainKind::kPlanar && kinds_[r] == Row::kWz ? "phi" : kRowNames[kind];
+      const auto it = std::find(tracked.begin(), tracked.end(), name);
+      if (it == tracked.end()) continue;
+      task_row_[r] = static_cast<int>(it - tracked.begin());
+      reference_row_[r] = robot.task_rows()[static_cast<std::size_t>(task_row_[r])];
+    }
+  }
+  all_task_rows_ = std::all_of(task_row_.begin(), task_row_.end(), [](int i) { return i >= 0; });
+  any_task_rows_ = std::any_of(task_row_.begin(), task_row_.end(), [](int i) { return i >= 0; });
   for (const auto* bounds : {&config_.lower, &config_.upper}) {
     if (*bounds && static_cast<int>((*bounds)->size()) != rows()) {
       throw FieldError(
@@ -164,6 +181,14 @@ void FrameTask::check_mode() const {
   if (config_.damping > 0.0 && mode() != TaskMode::kSoft) {
     throw FieldError("damping", "damping softens the rows into a damped least squares: use mode = \"soft\"");
   }
+}
+
+bool FrameTask::supports(ControlOrder order) const {
+  return order == ControlOrder::kVelocity || (all_task_rows_ && mode() != TaskMode::kInequality);
+}
+
+KinematicsLevel FrameTask::kinematics_level() const {
+  return any_task_rows_ ? KinematicsLevel::kJacobian : KinematicsLevel::kPosition;
 }
 
 std::string FrameTask::row_name(int r) const {
@@ -208,15 +233,22 @@ void FrameTask::compute(const Context& ctx, TaskData& data) const {
   TaskTerms& t = own.rows;
   const RobotModel& robot = *ctx.robot;
   const KinematicsData& kin = *ctx.kinematics;
-  const Eigen::Isometry3d pose = frame_pose(robot, kin, frame_);
-  const Eigen::Vector3d p = pose * point_;
-  const Eigen::Matrix3d R = pose.linear();
-  frame_jacobian(robot, kin, frame_, point_, own.J6);
-  if (!own.captured) {
-    own.p0 = p;
-    own.R0 = R;
-    own.a0 = R * axis_;
-    own.captured = true;
+  // Rows that are the robot's task rows read the kinematics and the path (bounds are on the frame's own position).
+  const bool task_rows = any_task_rows_ && mode() != TaskMode::kInequality;
+  const bool own_frame = !(task_rows && all_task_rows_);
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  if (own_frame) {
+    const Eigen::Isometry3d pose = frame_pose(robot, kin, frame_);
+    p = pose * point_;
+    R = pose.linear();
+    frame_jacobian(robot, kin, frame_, point_, own.J6);
+    if (!own.captured) {
+      own.p0 = p;
+      own.R0 = R;
+      own.a0 = R * axis_;
+      own.captured = true;
+    }
   }
   // The reference position and velocity, orientation and axis.
   Eigen::Vector3d p_d = position_, v_d = Eigen::Vector3d::Zero();
@@ -239,7 +271,19 @@ void FrameTask::compute(const Context& ctx, TaskData& data) const {
   const Eigen::Vector3d a = R * axis_;
   const Eigen::Vector3d a_d = axis_target_ ? *axis_target_ : own.a0;
   Eigen::Vector3d e_rot = Eigen::Vector3d::Zero();
-  if (has_orientation_rows()) e_rot = orientation_error_vector(R_d, R);
+  if (own_frame && has_orientation_rows()) e_rot = orientation_error_vector(R_d, R);
+  // A task row's orientation error: the rotation vector of R_d R', R_d the path's orientation.
+  Eigen::Vector3d e_path = Eigen::Vector3d::Zero();
+  if (task_rows && robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows()) {
+    e_path = orientation_error_vector(rotation_from_vector(ctx.r_d->tail<3>()), kin.ee_pose.linear());
+  }
+  const bool acceleration = ctx.order == ControlOrder::kAcceleration;
+  if (acceleration) {
+    REDRES_REQUIRE(task_rows && all_task_rows_ && ctx.r_d_ddot != nullptr &&
+                       ctx.r_d_ddot->size() == robot.reference_dim() && ctx.theta_dot != nullptr &&
+                       ctx.theta_dot->size() == kin.J.cols() && kin.dJ.cols() == kin.J.cols() * kin.J.cols(),
+                   "frame task", "at the acceleration level the context carries r_d_ddot, theta_dot and dJ");
+  }
   // u, v: an orthonormal basis of the plane normal to a.
   Eigen::Vector3d u = a.unitOrthogonal();
   Eigen::Vector3d v = a.cross(u);
@@ -249,6 +293,34 @@ void FrameTask::compute(const Context& ctx, TaskData& data) const {
     const Row kind = kinds_[static_cast<std::size_t>(r)];
     const double k = gain_(r);
     const int i = static_cast<int>(kind);
+    const int task_row = task_rows ? task_row_[static_cast<std::size_t>(r)] : -1;
+    if (task_row >= 0) {
+      // The robot's task row: J's row, e = r_d - f(theta) (orientation: the rotation vector), the path's velocity.
+      const int ref = reference_row_[static_cast<std::size_t>(r)];
+      t.J.row(r) = kin.J.row(task_row);
+      const double e = robot.kind() == ChainKind::kSpatial && ref >= 3 ? e_path(ref - 3)
+                                                                          : (*ctx.r_d)(ref) - kin.f(ref);
+      t.error(r) = e;
+      (i < 3 ? pos2 : rot2) += e * e;
+      const double r_d_dot = (*ctx.r_d_dot)(ref);
+      if (!acceleration) {
+        t.d(r) = r_d_dot + k * e;
+        continue;
+      }
+      // d = r_d_ddot - J_dot theta_dot + 2K (r_d_dot - J theta_dot) + K^2 e, with J_dot theta_dot summed as
+      // sum_j theta_dot_j (dJ/dtheta_j theta_dot).
+      const Eigen::Index n = kin.J.cols(), m = kin.J.rows();
+      const double* vel = ctx.theta_dot->data();
+      double jv = 0.0, jdv = 0.0;
+      for (Eigen::Index c = 0; c < n; ++c) jv += kin.J(task_row, c) * vel[c];
+      const double* dj = kin.dJ.data();
+      for (Eigen::Index j = 0; j < n; ++j) {
+        if (vel[j] == 0.0) continue;
+        for (Eigen::Index c = 0; c < n; ++c) jdv += dj[(j * n + c) * m + task_row] * (vel[j] * vel[c]);
+      }
+      t.d(r) = (*ctx.r_d_ddot)(ref) - jdv + 2.0 * k * (r_d_dot - jv) + k * k * e;
+      continue;
+    }
     double e = 0.0, feedforward = 0.0;
     if (i < 3) {
       t.J.row(r) = own.J6.row(i);

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/shape/box.h>
@@ -87,11 +88,13 @@ DistanceQuery::DistanceQuery(const std::vector<ShapeSpec>& shapes) : impl_(std::
     const double radius = s.radius.value_or(0.0);
     impl_->object_offset.push_back(Eigen::Isometry3d::Identity());
     if (s.is_cloud()) {
-      std::shared_ptr<const OccupancyMap> cloud = s.cloud;
+      const std::shared_ptr<const OccupancyMap>& cloud = s.cloud;
       if (!cloud) {
-        ShapeSpec copy = s;
-        load_cloud(copy);
-        cloud = copy.cloud;
+        throw std::invalid_argument("DistanceQuery: shape " + std::to_string(i) + " (" +
+                                    std::string(config_io::enum_name(s.shape)) + ", " +
+                                    (s.file ? s.file->string() : std::string("no file")) +
+                                    "): its cells are not read yet; load_cloud() (redres/parsers/cloud_file.hpp) reads "
+                                    "them");
       }
       const OccupancyInfo& info = cloud->info();
       const Eigen::Vector3d grow = Eigen::Vector3d::Constant(cloud->grow());

@@ -1,5 +1,5 @@
-// Cloud obstacles: OctoMap's octree of the occupied cells, read from an octree file or built from a point cloud
-// (model/cloud_files.hpp reads the files), and the nearest-cell search on it.
+// Cloud obstacles: OctoMap's octree of the occupied cells, built from points or from an OctoMap file's nodes (the files
+// are read in parsers/cloud_file.cpp), and the nearest-cell search on it.
 
 #include "model/occupancy.hpp"
 
@@ -9,18 +9,13 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
-#include "model/cloud_files.hpp"
 #include "redres/common/error.hpp"
 
 namespace redres {
-
-using cloud_detail::fail;
-using cloud_detail::lower_extension;
-using cloud_detail::read_cloud_file;
-using cloud_detail::read_octree;
 
 OccupancyMap::OccupancyMap(std::unique_ptr<octomap::OcTree> tree, double grow, std::size_t points)
     : tree_(std::move(tree)), grow_(grow) {
@@ -104,38 +99,89 @@ double OccupancyMap::nearest(const Metric& m, double within, Eigen::Vector3d& on
   return s.best;
 }
 
-void load_cloud(ShapeSpec& spec) {
-  if (spec.cloud || !spec.is_cloud()) return;
-  if (!spec.file || spec.file->empty()) throw std::invalid_argument("a cloud obstacle needs `file`");
-  const std::filesystem::path& file = *spec.file;
-  const double grow = spec.radius.value_or(0.0);
-  if (spec.shape == ShapeSpec::Kind::kOctree) {
-    const std::string ext = lower_extension(file);
-    if (ext != ".bt" && ext != ".ot")
-      fail(file, "an octree is read from an OctoMap .bt or .ot file (saw '" + ext + "')");
-    const std::string text = read_cloud_file(file);
-    spec.cloud = std::make_shared<const OccupancyMap>(read_octree(file, text, ext == ".bt"), grow, 0);
-  } else {
-    const std::vector<Eigen::Vector3d> points = read_points(file);
-    if (points.empty()) fail(file, "holds no points");
-    auto tree = std::make_unique<octomap::OcTree>(*spec.resolution);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const Eigen::Vector3d& p = points[i];
-      octomap::OcTreeKey key;
-      const double reach = *spec.resolution * 32767.0;  // checked first: OctoMap converts to int before it checks
-      if (!(p.cwiseAbs().maxCoeff() < reach) ||
-          !tree->coordToKeyChecked(
-              octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())), key)) {
-        std::ostringstream s;
-        s << "point " << i + 1 << " (" << p.transpose() << ") is outside the octree's reach: at resolution "
-          << *spec.resolution << " m it spans +-" << *spec.resolution * 32768.0 << " m";
-        fail(file, s.str());
-      }
-      tree->updateNode(key, true, true);
+namespace {
+
+// The nodes of an OctoMap file are walked before OctoMap reads them: its readers recurse without a depth limit and read
+// past the end of a truncated file, so only a tree that is whole and at most 16 levels deep reaches them. Each walk
+// returns the bytes the subtree takes, or 0 when it ends early or nests too deep.
+// Binary (.bt): two bytes a node, two bits a child (01 occupied leaf, 10 free leaf, 11 inner node, 00 none).
+std::size_t binary_subtree(const char* p, std::size_t n, int depth) {
+  if (n < 2 || depth > 16) return 0;
+  std::size_t used = 2;
+  for (int b = 0; b < 2; ++b) {
+    const auto bits = static_cast<unsigned char>(p[b]);
+    for (int i = 0; i < 4; ++i) {
+      if (((bits >> (2 * i)) & 3U) != 3U) continue;
+      const std::size_t sub = binary_subtree(p + used, n - used, depth + 1);
+      if (sub == 0) return 0;
+      used += sub;
     }
-    spec.cloud = std::make_shared<const OccupancyMap>(std::move(tree), grow, points.size());
   }
-  if (spec.cloud->empty()) fail(file, "has no occupied cell");
+  return used;
+}
+// Full (.ot, an OcTree's): a 4-byte value and a byte of child flags a node.
+std::size_t full_subtree(const char* p, std::size_t n, int depth) {
+  if (n < 5 || depth > 16) return 0;
+  std::size_t used = 5;
+  const auto bits = static_cast<unsigned char>(p[4]);
+  for (int i = 0; i < 8; ++i) {
+    if (((bits >> i) & 1U) == 0) continue;
+    const std::size_t sub = full_subtree(p + used, n - used, depth + 1);
+    if (sub == 0) return 0;
+    used += sub;
+  }
+  return used;
+}
+
+}  // namespace
+
+std::shared_ptr<const OccupancyMap> occupancy_of_points(const std::vector<Eigen::Vector3d>& points, double resolution,
+                                                        double grow) {
+  REDRES_REQUIRE(resolution > 0.0 && std::isfinite(resolution), "occupancy_of_points", "resolution > 0");
+  auto tree = std::make_unique<octomap::OcTree>(resolution);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d& p = points[i];
+    octomap::OcTreeKey key;
+    const double reach = resolution * 32767.0;  // checked first: OctoMap converts to int before it checks
+    if (!(p.cwiseAbs().maxCoeff() < reach) ||
+        !tree->coordToKeyChecked(
+            octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())), key)) {
+      std::ostringstream s;
+      s << "point " << i + 1 << " (" << p.transpose() << ") is outside the octree's reach: at resolution " << resolution
+        << " m it spans +-" << resolution * 32768.0 << " m";
+      throw std::invalid_argument(s.str());
+    }
+    tree->updateNode(key, true, true);
+  }
+  auto cloud = std::make_shared<const OccupancyMap>(std::move(tree), grow, points.size());
+  if (cloud->empty()) throw std::invalid_argument("has no occupied cell");
+  return cloud;
+}
+
+std::shared_ptr<const OccupancyMap> occupancy_of_octree(std::string_view nodes, bool binary, double resolution,
+                                                        long size, double grow) {
+  const std::size_t left = nodes.size();
+  const std::size_t used =
+      left == 0 ? 0 : (binary ? binary_subtree(nodes.data(), left, 0) : full_subtree(nodes.data(), left, 0));
+  if (left > 0 && used == 0)
+    throw std::invalid_argument("its nodes end early or nest deeper than 16 levels: the file is cut or corrupt");
+  auto tree = std::make_unique<octomap::OcTree>(resolution);
+  if (used > 0) {
+    std::istringstream in(std::string(nodes.data(), used));
+    if (binary) {
+      tree->readBinaryData(in);
+    } else {
+      tree->readData(in);
+    }
+    if (!in) throw std::invalid_argument("OctoMap could not read its nodes");
+  }
+  if (size >= 0 && static_cast<long>(tree->size()) != size) {
+    throw std::invalid_argument("the header says " + std::to_string(size) + " nodes, the data holds " +
+                                std::to_string(tree->size()));
+  }
+  auto cloud = std::make_shared<const OccupancyMap>(std::move(tree), grow, 0);
+  if (cloud->empty()) throw std::invalid_argument("has no occupied cell");
+  return cloud;
 }
 
 OccupancyInfo occupancy_info(const OccupancyMap& cloud) { return cloud.info(); }

@@ -23,6 +23,7 @@
 #include "redres/model/collision.hpp"
 #include "redres/model/convex.hpp"
 #include "redres/model/mesh.hpp"
+#include "redres/parsers/cloud_file.hpp"
 #include "redres/parsers/mesh_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/run/scenario.hpp"
@@ -617,6 +618,7 @@ TEST(ConvexDistance, AHullAgainstAPointCloud) {
   cloud.file = dir / "c.xyz";
   const double edge = 0.02;
   cloud.resolution = edge;
+  load_cloud(cloud);
   int reached = 0;
   for (int trial = 0; trial < 20; ++trial) {
     const ShapeSpec a = random_hull(rng);

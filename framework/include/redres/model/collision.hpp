@@ -22,6 +22,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -41,7 +42,8 @@ struct ConvexHull;
 /// Obstacles may also be occupied space read from a file (docs/collision.md, "Point clouds and octrees"): an OctoMap
 /// octree (`octree`, `.bt` or `.ot`) or a point cloud (`points`, `.ply`, `.pcd` or `.xyz`) put into cubic cells of
 /// edge `resolution`. The obstacle is the union of the occupied cells grown by `radius` (0 for an octree unless
-/// given), placed by xyz/rpy. The file is read once (cloud(), load_cloud()) and shared by every copy of the spec.
+/// given), placed by xyz/rpy. The file is read once (load_cloud(), redres/parsers/cloud_file.hpp) and the cells are shared
+/// by every copy of the spec.
 ///
 /// A robot link may also be the convex hull of a collision mesh piece (`convex`, made by a robot file's
 /// `collision_model = "hull"`, docs/robot_format.md "Meshes"): its vertices and faces in `hull`, shared by every copy
@@ -59,7 +61,8 @@ struct ShapeSpec {
   std::optional<std::array<double, 3>> velocity{};  //!< obstacles: constant linear velocity (m/s)
   std::optional<std::filesystem::path> file{};      //!< octree, points: the file (relative to the file naming it)
   std::optional<double> resolution{};               //!< points: the cell edge the points are put into (m)
-  /// octree, points: the occupied cells, once read (load_cloud()); shared by the spec's copies.
+  /// octree, points: the occupied cells, once read (load_cloud(), redres/parsers/cloud_file.hpp); shared by the spec's
+  /// copies.
   std::shared_ptr<const OccupancyMap> cloud{};
   /// A robot's shapes: the body (a URDF link riding on the joint) it belongs to; empty: the joint's own link. Not a
   /// key of the files (a URDF link's shapes are given by the link's name).
@@ -97,15 +100,22 @@ struct OccupancyInfo {
   Eigen::Vector3d max = Eigen::Vector3d::Zero();
 };
 
-/// Reads an octree or point cloud obstacle's file into spec.cloud (if not read yet). Throws std::invalid_argument
-/// naming the file, and the line or byte where it went wrong.
-void load_cloud(ShapeSpec& spec);
+/// The occupied space of `points` (in the cloud's frame) put into cubic cells of edge `resolution` (m, > 0), grown by
+/// `grow` (m). Throws std::invalid_argument naming the first point out of the octree's reach (+-32768 cells), or when
+/// no cell is occupied. (The files are read by redres/parsers/cloud_file.hpp.)
+[[nodiscard]] std::shared_ptr<const OccupancyMap> occupancy_of_points(const std::vector<Eigen::Vector3d>& points,
+                                                                      double resolution, double grow);
+/// An occupancy octree from the nodes of an OctoMap file (binary: a .bt file's, else an .ot file's), of cell edge
+/// `resolution`, grown by `grow`; `size` >= 0 is the node count its header gives. The nodes are walked before OctoMap
+/// reads them (its readers recurse without a depth limit and read past the end of the data): throws
+/// std::invalid_argument when they end early or nest deeper than 16 levels, when the tree does not hold `size` nodes,
+/// or when no cell is occupied.
+[[nodiscard]] std::shared_ptr<const OccupancyMap> occupancy_of_octree(std::string_view nodes, bool binary,
+                                                                      double resolution, long size, double grow);
 /// The statistics of a loaded cloud.
 [[nodiscard]] OccupancyInfo occupancy_info(const OccupancyMap& cloud);
 /// The centres and edges of the occupied leaf cells, in the cloud's frame (for plots and tests): [x, y, z, edge].
 [[nodiscard]] std::vector<std::array<double, 4>> occupied_cells(const OccupancyMap& cloud);
-/// The points a `points` file holds, as read (for tests: brute-force distances); throws as load_cloud().
-[[nodiscard]] std::vector<Eigen::Vector3d> read_points(const std::filesystem::path& file);
 
 /// R = Rz(yaw) Ry(pitch) Rx(roll) from {roll, pitch, yaw} (rad): ShapeSpec's and URDF's convention.
 [[nodiscard]] Eigen::Matrix3d rpy_matrix(const std::array<double, 3>& rpy);
@@ -135,7 +145,8 @@ struct ShapeDistance {
 class DistanceQuery {
  public:
   /// Builds one FCL geometry per shape (sizes checked: std::invalid_argument naming the shape). A cloud shape (octree,
-  /// points) is read from its file unless its spec holds it already (load_cloud()).
+  /// points) must hold its cells (read by load_cloud(), redres/parsers/cloud_file.hpp): one that does not is refused
+  /// with std::invalid_argument naming the shape and its file.
   explicit DistanceQuery(const std::vector<ShapeSpec>& shapes);
   ~DistanceQuery();
   DistanceQuery(const DistanceQuery&) = delete;

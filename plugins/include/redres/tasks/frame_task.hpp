@@ -10,7 +10,17 @@
 ///   orthonormal basis of the plane normal to a.
 /// The reference (`reference`): "start" (the frame's pose at the first step of a run), "fixed" (`position`, `rpy`)
 /// or "path" (the position rows follow the scenario's path and its velocity; orientation rows and the axis hold their
-/// start). In mode "inequality" the position rows are kept within `lower` <= p <= `upper` (world coordinates, m; one
+/// start).
+///
+/// The end-effector task. On the frame "end_effector" at its origin with reference "path", a row the robot tracks
+/// (its task rows: x, y, z, and with a pose task the orientation rows, a planar robot's "phi" being "wz") is the
+/// robot's task row itself: J is that row of the kinematics' task Jacobian, the error r_d - f(theta) (a spatial
+/// orientation's is the rotation vector of R_d R', R_d the path's orientation), and d = r_d_dot + K e. Such a task
+/// works at the acceleration level too (when every row is a task row and the mode is not "inequality"): its rows are
+/// those of the error dynamics e_ddot + 2K e_dot + K^2 e = 0,
+///   J x = r_d_ddot - J_dot theta_dot + 2K (r_d_dot - J theta_dot) + K^2 e,
+/// with J_dot theta_dot = sum_i theta_dot_i (dJ/dtheta_i) theta_dot. The constraint `task_tracking` (eq. 6) is this
+/// task on every task row, held as a hard constraint at every priority level (constraints/task_tracking.hpp). In mode "inequality" the position rows are kept within `lower` <= p <= `upper` (world coordinates, m; one
 /// entry per row, +-inf where open): K (lower - p) <= J x <= K (upper - p).
 /// `damping` (soft mode): the Levenberg-Marquardt term lambda^2 = damping^2 (1 - (sigma / damping_threshold)^2) that
 /// the task's level adds to W while the rows' smallest singular value sigma is below the threshold.
@@ -62,6 +72,12 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
   void start(PluginData* data) const override;
   /// The frame's index in RobotModel::frames().
   [[nodiscard]] int frame() const noexcept { return frame_; }
+  /// The velocity level always; the acceleration level when every row is one of the robot's task rows (above) and
+  /// the mode is not "inequality".
+  [[nodiscard]] bool supports(ControlOrder order) const override;
+  /// The kinematics' task Jacobian when a row is a task row (at the acceleration level the scheme asks for its
+  /// derivative too); else the link frames.
+  [[nodiscard]] KinematicsLevel kinematics_level() const override;
 
   [[nodiscard]] std::vector<std::string> recorded_columns() const override;
   void record(const PluginData* data, double* values) const override;
@@ -78,6 +94,10 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
   int frame_ = -1;
   Reference reference_ = Reference::kStart;  // config_.reference, read once
   std::vector<Row> kinds_;
+  // For each row: the robot's task row it is (the index into the kinematics' J, and its reference row), or -1.
+  std::vector<int> task_row_, reference_row_;
+  bool all_task_rows_ = false;  // every row is a task row: the frame's own pose and Jacobian are not needed
+  bool any_task_rows_ = false;
   Eigen::VectorXd gain_;
   Eigen::Vector3d point_, axis_;
   std::optional<Eigen::Vector3d> axis_target_;

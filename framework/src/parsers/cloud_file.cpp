@@ -1,12 +1,17 @@
-// Reading the files of cloud obstacles: OctoMap's octrees (.bt, .ot) and point clouds (.ply through Assimp, .pcd,
-// .xyz) (model/cloud_files.hpp; read_points(), redres/model/collision.hpp).
+// Reading the files of cloud obstacles (redres/parsers/cloud_file.hpp): OctoMap's octrees (.bt, .ot) and point clouds
+// (.ply through Assimp, .pcd, .xyz), each checked as it is read; the model puts what they hold into an OccupancyMap
+// (occupancy_of_points(), occupancy_of_octree()). Every problem is a std::invalid_argument naming the file, and the line
+// or byte.
 
-#include "model/cloud_files.hpp"
+#include "redres/parsers/cloud_file.hpp"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -23,8 +28,6 @@
 
 namespace redres {
 
-namespace cloud_detail {
-
 namespace {
 
 // Cloud files may be large (a depth camera's frame is some 10 MB as text): read whole, up to 1 GiB.
@@ -34,9 +37,7 @@ constexpr std::uintmax_t kMaxCloudBytes = std::uintmax_t{1} << 30;
   throw std::invalid_argument(file.string() + ":" + std::to_string(line) + ": " + what);
 }
 
-}  // namespace
-
-void fail(const std::filesystem::path& file, const std::string& what) {
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
   throw std::invalid_argument(file.string() + ": " + what);
 }
 
@@ -53,8 +54,6 @@ std::string read_cloud_file(const std::filesystem::path& file) {
     fail(file, e.detail());
   }
 }
-
-namespace {
 
 // Splits a line into tokens at blanks and commas.
 int split(std::string_view line, std::string_view* out, int max) {
@@ -292,38 +291,10 @@ std::vector<Eigen::Vector3d> read_ply(const std::filesystem::path& file, const s
   return points;
 }
 
-// Binary (.bt): two bytes a node, two bits a child (01 occupied leaf, 10 free leaf, 11 inner node, 00 none).
-std::size_t binary_subtree(const char* p, std::size_t n, int depth) {
-  if (n < 2 || depth > 16) return 0;
-  std::size_t used = 2;
-  for (int b = 0; b < 2; ++b) {
-    const auto bits = static_cast<unsigned char>(p[b]);
-    for (int i = 0; i < 4; ++i) {
-      if (((bits >> (2 * i)) & 3U) != 3U) continue;
-      const std::size_t sub = binary_subtree(p + used, n - used, depth + 1);
-      if (sub == 0) return 0;
-      used += sub;
-    }
-  }
-  return used;
-}
-// Full (.ot, an OcTree's): a 4-byte value and a byte of child flags a node.
-std::size_t full_subtree(const char* p, std::size_t n, int depth) {
-  if (n < 5 || depth > 16) return 0;
-  std::size_t used = 5;
-  const auto bits = static_cast<unsigned char>(p[4]);
-  for (int i = 0; i < 8; ++i) {
-    if (((bits >> i) & 1U) == 0) continue;
-    const std::size_t sub = full_subtree(p + used, n - used, depth + 1);
-    if (sub == 0) return 0;
-    used += sub;
-  }
-  return used;
-}
-
-}  // namespace
-
-std::unique_ptr<octomap::OcTree> read_octree(const std::filesystem::path& file, const std::string& text, bool binary) {
+// OctoMap's files: a text header ("# Octomap OcTree binary file" or "# Octomap OcTree file", comment lines, then `id`,
+// `size`, `res` and `data` lines), then the nodes, which OccupancyMap's octree reader takes (occupancy_of_octree()).
+std::shared_ptr<const OccupancyMap> read_octree(const std::filesystem::path& file, const std::string& text, bool binary,
+                                                double grow) {
   const std::string_view first = binary ? "# Octomap OcTree binary file" : "# Octomap OcTree file";
   if (text.rfind(first, 0) != 0)
     fail(file, "not an OctoMap " + std::string(binary ? ".bt" : ".ot") + " file (its first line is not '" +
@@ -360,31 +331,16 @@ std::unique_ptr<octomap::OcTree> read_octree(const std::filesystem::path& file, 
   }
   if (id != "OcTree") fail(file, "holds an octree of type '" + id + "'; an occupancy octree (id OcTree) is read");
   if (!(res > 0.0)) fail(file, "the header gives no `res`");
-  const char* nodes = text.data() + pos;
-  const std::size_t left = text.size() - pos;
-  const std::size_t used = left == 0 ? 0 : (binary ? binary_subtree(nodes, left, 0) : full_subtree(nodes, left, 0));
-  if (left > 0 && used == 0)
-    fail(file, "its nodes end early or nest deeper than 16 levels: the file is cut or corrupt");
-  auto tree = std::make_unique<octomap::OcTree>(res);
-  if (used > 0) {
-    std::istringstream in(std::string(nodes, used));
-    if (binary) {
-      tree->readBinaryData(in);
-    } else {
-      tree->readData(in);
-    }
-    if (!in) fail(file, "OctoMap could not read its nodes");
+  try {
+    return occupancy_of_octree(std::string_view(text).substr(pos), binary, res, size, grow);
+  } catch (const std::invalid_argument& e) {
+    fail(file, e.what());
   }
-  if (size >= 0 && static_cast<long>(tree->size()) != size) {
-    fail(file, "the header says " + std::to_string(size) + " nodes, the data holds " + std::to_string(tree->size()));
-  }
-  return tree;
 }
 
-}  // namespace cloud_detail
+}  // namespace
 
 std::vector<Eigen::Vector3d> read_points(const std::filesystem::path& file) {
-  using namespace cloud_detail;
   const std::string ext = lower_extension(file);
   if (ext != ".ply" && ext != ".pcd" && ext != ".xyz") {
     fail(file, "a point cloud is read from a .ply, .pcd or .xyz file (saw '" + ext + "')");
@@ -393,6 +349,27 @@ std::vector<Eigen::Vector3d> read_points(const std::filesystem::path& file) {
   if (ext == ".ply") return read_ply(file, text);
   if (ext == ".pcd") return read_pcd(file, text);
   return read_xyz(file, text);
+}
+
+void load_cloud(ShapeSpec& spec) {
+  if (spec.cloud || !spec.is_cloud()) return;
+  if (!spec.file || spec.file->empty()) throw std::invalid_argument("a cloud obstacle needs `file`");
+  const std::filesystem::path& file = *spec.file;
+  const double grow = spec.radius.value_or(0.0);
+  if (spec.shape == ShapeSpec::Kind::kOctree) {
+    const std::string ext = lower_extension(file);
+    if (ext != ".bt" && ext != ".ot")
+      fail(file, "an octree is read from an OctoMap .bt or .ot file (saw '" + ext + "')");
+    spec.cloud = read_octree(file, read_cloud_file(file), ext == ".bt", grow);
+  } else {
+    const std::vector<Eigen::Vector3d> points = read_points(file);
+    if (points.empty()) fail(file, "holds no points");
+    try {
+      spec.cloud = occupancy_of_points(points, *spec.resolution, grow);
+    } catch (const std::invalid_argument& e) {
+      fail(file, e.what());
+    }
+  }
 }
 
 }  // namespace redres

@@ -1,6 +1,7 @@
 #pragma once
 // Point clouds for the cloud obstacles' tests (the readers' in tests/framework/parsers/, the distances' in
-// tests/framework/model/): a sampled cloud, its .xyz file, and a `points` obstacle naming a file (their directories: scratch_dir(), test_util.hpp).
+// tests/framework/model/): a sampled cloud, its .xyz file, and a `points` obstacle naming a file (their directories:
+// scratch_dir(), test_util.hpp).
 
 #include <filesystem>
 #include <fstream>

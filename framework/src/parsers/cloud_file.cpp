@@ -1,7 +1,7 @@
 // Reading the files of cloud obstacles (redres/parsers/cloud_file.hpp): OctoMap's octrees (.bt, .ot) and point clouds
 // (.ply through Assimp, .pcd, .xyz), each checked as it is read; the model puts what they hold into an OccupancyMap
-// (occupancy_of_points(), occupancy_of_octree()). Every problem is a std::invalid_argument naming the file, and the line
-// or byte.
+// (occupancy_of_points(), occupancy_of_octree()). Every problem is a std::invalid_argument naming the file, and the
+// line or byte.
 
 #include "redres/parsers/cloud_file.hpp"
 

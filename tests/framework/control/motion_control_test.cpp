@@ -23,6 +23,7 @@
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
 #include "scenario_text.hpp"
+#include "task_rows.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -319,15 +320,6 @@ const std::string kTaskOnly = "[scheme]\nlevel = \"acceleration\"\n" + objective
                               constraint_entry("joint_acceleration_limits", "active = false\n") +
                               constraint_entry("joint_jerk_limits", "active = false\n");
 
-// J_dot v by central differences of the task rows' J along v.
-Eigen::VectorXd jdot_v(const RobotModel& robot, const Eigen::VectorXd& theta, const Eigen::VectorXd& v) {
-  KinematicsData kp(robot), km(robot);
-  const double h = 1e-6;
-  compute_kinematics(robot, theta + h * v, kp, KinematicsLevel::kJacobian);
-  compute_kinematics(robot, theta - h * v, km, KinematicsLevel::kJacobian);
-  return (kp.J - km.J) * v / (2.0 * h);
-}
-
 // At theta with velocity v, r_d = f, r_d_dot = J v, r_d_ddot = 0: the task rows' d is -J_dot v; against central
 // differences of J along v.
 TEST(AccelerationLevel, JdotThetaDotMatchesCentralDifferences) {
@@ -345,7 +337,7 @@ TEST(AccelerationLevel, JdotThetaDotMatchesCentralDifferences) {
     for (int j = 0; j < n; ++j) v(j) = u(rng);
     KinematicsData k(*robot);
     compute_kinematics(*robot, theta, k, KinematicsLevel::kJacobian);
-    const Eigen::VectorXd jdv = jdot_v(*robot, theta, v);
+    const Eigen::VectorXd jdv = testing::jdot_v(*robot, theta, v);
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(robot->reference_dim());
     ctrl.step(theta, 0.0, k.f, zero, zero, out);
     ctrl.set_applied(v);  // the velocity at the next step
@@ -361,10 +353,7 @@ TEST(AccelerationLevel, JdotThetaDotMatchesCentralDifferences) {
 // The same for a task that names a subset of the rows (x and z): KinematicsData::J holds those rows only, and the
 // acceleration-level rows must read J theta_dot and J_dot theta_dot by task row, not by reference row.
 TEST(AccelerationLevel, JdotThetaDotOfASubsetTaskReadsItsOwnRows) {
-  std::string text = read_text(source_path("robots/franka_panda.toml"));
-  const std::string position = "task = \"position\"";
-  text.replace(text.find(position), position.size(), "task = [\"x\", \"z\"]");
-  const RobotModel robot = load_robot(TableReader::root(parse_toml_string(text, "panda_xz.toml")));
+  const RobotModel robot = testing::robot_with_task("robots/franka_panda.toml", "[\"x\", \"z\"]");
   ASSERT_EQ(robot.task_dim(), 2);
   const auto scheme = scheme_from_text(kTaskOnly, robot);
   auto engine = make_engine("newton");
@@ -378,7 +367,7 @@ TEST(AccelerationLevel, JdotThetaDotOfASubsetTaskReadsItsOwnRows) {
     for (int j = 0; j < robot.dof(); ++j) v(j) = u(rng);
     KinematicsData k(robot);
     compute_kinematics(robot, theta, k, KinematicsLevel::kJacobian);
-    const Eigen::VectorXd jdv = jdot_v(robot, theta, v);  // the task rows x, z
+    const Eigen::VectorXd jdv = testing::jdot_v(robot, theta, v);  // the task rows x, z
     ASSERT_EQ(jdv.size(), 2);
     // r_d_dot's reference rows x, y, z: the task's velocity in x and z, anything in y (not a task row).
     const Eigen::VectorXd jv = k.J * v;

@@ -26,7 +26,6 @@
 
 #include "lexicographic_reference.hpp"
 #include "random_chain.hpp"
-#include "redres/config/toml_reader.hpp"
 #include "redres/constraints/joint_velocity_limits.hpp"
 #include "redres/constraints/task_tracking.hpp"
 #include "redres/control/controller.hpp"
@@ -36,6 +35,7 @@
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/tasks/frame_task.hpp"
 #include "redres/tasks/posture.hpp"
+#include "task_rows.hpp"
 #include "test_util.hpp"
 
 namespace redres {
@@ -677,29 +677,11 @@ TEST(Tasks, APostureThatCannotBeMetIsMetAsWellAsTheLimitsAllowAndTheStepDoesNotF
       << rig.out.levels[2].diagnosis;
 }
 
-
 // ---------------------------------------------------------------------------------------------------------------
 // The end-effector task: `task_tracking` is the frame task on "end_effector" with reference "path" and the robot's
 // task rows. Its rows are eq. 6 (and at the acceleration level the critically damped error dynamics), computed here
 // on their own from the kinematics, the path and central differences; and a [[tasks]] frame task on the same rows
 // writes the same QP rows, entry for entry, at both orders.
-
-// The robot file `file` with its `task = "position"` replaced by `task`.
-RobotModel robot_with_task(const std::string& file, const std::string& task) {
-  std::string text = read_text(source_path(file));
-  const std::string position = "task = \"position\"";
-  text.replace(text.find(position), position.size(), "task = " + task);
-  return load_robot(TableReader::root(parse_toml_string(text, file)));
-}
-
-// J theta_dot's derivative along v (J_dot v), by central differences of the kinematics' J.
-Eigen::VectorXd jdot_times(const RobotModel& robot, const Eigen::VectorXd& theta, const Eigen::VectorXd& v) {
-  KinematicsData kp(robot), km(robot);
-  const double h = 1e-6;
-  compute_kinematics(robot, theta + h * v, kp, KinematicsLevel::kJacobian);
-  compute_kinematics(robot, theta - h * v, km, KinematicsLevel::kJacobian);
-  return (kp.J - km.J) * v / (2.0 * h);
-}
 
 // One step of a one-level scheme at `order`; the QP's equality rows [J d].
 Eigen::MatrixXd equality_rows(const RobotModel& robot, std::vector<std::unique_ptr<Constraint>> constraints,
@@ -722,10 +704,10 @@ Eigen::MatrixXd equality_rows(const RobotModel& robot, std::vector<std::unique_p
 
 TEST(Tasks, TheEndEffectorTaskIsTheFrameTaskOnTheEndEffectorAndItsRowsAreEquationSix) {
   std::vector<RobotModel> robots;
-  robots.push_back(load_robot(source_path("robots/paper_pushrod_6dof.toml")));           // planar x, y
-  robots.push_back(robot_with_task("robots/planar_4link.toml", "\"pose\""));             // planar x, y, phi
-  robots.push_back(robot_with_task("robots/franka_panda.toml", "\"pose\""));             // spatial pose
-  robots.push_back(robot_with_task("robots/franka_panda.toml", "[\"x\", \"z\", \"wy\"]"));  // a subset
+  robots.push_back(load_robot(source_path("robots/paper_pushrod_6dof.toml")));                       // planar x, y
+  robots.push_back(testing::robot_with_task("robots/planar_4link.toml", "\"pose\""));                // planar x, y, phi
+  robots.push_back(testing::robot_with_task("robots/franka_panda.toml", "\"pose\""));                // spatial pose
+  robots.push_back(testing::robot_with_task("robots/franka_panda.toml", "[\"x\", \"z\", \"wy\"]"));  // a subset
   std::mt19937 rng(41);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (const RobotModel& robot : robots) {
@@ -766,12 +748,11 @@ TEST(Tasks, TheEndEffectorTaskIsTheFrameTaskOnTheEndEffectorAndItsRowsAreEquatio
         e(i) = robot.kind() == ChainKind::kSpatial && r >= 3 ? (turn.angle() * turn.axis())(r - 3) : r_d(r) - k.f(r);
       }
       Eigen::VectorXd d_velocity(m), d_acceleration(m);
-      const Eigen::VectorXd jdv = jdot_times(robot, theta, v), jv = k.J * v;
+      const Eigen::VectorXd jdv = testing::jdot_v(robot, theta, v), jv = k.J * v;
       for (int i = 0; i < m; ++i) {
         const int r = robot.task_rows()[static_cast<std::size_t>(i)];
         d_velocity(i) = r_d_dot(r) + gain(i) * e(i);
-        d_acceleration(i) =
-            r_d_ddot(r) - jdv(i) + 2.0 * gain(i) * (r_d_dot(r) - jv(i)) + gain(i) * gain(i) * e(i);
+        d_acceleration(i) = r_d_ddot(r) - jdv(i) + 2.0 * gain(i) * (r_d_dot(r) - jv(i)) + gain(i) * gain(i) * e(i);
       }
       for (ControlOrder order : {ControlOrder::kVelocity, ControlOrder::kAcceleration}) {
         const bool acceleration = order == ControlOrder::kAcceleration;
@@ -782,14 +763,15 @@ TEST(Tasks, TheEndEffectorTaskIsTheFrameTaskOnTheEndEffectorAndItsRowsAreEquatio
         std::vector<std::unique_ptr<Task>> tasks;
         tasks.push_back(frame_task(robot, "tool", frame, TaskMode::kEquality, 0));
         ASSERT_TRUE(tasks.back()->supports(order)) << robot.name();
-        const Eigen::MatrixXd as_task = equality_rows(robot, {}, std::move(tasks), order, theta, v, r_d, r_d_dot, r_d_ddot);
+        const Eigen::MatrixXd as_task =
+            equality_rows(robot, {}, std::move(tasks), order, theta, v, r_d, r_d_dot, r_d_ddot);
         EXPECT_EQ(as_constraint, as_task) << robot.name() << (acceleration ? ", acceleration" : ", velocity");
         ASSERT_EQ(as_constraint.rows(), m);
         EXPECT_LT((as_constraint.leftCols(n) - k.J).cwiseAbs().maxCoeff(), 1e-12) << robot.name();
         const Eigen::VectorXd& expected = acceleration ? d_acceleration : d_velocity;
         EXPECT_LT((as_constraint.col(n) - expected).cwiseAbs().maxCoeff(), 1e-6 * (1.0 + expected.norm()))
-            << robot.name() << (acceleration ? ", acceleration" : ", velocity") << "\nd = "
-            << as_constraint.col(n).transpose() << "\nexpected " << expected.transpose();
+            << robot.name() << (acceleration ? ", acceleration" : ", velocity")
+            << "\nd = " << as_constraint.col(n).transpose() << "\nexpected " << expected.transpose();
         if (acceleration) EXPECT_GT(jdv.norm(), 1e-3) << robot.name();  // J_dot v is in the test
       }
     }

@@ -22,11 +22,11 @@
 #include <octomap/OcTree.h>
 
 #include "alloc_counter.hpp"
+#include "cloud_samples.hpp"
 #include "redres/common/error.hpp"
 #include "redres/model/collision.hpp"
 #include "redres/parsers/cloud_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
-#include "cloud_samples.hpp"
 #include "test_util.hpp"
 
 namespace redres {

@@ -42,8 +42,8 @@ struct ConvexHull;
 /// Obstacles may also be occupied space read from a file (docs/collision.md, "Point clouds and octrees"): an OctoMap
 /// octree (`octree`, `.bt` or `.ot`) or a point cloud (`points`, `.ply`, `.pcd` or `.xyz`) put into cubic cells of
 /// edge `resolution`. The obstacle is the union of the occupied cells grown by `radius` (0 for an octree unless
-/// given), placed by xyz/rpy. The file is read once (load_cloud(), redres/parsers/cloud_file.hpp) and the cells are shared
-/// by every copy of the spec.
+/// given), placed by xyz/rpy. The file is read once (load_cloud(), redres/parsers/cloud_file.hpp) and the cells are
+/// shared by every copy of the spec.
 ///
 /// A robot link may also be the convex hull of a collision mesh piece (`convex`, made by a robot file's
 /// `collision_model = "hull"`, docs/robot_format.md "Meshes"): its vertices and faces in `hull`, shared by every copy

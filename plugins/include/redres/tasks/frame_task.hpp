@@ -20,8 +20,10 @@
 /// those of the error dynamics e_ddot + 2K e_dot + K^2 e = 0,
 ///   J x = r_d_ddot - J_dot theta_dot + 2K (r_d_dot - J theta_dot) + K^2 e,
 /// with J_dot theta_dot = sum_i theta_dot_i (dJ/dtheta_i) theta_dot. The constraint `task_tracking` (eq. 6) is this
-/// task on every task row, held as a hard constraint at every priority level (constraints/task_tracking.hpp). In mode "inequality" the position rows are kept within `lower` <= p <= `upper` (world coordinates, m; one
-/// entry per row, +-inf where open): K (lower - p) <= J x <= K (upper - p).
+/// task on every task row, held as a hard constraint at every priority level (constraints/task_tracking.hpp).
+///
+/// In mode "inequality" the position rows are kept within `lower` <= p <= `upper` (world coordinates, m; one entry per
+/// row, +-inf where open): K (lower - p) <= J x <= K (upper - p).
 /// `damping` (soft mode): the Levenberg-Marquardt term lambda^2 = damping^2 (1 - (sigma / damping_threshold)^2) that
 /// the task's level adds to W while the rows' smallest singular value sigma is below the threshold.
 /// Records `<name>_error` (m: the norm of the position rows' error; inequality: how far outside its bounds) and, with

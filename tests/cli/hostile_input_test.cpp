@@ -78,7 +78,9 @@ TEST(HostileInput, TomlWithDotsInStringsCommentsAndNumbersStillParses) {
   EXPECT_EQ(file->root["s"].value_or(std::string()), many_dots);
   EXPECT_EQ(file->root["m"].value_or(std::string()), many_dots + "\n");
   EXPECT_EQ(file->root["q"].value_or(std::string()), "x\"");
-  EXPECT_EQ(file->root["v"].as_array()->size(), 500u);
+  const toml::array* v = file->root["v"].as_array();
+  ASSERT_NE(v, nullptr);
+  EXPECT_EQ(v->size(), 500u);
 }
 
 TEST(HostileInput, InputsThatAreNotBoundedRegularFilesAreRefusedBeforeReading) {

@@ -772,7 +772,9 @@ TEST(Tasks, TheEndEffectorTaskIsTheFrameTaskOnTheEndEffectorAndItsRowsAreEquatio
         EXPECT_LT((as_constraint.col(n) - expected).cwiseAbs().maxCoeff(), 1e-6 * (1.0 + expected.norm()))
             << robot.name() << (acceleration ? ", acceleration" : ", velocity")
             << "\nd = " << as_constraint.col(n).transpose() << "\nexpected " << expected.transpose();
-        if (acceleration) EXPECT_GT(jdv.norm(), 1e-3) << robot.name();  // J_dot v is in the test
+        if (acceleration) {
+          EXPECT_GT(jdv.norm(), 1e-3) << robot.name();  // J_dot v is in the test
+        }
       }
     }
   }

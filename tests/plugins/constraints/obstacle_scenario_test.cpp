@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "redres/constraints/obstacle_avoidance.hpp"
+#include "redres/parsers/cloud_file.hpp"
 #include "redres/run/run_summary.hpp"
 #include "test_util.hpp"
 

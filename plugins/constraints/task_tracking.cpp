@@ -37,11 +37,7 @@ TaskTracking::TaskTracking(const Config& config, const RobotModel& robot)
 }
 
 void TaskTracking::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
-  REDRES_REQUIRE(ctx.r_d != nullptr && ctx.r_d_dot != nullptr, "task_tracking",
-                 "the context carries the desired r_d and r_d_dot");
-  const Eigen::Index rows = ctx.robot->reference_dim();
-  REDRES_REQUIRE(ctx.r_d->size() == rows && ctx.r_d_dot->size() == rows, "task_tracking",
-                 "r_d and r_d_dot have one entry per reference row (" + std::to_string(rows) + ")");
+  REDRES_REQUIRE(data != nullptr, "task_tracking", "its data is the one make_data() made");
   auto& terms = static_cast<TaskData&>(*data);
   task_.evaluate(ctx, terms);
   write_task_terms(task_, terms.rows, builder);

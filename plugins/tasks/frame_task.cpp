@@ -148,6 +148,7 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
   }
   all_task_rows_ = std::all_of(task_row_.begin(), task_row_.end(), [](int i) { return i >= 0; });
   any_task_rows_ = std::any_of(task_row_.begin(), task_row_.end(), [](int i) { return i >= 0; });
+  spatial_pose_ = robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows();
   for (const auto* bounds : {&config_.lower, &config_.upper}) {
     if (*bounds && static_cast<int>((*bounds)->size()) != rows()) {
       throw FieldError(
@@ -228,6 +229,36 @@ void FrameTask::start(PluginData* data) const {
   own.position_error = own.orientation_error = 0.0;
 }
 
+double FrameTask::write_task_row(const Context& ctx, int r, int task_row, const Eigen::Vector3d& e_path,
+                                 TaskTerms& t) const {
+  // The robot's task row: J's row, e = r_d - f(theta) (a spatial orientation's: the rotation vector of R_d R'), the
+  // path's velocity (and at the acceleration level its acceleration).
+  const KinematicsData& kin = *ctx.kinematics;
+  const Eigen::Index n = kin.J.cols(), m = kin.J.rows();
+  const int ref = reference_row_[static_cast<std::size_t>(r)];
+  for (Eigen::Index c = 0; c < n; ++c) t.J(r, c) = kin.J(task_row, c);
+  const double e = spatial_pose_ && ref >= 3 ? e_path(ref - 3) : (*ctx.r_d)(ref) - kin.f(ref);
+  t.error(r) = e;
+  const double k = gain_(r);
+  const double r_d_dot = (*ctx.r_d_dot)(ref);
+  if (ctx.order == ControlOrder::kVelocity) {
+    t.d(r) = r_d_dot + k * e;
+    return e;
+  }
+  // d = r_d_ddot - J_dot theta_dot + 2K (r_d_dot - J theta_dot) + K^2 e, with J_dot theta_dot summed as
+  // sum_j theta_dot_j (dJ/dtheta_j theta_dot).
+  const double* vel = ctx.theta_dot->data();
+  double jv = 0.0, jdv = 0.0;
+  for (Eigen::Index c = 0; c < n; ++c) jv += kin.J(task_row, c) * vel[c];
+  const double* dj = kin.dJ.data();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (vel[j] == 0.0) continue;
+    for (Eigen::Index c = 0; c < n; ++c) jdv += dj[(j * n + c) * m + task_row] * (vel[j] * vel[c]);
+  }
+  t.d(r) = (*ctx.r_d_ddot)(ref) - jdv + 2.0 * k * (r_d_dot - jv) + k * k * e;
+  return e;
+}
+
 void FrameTask::compute(const Context& ctx, TaskData& data) const {
   auto& own = static_cast<FrameTaskData&>(data);
   TaskTerms& t = own.rows;
@@ -236,6 +267,37 @@ void FrameTask::compute(const Context& ctx, TaskData& data) const {
   // Rows that are the robot's task rows read the kinematics and the path (bounds are on the frame's own position).
   const bool task_rows = any_task_rows_ && mode() != TaskMode::kInequality;
   const bool own_frame = !(task_rows && all_task_rows_);
+  // A task row's orientation error: the rotation vector of R_d R', R_d the path's orientation.
+  Eigen::Vector3d e_path = Eigen::Vector3d::Zero();
+  if (task_rows) {
+    REDRES_REQUIRE(ctx.r_d != nullptr && ctx.r_d_dot != nullptr && ctx.r_d->size() == robot.reference_dim() &&
+                       ctx.r_d_dot->size() == robot.reference_dim(),
+                   "frame task", "the context carries the path's r_d and r_d_dot, one entry per reference row");
+    if (spatial_pose_) {
+      e_path = orientation_error_vector(rotation_from_vector(ctx.r_d->tail<3>()), kin.ee_pose.linear());
+    }
+  }
+  if (ctx.order == ControlOrder::kAcceleration) {
+    REDRES_REQUIRE(task_rows && all_task_rows_ && ctx.r_d_ddot != nullptr &&
+                       ctx.r_d_ddot->size() == robot.reference_dim() && ctx.theta_dot != nullptr &&
+                       ctx.theta_dot->size() == kin.J.cols() && kin.dJ.cols() == kin.J.cols() * kin.J.cols(),
+                   "frame task", "at the acceleration level the context carries r_d_ddot, theta_dot and dJ");
+  }
+  if (!own_frame) {
+    // The end-effector task: every row is one of the robot's task rows.
+    double pos2 = 0.0, rot2 = 0.0;
+    for (int r = 0; r < rows(); ++r) {
+      const double e = write_task_row(ctx, r, task_row_[static_cast<std::size_t>(r)], e_path, t);
+      (static_cast<int>(kinds_[static_cast<std::size_t>(r)]) < 3 ? pos2 : rot2) += e * e;
+    }
+    own.position_error = std::sqrt(pos2);
+    own.orientation_error = std::sqrt(rot2);
+    if (config_.damping > 0.0) {
+      t.sigma_min = smallest_singular_value(t.J);
+      t.damping = damping_term(t.sigma_min, config_.damping, config_.damping_threshold);
+    }
+    return;
+  }
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   if (own_frame) {
@@ -272,18 +334,6 @@ void FrameTask::compute(const Context& ctx, TaskData& data) const {
   const Eigen::Vector3d a_d = axis_target_ ? *axis_target_ : own.a0;
   Eigen::Vector3d e_rot = Eigen::Vector3d::Zero();
   if (own_frame && has_orientation_rows()) e_rot = orientation_error_vector(R_d, R);
-  // A task row's orientation error: the rotation vector of R_d R', R_d the path's orientation.
-  Eigen::Vector3d e_path = Eigen::Vector3d::Zero();
-  if (task_rows && robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows()) {
-    e_path = orientation_error_vector(rotation_from_vector(ctx.r_d->tail<3>()), kin.ee_pose.linear());
-  }
-  const bool acceleration = ctx.order == ControlOrder::kAcceleration;
-  if (acceleration) {
-    REDRES_REQUIRE(task_rows && all_task_rows_ && ctx.r_d_ddot != nullptr &&
-                       ctx.r_d_ddot->size() == robot.reference_dim() && ctx.theta_dot != nullptr &&
-                       ctx.theta_dot->size() == kin.J.cols() && kin.dJ.cols() == kin.J.cols() * kin.J.cols(),
-                   "frame task", "at the acceleration level the context carries r_d_ddot, theta_dot and dJ");
-  }
   // u, v: an orthonormal basis of the plane normal to a.
   Eigen::Vector3d u = a.unitOrthogonal();
   Eigen::Vector3d v = a.cross(u);
@@ -295,30 +345,8 @@ void FrameTask::compute(const Context& ctx, TaskData& data) const {
     const int i = static_cast<int>(kind);
     const int task_row = task_rows ? task_row_[static_cast<std::size_t>(r)] : -1;
     if (task_row >= 0) {
-      // The robot's task row: J's row, e = r_d - f(theta) (orientation: the rotation vector), the path's velocity.
-      const int ref = reference_row_[static_cast<std::size_t>(r)];
-      t.J.row(r) = kin.J.row(task_row);
-      const double e = robot.kind() == ChainKind::kSpatial && ref >= 3 ? e_path(ref - 3)
-                                                                          : (*ctx.r_d)(ref) - kin.f(ref);
-      t.error(r) = e;
+      const double e = write_task_row(ctx, r, task_row, e_path, t);
       (i < 3 ? pos2 : rot2) += e * e;
-      const double r_d_dot = (*ctx.r_d_dot)(ref);
-      if (!acceleration) {
-        t.d(r) = r_d_dot + k * e;
-        continue;
-      }
-      // d = r_d_ddot - J_dot theta_dot + 2K (r_d_dot - J theta_dot) + K^2 e, with J_dot theta_dot summed as
-      // sum_j theta_dot_j (dJ/dtheta_j theta_dot).
-      const Eigen::Index n = kin.J.cols(), m = kin.J.rows();
-      const double* vel = ctx.theta_dot->data();
-      double jv = 0.0, jdv = 0.0;
-      for (Eigen::Index c = 0; c < n; ++c) jv += kin.J(task_row, c) * vel[c];
-      const double* dj = kin.dJ.data();
-      for (Eigen::Index j = 0; j < n; ++j) {
-        if (vel[j] == 0.0) continue;
-        for (Eigen::Index c = 0; c < n; ++c) jdv += dj[(j * n + c) * m + task_row] * (vel[j] * vel[c]);
-      }
-      t.d(r) = (*ctx.r_d_ddot)(ref) - jdv + 2.0 * k * (r_d_dot - jv) + k * k * e;
       continue;
     }
     double e = 0.0, feedforward = 0.0;

@@ -1,5 +1,6 @@
 #include "redres/control/task.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -106,8 +107,18 @@ int write_task_terms(const Task& task, const TaskTerms& t, QpBuilder& builder, i
       if (least_squares) {
         builder.add_least_squares(t.J, t.d, task.weight());
       } else {
-        builder.equality_matrix().leftCols(n) = t.J;
-        builder.equality_rhs() = t.d;
+        // Column by column into the QP's J (column-major, leading dimension m_eq): the end-effector task's rows are
+        // written at every step, by a copy as cheap as the rows themselves.
+        auto J = builder.equality_matrix();
+        const Eigen::Index m = t.J.rows(), ld = J.outerStride();
+        const double* from = t.J.data();
+        double* to = J.data();
+        if (ld == m) {
+          std::copy_n(from, m * n, to);
+        } else {
+          for (Eigen::Index c = 0; c < n; ++c) std::copy_n(from + c * m, m, to + c * ld);
+        }
+        std::copy_n(t.d.data(), m, builder.equality_rhs().data());
       }
       break;
     case TaskMode::kInequality: {

@@ -89,6 +89,9 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
  private:
   enum class Row { kX, kY, kZ, kWx, kWy, kWz, kAxisU, kAxisV };
   void compute(const Context& ctx, TaskData& data) const override;
+  // Writes row r as the robot's task row `task_row` (J, error, d; e_path: the orientation error of a spatial pose
+  // task's rows); returns its error.
+  double write_task_row(const Context& ctx, int r, int task_row, const Eigen::Vector3d& e_path, TaskTerms& t) const;
   [[nodiscard]] bool has_position_rows() const;
   [[nodiscard]] bool has_orientation_rows() const;
 
@@ -100,6 +103,7 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
   std::vector<int> task_row_, reference_row_;
   bool all_task_rows_ = false;  // every row is a task row: the frame's own pose and Jacobian are not needed
   bool any_task_rows_ = false;
+  bool spatial_pose_ = false;  // the robot's reference has a spatial orientation (a rotation vector in rows 3 to 5)
   Eigen::VectorXd gain_;
   Eigen::Vector3d point_, axis_;
   std::optional<Eigen::Vector3d> axis_target_;

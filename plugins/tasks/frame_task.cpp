@@ -237,7 +237,8 @@ double FrameTask::write_task_row(const Context& ctx, int r, int task_row, const 
   const Eigen::Index n = kin.J.cols(), m = kin.J.rows();
   const int ref = reference_row_[static_cast<std::size_t>(r)];
   for (Eigen::Index c = 0; c < n; ++c) t.J(r, c) = kin.J(task_row, c);
-  const double e = spatial_pose_ && ref >= 3 ? e_path(ref - 3) : (*ctx.r_d)(ref) - kin.f(ref);
+  const Eigen::VectorXd& r_d = *ctx.r_d;
+  const double e = spatial_pose_ && ref >= 3 ? e_path(ref - 3) : r_d(ref) - kin.f(ref);
   t.error(r) = e;
   const double k = gain_(r);
   const double r_d_dot = (*ctx.r_d_dot)(ref);
@@ -255,7 +256,8 @@ double FrameTask::write_task_row(const Context& ctx, int r, int task_row, const 
     if (vel[j] == 0.0) continue;
     for (Eigen::Index c = 0; c < n; ++c) jdv += dj[(j * n + c) * m + task_row] * (vel[j] * vel[c]);
   }
-  t.d(r) = (*ctx.r_d_ddot)(ref) - jdv + 2.0 * k * (r_d_dot - jv) + k * k * e;
+  const Eigen::VectorXd& r_d_ddot = *ctx.r_d_ddot;
+  t.d(r) = r_d_ddot(ref) - jdv + 2.0 * k * (r_d_dot - jv) + k * k * e;
   return e;
 }
 

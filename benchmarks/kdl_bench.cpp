@@ -19,6 +19,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "bench_counters.hpp"
 #include "redres/run/simulation.hpp"
 
 namespace redres {
@@ -77,11 +78,6 @@ void check_same_arm(const RobotModel& robot, KDL::Chain& chain, const Eigen::Vec
   }
 }
 
-void per_step(benchmark::State& state, int steps) {
-  state.counters["per_step"] =
-      benchmark::Counter(steps + 1, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
-}
-
 void BM_PandaHelix_Redres(benchmark::State& state) {
   Helix h = helix();
   for (auto _ : state) {
@@ -89,7 +85,7 @@ void BM_PandaHelix_Redres(benchmark::State& state) {
     if (run.failures != 0) state.SkipWithError(run.first_failure.c_str());
     benchmark::DoNotOptimize(run.trajectory.values().data());
   }
-  per_step(state, h.scenario.steps());
+  set_per_step(state, h.scenario.steps() + 1);
 }
 
 void BM_PandaHelix_KdlJacPinv(benchmark::State& state) {
@@ -121,7 +117,7 @@ void BM_PandaHelix_KdlJacPinv(benchmark::State& state) {
     }
     benchmark::DoNotOptimize(q.data.data());
   }
-  per_step(state, steps);
+  set_per_step(state, steps + 1);
 }
 
 void BM_PandaHelix_KdlIkVelPinv(benchmark::State& state) {
@@ -146,7 +142,7 @@ void BM_PandaHelix_KdlIkVelPinv(benchmark::State& state) {
     }
     benchmark::DoNotOptimize(q.data.data());
   }
-  per_step(state, steps);
+  set_per_step(state, steps + 1);
 }
 
 BENCHMARK(BM_PandaHelix_Redres)->Name("BM_PandaHelix/redres_newton")->Unit(benchmark::kMillisecond);

@@ -12,6 +12,8 @@
 #include <benchmark/benchmark.h>
 #include <pybind11/embed.h>
 
+#include "bench_counters.hpp"
+
 namespace py = pybind11;
 
 namespace {
@@ -69,9 +71,7 @@ void BM_PaperRun(benchmark::State& state, const char* objective, const char* eng
     if (result.attr("failures").cast<int>() != 0) state.SkipWithError("the run has failed steps");
     benchmark::DoNotOptimize(result.ptr());
   }
-  // Seconds per step (printed with an SI prefix, e.g. 1.25u = 1.25 us).
-  state.counters["per_step"] = benchmark::Counter(
-      static_cast<double>(steps), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  redres::set_per_step(state, static_cast<double>(steps));
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench_counters.hpp"
 #include "random_chain.hpp"
 #include "redres/constraints/joint_angle_margin.hpp"
 #include "redres/constraints/joint_velocity_limits.hpp"
@@ -93,8 +94,7 @@ void BM_Scaling(benchmark::State& state, const char* engine_name, bool planar, d
     }
     benchmark::DoNotOptimize(theta.data());
   }
-  state.counters["per_step"] =
-      benchmark::Counter(steps, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  set_per_step(state, steps);
   state.counters["failed_steps"] = failures;
   state.counters["iterations_per_step"] =
       benchmark::Counter(static_cast<double>(iterations) / steps, benchmark::Counter::kAvgIterations);

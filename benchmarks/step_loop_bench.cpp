@@ -20,6 +20,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench_counters.hpp"
 #include "paper_baseline_setup.hpp"
 #include "redres/run/simulation.hpp"
 
@@ -29,11 +30,6 @@ namespace {
 Scenario paper_scenario(const char* engine) {
   return load_scenario(std::string(REDRES_SOURCE_DIR) + "/configs/paper_r_tvcmm.toml",
                        {"step=0.001", std::string("solver.engine=") + engine});
-}
-
-void per_step(benchmark::State& state, int steps) {
-  state.counters["per_step"] =
-      benchmark::Counter(steps + 1, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 // in_loop: the letter evaluated in the loop (run_letter_r); otherwise the path from the table (run).
@@ -48,7 +44,7 @@ void BM_PaperRun_Baseline(benchmark::State& state, bool in_loop) {
         in_loop ? baseline::run_letter_r(c.arm, c.letter, c.theta0, c.steps, c.tau, record)
                 : baseline::run(c.arm, c.theta0, c.r_d.data(), c.r_d_dot.data(), c.steps, c.tau, record));
   }
-  per_step(state, c.steps);
+  set_per_step(state, c.steps + 1);
 }
 
 void BM_PaperRun_Redres(benchmark::State& state, const char* engine, bool fresh) {
@@ -60,7 +56,7 @@ void BM_PaperRun_Redres(benchmark::State& state, const char* engine, bool fresh)
     if (run.failures != 0) state.SkipWithError(run.first_failure.c_str());
     benchmark::DoNotOptimize(run.trajectory.values().data());
   }
-  per_step(state, s.steps());
+  set_per_step(state, s.steps() + 1);
 }
 
 void BM_PaperRun_RedresNoRecord(benchmark::State& state) {
@@ -78,7 +74,7 @@ void BM_PaperRun_RedresNoRecord(benchmark::State& state) {
     }
     benchmark::DoNotOptimize(theta.data());
   }
-  per_step(state, steps);
+  set_per_step(state, steps + 1);
 }
 
 BENCHMARK_CAPTURE(BM_PaperRun_Baseline, in_loop, true)->Name("BM_PaperRun/baseline")->Unit(benchmark::kMillisecond);

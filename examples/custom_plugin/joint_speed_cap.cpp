@@ -48,7 +48,7 @@ class JointSpeedCap final : public redres::Configured<redres::Constraint, JointS
   }
 };
 
-const bool kRegistered =
+const bool kJointSpeedCapRegistered =
     redres::constraint_registry().add_plugin<JointSpeedCap>("|x_j| <= cap for chosen joints (inequality rows)");
 
 }  // namespace

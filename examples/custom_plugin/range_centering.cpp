@@ -47,7 +47,7 @@ class RangeCentering final : public redres::Configured<redres::Objective, RangeC
   Eigen::VectorXd mid_, inv_half_sq_;
 };
 
-const bool kRegistered =
+const bool kRangeCenteringRegistered =
     redres::objective_registry().add_plugin<RangeCentering>("zeta += lambda (theta - mid) / half_range^2");
 
 }  // namespace

@@ -9,8 +9,8 @@ namespace redres {
 namespace {
 const Rule<double> kFraction = rule<double>("in (0, 1]", [](double v) { return v > 0.0 && v <= 1.0; });
 
-struct Data final : PluginData {
-  explicit Data(int n) : a_lo(n), a_hi(n), j_lo(n), j_hi(n), lo(n), hi(n), zero(Eigen::VectorXd::Zero(n)) {}
+struct AccelerationData final : PluginData {
+  explicit AccelerationData(int n) : a_lo(n), a_hi(n), j_lo(n), j_hi(n), lo(n), hi(n), zero(Eigen::VectorXd::Zero(n)) {}
   Eigen::VectorXd a_lo, a_hi, j_lo, j_hi, lo, hi, zero;
 };
 }  // namespace
@@ -41,11 +41,13 @@ JointAccelerationLimits::JointAccelerationLimits(const Config& config, const Rob
   require_motion_limit(robot, robot.first_without_acceleration_limit(), "acceleration_limit", kType);
 }
 
-std::unique_ptr<PluginData> JointAccelerationLimits::make_data() const { return std::make_unique<Data>(n_); }
+std::unique_ptr<PluginData> JointAccelerationLimits::make_data() const {
+  return std::make_unique<AccelerationData>(n_);
+}
 
 void JointAccelerationLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
-  auto& d = static_cast<Data&>(*data);
+  auto& d = static_cast<AccelerationData&>(*data);
   const RobotModel& robot = *ctx.robot;
   const Eigen::VectorXd& theta = ctx.theta();
   // The laws at theta: as the Controller evaluated them for the step, or here where a caller's Context has none.
@@ -91,7 +93,7 @@ void JointAccelerationLimits::add_to(const Context& ctx, QpBuilder& builder, Plu
 }
 
 namespace {
-const bool kRegistered = constraint_registry().add_plugin<JointAccelerationLimits>(
+const bool kJointAccelerationLimitsRegistered = constraint_registry().add_plugin<JointAccelerationLimits>(
     "v + tau a^- <= theta_dot <= v + tau a^+ from the previous command v, and each joint able to stop before its "
     "position limits (the robot file's acceleration_limit; both levels)");
 }  // namespace

@@ -62,7 +62,7 @@ void JointAngleMargin::summarise(const RobotModel& robot, const Trajectory& run,
 }
 
 namespace {
-const bool kRegistered = constraint_registry().add_plugin<JointAngleMargin>(
+const bool kJointAngleMarginRegistered = constraint_registry().add_plugin<JointAngleMargin>(
     "kappa((theta^- + margin) - theta) <= x <= kappa((theta^+ - margin) - theta) (eq. 9 with a safety region)");
 }  // namespace
 

@@ -9,8 +9,8 @@
 namespace redres {
 
 namespace {
-struct Data final : PluginData {
-  explicit Data(int n) : j_lo(n), j_hi(n), lo(n), hi(n), zero(Eigen::VectorXd::Zero(n)) {}
+struct JerkData final : PluginData {
+  explicit JerkData(int n) : j_lo(n), j_hi(n), lo(n), hi(n), zero(Eigen::VectorXd::Zero(n)) {}
   Eigen::VectorXd j_lo, j_hi, lo, hi, zero;
 };
 }  // namespace
@@ -27,11 +27,11 @@ JointJerkLimits::JointJerkLimits(const Config& config, const RobotModel& robot)
   require_motion_limit(robot, robot.first_without_jerk_limit(), "jerk_limit", kType);
 }
 
-std::unique_ptr<PluginData> JointJerkLimits::make_data() const { return std::make_unique<Data>(n_); }
+std::unique_ptr<PluginData> JointJerkLimits::make_data() const { return std::make_unique<JerkData>(n_); }
 
 void JointJerkLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
-  auto& d = static_cast<Data&>(*data);
+  auto& d = static_cast<JerkData&>(*data);
   // The laws at theta: as the Controller evaluated them for the step, or here where a caller's Context has none.
   const Eigen::VectorXd* jerk_lo = ctx.jerk_lower;
   const Eigen::VectorXd* jerk_hi = ctx.jerk_upper;
@@ -63,7 +63,7 @@ void JointJerkLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData*
 }
 
 namespace {
-const bool kRegistered = constraint_registry().add_plugin<JointJerkLimits>(
+const bool kJointJerkLimitsRegistered = constraint_registry().add_plugin<JointJerkLimits>(
     "a_prev + tau j^- <= (theta_dot - theta_dot_prev) / tau <= a_prev + tau j^+ (the robot file's jerk_limit; both "
     "levels)");
 }  // namespace

@@ -39,7 +39,7 @@ void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder, PluginD
 }
 
 namespace {
-const bool kRegistered = constraint_registry().add_plugin<JointVelocityLimits>(
+const bool kJointVelocityLimitsRegistered = constraint_registry().add_plugin<JointVelocityLimits>(
     "scale theta_dot^-(theta) <= x <= scale theta_dot^+(theta): the robot's velocity-limit laws (eq. 8, VJVL)");
 }  // namespace
 

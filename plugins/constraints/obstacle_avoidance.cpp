@@ -318,7 +318,7 @@ ObstacleAvoidanceConfig example() {
   return c;
 }
 
-const bool kRegistered = constraint_registry().add_plugin<ObstacleAvoidance>(
+const bool kObstacleAvoidanceRegistered = constraint_registry().add_plugin<ObstacleAvoidance>(
     "n' J_p x >= -xi (d - d_s)/(d_i - d_s) + n' v_obstacle: links kept away from obstacles (FCL distances)", example());
 }  // namespace
 

@@ -108,7 +108,7 @@ std::string SelfCollision::describe_inequality_row(const PluginData* data, int r
 }
 
 namespace {
-const bool kRegistered = constraint_registry().add_plugin<SelfCollision>(
+const bool kSelfCollisionRegistered = constraint_registry().add_plugin<SelfCollision>(
     "n' (J_a - J_b) x >= -xi (d - d_s)/(d_i - d_s): links kept away from each other (FCL distances)");
 }  // namespace
 

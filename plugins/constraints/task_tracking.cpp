@@ -54,7 +54,7 @@ void TaskTracking::summarise(const RobotModel& robot, const Trajectory& run, con
 }
 
 namespace {
-const bool kRegistered = constraint_registry().add_plugin<TaskTracking>(
+const bool kTaskTrackingRegistered = constraint_registry().add_plugin<TaskTracking>(
     "J x = r_d_dot + K (r_d - f(theta)) (eq. 6): the end-effector task with error feedback");
 }  // namespace
 

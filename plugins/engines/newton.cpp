@@ -172,7 +172,7 @@ void Newton::finish(SolverResult& result, SolverStatus status, int iterations, d
 
 namespace {
 
-const bool kRegistered = engine_registry().add<NewtonConfig>(
+const bool kNewtonRegistered = engine_registry().add<NewtonConfig>(
     "newton", "semismooth Newton on eq. 14 (exact; equality and inequality rows, bounds, any W > 0)",
     [](const NewtonConfig& /*config*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
       return std::make_unique<newton_internal::Newton>(s);

@@ -189,7 +189,7 @@ class NloptSlsqp final : public LviEngine {
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_;
 };
 
-const bool kRegistered = engine_registry().add<NloptConfig>(
+const bool kNloptRegistered = engine_registry().add<NloptConfig>(
     "nlopt", "NLopt SLSQP on the QP (independent cross-check; NLopt allocates its work array per solve)",
     [](const NloptConfig& /*config*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
       return std::make_unique<NloptSlsqp>(s);

@@ -311,7 +311,7 @@ class Projection final : public LviEngine {
   Eigen::VectorXd ux_, uy_, uz_, rx_, ry_, rz_, ex_, ey_, ez_, px_, py_, pz_, ry2_, py2_;
 };
 
-const bool kRegistered = engine_registry().add<ProjectionConfig>(
+const bool kProjectionRegistered = engine_registry().add<ProjectionConfig>(
     "projection", "the paper's eq. 15 (linear convergence; the reference for fidelity)",
     [](const ProjectionConfig& /*config*/, const SolverSettings& s) -> std::unique_ptr<LviEngine> {
       return std::make_unique<Projection>(s);

@@ -30,7 +30,7 @@ void JointCentering::add_to(const Context& ctx, QpBuilder& builder, PluginData* 
 }
 
 namespace {
-const bool kRegistered = objective_registry().add_plugin<JointCentering>(
+const bool kJointCenteringRegistered = objective_registry().add_plugin<JointCentering>(
     "zeta += lambda (theta - theta_ref): pulls the joints towards theta_ref (repetitive motion)");
 }  // namespace
 

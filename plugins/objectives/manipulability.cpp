@@ -108,7 +108,7 @@ void Manipulability::add_to(const Context& ctx, QpBuilder& builder, PluginData* 
 }
 
 namespace {
-const bool kRegistered = objective_registry().add_plugin<Manipulability>(
+const bool kManipulabilityRegistered = objective_registry().add_plugin<Manipulability>(
     "zeta += -p(t) grad w (eq. 5): maximises det(JJ'), sqrt(det(JJ')) or log det(JJ') with a coefficient schedule");
 }  // namespace
 

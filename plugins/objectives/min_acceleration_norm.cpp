@@ -23,7 +23,7 @@ void MinAccelerationNorm::add_to(const Context& ctx, QpBuilder& builder, PluginD
 }
 
 namespace {
-const bool kRegistered = objective_registry().add_plugin<MinAccelerationNorm>(
+const bool kMinAccelerationNormRegistered = objective_registry().add_plugin<MinAccelerationNorm>(
     "x'x/2 + damping theta_dot'x at the acceleration level (MAN); |x - theta_dot_prev|^2/2 at the velocity level");
 }  // namespace
 

@@ -17,7 +17,7 @@ void MinVelocityNorm::add_to(const Context& /*ctx*/, QpBuilder& builder, PluginD
 }
 
 namespace {
-const bool kRegistered =
+const bool kMinVelocityNormRegistered =
     objective_registry().add_plugin<MinVelocityNorm>("x'x/2: W += weight * I (MVN, the paper's p = 0)");
 }  // namespace
 

@@ -35,7 +35,7 @@ std::unique_ptr<PathGeometry> make_circle(const CircleConfig& c, const PathConte
   return g;
 }
 
-const bool kRegistered = path_registry().add<CircleConfig>(
+const bool kCircleRegistered = path_registry().add<CircleConfig>(
     "circle", "a circle through the path origin (planar, or in any plane with `normal`)", make_circle);
 
 }  // namespace

@@ -36,7 +36,7 @@ std::unique_ptr<PathGeometry> make_helix(const HelixConfig& c, const PathContext
   return g;
 }
 
-const bool kRegistered = path_registry().add<HelixConfig>(
+const bool kHelixRegistered = path_registry().add<HelixConfig>(
     "helix", "a helix through the path origin, advancing along `axis` (spatial tasks)", make_helix);
 
 }  // namespace

@@ -24,7 +24,7 @@ std::unique_ptr<PathGeometry> make_letter_r(const LetterRConfig& config, const P
   return g;
 }
 
-const bool kRegistered = path_registry().add<LetterRConfig>(
+const bool kLetterRRegistered = path_registry().add<LetterRConfig>(
     "letter_r",
     "the letter R of the paper's experiment (stem, bowl, leg; docs/letter_r.md); rotated 180 deg by default",
     make_letter_r);

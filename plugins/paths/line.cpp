@@ -22,7 +22,7 @@ std::unique_ptr<PathGeometry> make_line(const LineConfig& c, const PathContext& 
   return g;
 }
 
-const bool kRegistered =
+const bool kLineRegistered =
     path_registry().add<LineConfig>("line", "a straight line from the path origin (planar or spatial)", make_line);
 
 }  // namespace

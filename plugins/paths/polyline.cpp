@@ -62,7 +62,7 @@ std::unique_ptr<PathGeometry> make_polyline(const PolylineConfig& c, const PathC
   return std::make_unique<PathGeometry>(strokes_from(std::move(all), c.stop_at_corners));
 }
 
-const bool kRegistered = path_registry().add<PolylineConfig>(
+const bool kPolylineRegistered = path_registry().add<PolylineConfig>(
     "polyline", "planar lines ({to = [x, y]}) and arcs ({center = [x, y], sweep_deg = s}) from the path origin",
     make_polyline);
 

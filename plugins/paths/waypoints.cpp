@@ -41,7 +41,7 @@ std::unique_ptr<PathGeometry> make_waypoints(const WaypointsConfig& c, const Pat
   return g;
 }
 
-const bool kRegistered = path_registry().add<WaypointsConfig>(
+const bool kWaypointsRegistered = path_registry().add<WaypointsConfig>(
     "waypoints", "lines through CSV waypoints (columns x,y[,z]), relative to the path origin", make_waypoints);
 
 }  // namespace

@@ -72,7 +72,7 @@ void Posture::summarise(const RobotModel& /*robot*/, const Trajectory& run, cons
 }
 
 namespace {
-const bool kRegistered =
+const bool kPostureRegistered =
     task_registry().add_plugin<Posture>("the joints towards a configuration, weighted per joint (theta_ref - theta)");
 }  // namespace
 

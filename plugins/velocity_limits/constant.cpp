@@ -22,7 +22,7 @@ std::string ConstantLaw::describe() const {
 }
 
 namespace {
-const bool kRegistered =
+const bool kConstantRegistered =
     velocity_limit_registry().add_plugin<ConstantLaw>("limits that do not depend on the joint position");
 }  // namespace
 

@@ -44,7 +44,7 @@ std::string ExpressionLaw::describe() const {
 }
 
 namespace {
-const bool kRegistered =
+const bool kExpressionRegistered =
     velocity_limit_registry().add_plugin<ExpressionLaw>("limits given as muParser formulas of theta");
 }  // namespace
 

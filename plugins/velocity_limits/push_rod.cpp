@@ -45,7 +45,7 @@ std::optional<UndefinedAt> PushRodLaw::undefined_in(double lo, double hi) const 
 }
 
 namespace {
-const bool kRegistered = velocity_limit_registry().add_plugin<PushRodLaw>(
+const bool kPushRodRegistered = velocity_limit_registry().add_plugin<PushRodLaw>(
     "push-rod joint, eq. 2: s sigma sqrt(a^2 + b^2 + 2ab sin(theta)) / (ab cos(theta))");
 }  // namespace
 

@@ -96,7 +96,7 @@ std::optional<UndefinedAt> TableLaw::undefined_in(double lo, double hi) const {
 }
 
 namespace {
-const bool kRegistered =
+const bool kTableRegistered =
     velocity_limit_registry().add_plugin<TableLaw>("limits piecewise linear in theta, inline or from a CSV file");
 }  // namespace
 

@@ -132,7 +132,9 @@ TEST(SweepLimits, MergeRefusesTablesOfDifferentSweeps) {
   const Cli ok = redres("sweep --merge '" + (dir / "s").string() + "' --out '" + (dir / "m").string() + "'");
   EXPECT_EQ(ok.code, 0) << ok.out;
   std::ifstream meta(dir / "m" / "sweep.json");
-  EXPECT_EQ(nlohmann::json::parse(meta).value("identity", ""), sweep_identity(load_sweep(a)));
+  const nlohmann::json merged = nlohmann::json::parse(meta);
+  ASSERT_TRUE(merged.contains("identity") && merged["identity"].is_string()) << merged.dump();
+  EXPECT_EQ(merged["identity"].get<std::string>(), sweep_identity(load_sweep(a)));
   // A table without its description cannot be told apart: refused.
   std::filesystem::remove(dir / "s" / "sweep-shard-0-of-2.json");
   const Cli blind = redres("sweep --merge '" + (dir / "s").string() + "' --out '" + (dir / "n").string() + "'");

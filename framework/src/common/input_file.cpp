@@ -12,9 +12,8 @@
 
 namespace redres {
 
-namespace {
-
-std::string kind_of(mode_t mode) {
+const char* file_kind(mode_t mode) {
+  if (S_ISLNK(mode)) return "a symbolic link";
   if (S_ISDIR(mode)) return "a directory";
   if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
   if (S_ISCHR(mode)) return "a character device";
@@ -22,6 +21,8 @@ std::string kind_of(mode_t mode) {
   if (S_ISSOCK(mode)) return "a socket";
   return "not a regular file";
 }
+
+namespace {
 
 // Closes the descriptor on every path out.
 struct Descriptor {
@@ -46,7 +47,7 @@ std::string read_input_file(const std::filesystem::path& path, const char* what,
   }
   struct stat st {};
   if (::fstat(d.fd, &st) != 0) fail(std::string("cannot be read: ") + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) fail("is " + kind_of(st.st_mode) + ", expected a regular file");
+  if (!S_ISREG(st.st_mode)) fail("is " + std::string(file_kind(st.st_mode)) + ", expected a regular file");
   const auto size = static_cast<std::uintmax_t>(st.st_size);
   if (size > max_bytes) {
     fail("is " + std::to_string(size) + " bytes, more than the " + std::to_string(max_bytes) +

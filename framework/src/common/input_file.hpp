@@ -5,6 +5,8 @@
 /// (`/dev/zero`) or an oversized file is a ConfigError that says which, before anything is read, and a FIFO never
 /// blocks the reader.
 
+#include <sys/types.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -14,6 +16,10 @@ namespace redres {
 /// The largest input file read, in bytes (16 MiB). Robot and scenario files are a few kilobytes; the largest
 /// tables and URDF files in common use are well below this.
 inline constexpr std::uintmax_t kMaxInputFileBytes = std::uintmax_t{16} << 20;
+
+/// What a file that is not a regular file is, for messages ("a directory", "a symbolic link", "a FIFO (named pipe)",
+/// ...), from its `st_mode`.
+[[nodiscard]] const char* file_kind(mode_t mode);
 
 /// The contents of `path`, of at most `max_bytes` bytes. `what` names the kind of file in messages ("robot file",
 /// "CSV file"). Throws ConfigError at `path` when it does not exist, cannot be read, is not a regular file, or is

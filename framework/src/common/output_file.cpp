@@ -13,6 +13,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/input_file.hpp"
+
 namespace redres {
 
 namespace {
@@ -30,22 +32,13 @@ std::string fresh_suffix() {
   return text;
 }
 
-const char* kind_of(mode_t mode) {
-  if (S_ISLNK(mode)) return "a symbolic link";
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
-  return "not a regular file";
-}
-
 }  // namespace
 
 void require_replaceable(const std::filesystem::path& file, const std::string& what) {
   struct stat st {};
   if (::lstat(file.c_str(), &st) != 0) return;  // missing: fine
   if (S_ISREG(st.st_mode)) return;
-  throw std::runtime_error(what + " " + file.string() + " is " + kind_of(st.st_mode) +
+  throw std::runtime_error(what + " " + file.string() + " is " + file_kind(st.st_mode) +
                            "; redres writes only regular files and never replaces or follows anything else (remove "
                            "it, or choose another output directory)");
 }

@@ -215,7 +215,7 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& file, const s
         if (size[k] == 4) {
           float v = 0.0F;
           std::memcpy(&v, record + offset[k], 4);
-          p(static_cast<Eigen::Index>(k)) = v;
+          p(static_cast<Eigen::Index>(k)) = static_cast<double>(v);
         } else {
           std::memcpy(&p(static_cast<Eigen::Index>(k)), record + offset[k], 8);
         }
@@ -283,7 +283,7 @@ std::vector<Eigen::Vector3d> read_ply(const std::filesystem::path& file, const s
     const aiMesh* mesh = scene->mMeshes[m];
     for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
       const aiVector3D& a = mesh->mVertices[v];
-      const Eigen::Vector3d p(a.x, a.y, a.z);
+      const Eigen::Vector3d p(static_cast<double>(a.x), static_cast<double>(a.y), static_cast<double>(a.z));
       if (!p.allFinite()) fail(file, "vertex " + std::to_string(v + 1) + " has a coordinate that is not finite");
       points.push_back(p);
     }

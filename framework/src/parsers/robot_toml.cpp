@@ -226,12 +226,12 @@ const Schema<RobotReading>& RobotReading::schema() {
           "the configuration a scenario starts from unless it sets theta0",
           [](const TableReader& r, C& c) {
             if (!r.has("home")) return;
-            RobotSpec& spec = c.spec;
-            const auto n = static_cast<Eigen::Index>(spec.joints.size());
+            RobotSpec& robot = c.spec;
+            const auto n = static_cast<Eigen::Index>(robot.joints.size());
             const std::vector<double> h = r.numbers("home", static_cast<std::size_t>(n));
-            spec.home = Eigen::Map<const Eigen::VectorXd>(h.data(), n);
-            for (std::size_t j = 0; j < spec.joints.size(); ++j) {
-              const JointSpec& jt = spec.joints[j];
+            robot.home = Eigen::Map<const Eigen::VectorXd>(h.data(), n);
+            for (std::size_t j = 0; j < robot.joints.size(); ++j) {
+              const JointSpec& jt = robot.joints[j];
               if (h[j] < jt.lower || h[j] > jt.upper) {
                 r.fail("home", "expected joint '" + jt.name + "' within its limits [" + num(jt.lower) + ", " +
                                    num(jt.upper) + "], got " + num(h[j]));

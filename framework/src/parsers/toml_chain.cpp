@@ -73,11 +73,11 @@ const Schema<JointReading>& JointReading::schema() {
           "the link's collision shapes, in the joint's frame (self-collision, obstacle avoidance)",
           [](const TableReader& r, C& c) {
             if (!r.has("collision")) return;
-            JointSpec& jt = c.jt;
-            config_io::read(r, "collision", jt.collision);
-            for (std::size_t k = 0; k < jt.collision.size(); ++k) {
-              const ShapeSpec& sh = jt.collision[k];
-              const std::string which = "joint '" + jt.name + "': key 'collision': shape " + std::to_string(k + 1);
+            JointSpec& joint = c.jt;
+            config_io::read(r, "collision", joint.collision);
+            for (std::size_t k = 0; k < joint.collision.size(); ++k) {
+              const ShapeSpec& sh = joint.collision[k];
+              const std::string which = "joint '" + joint.name + "': key 'collision': shape " + std::to_string(k + 1);
               if (sh.velocity) {
                 throw ConfigError(r.location("collision"), which + " has a velocity; only obstacles move");
               }

@@ -154,7 +154,8 @@ void add_visuals(const Namer& names, const urdf::Link& link, const Eigen::Isomet
     u.length = g.length;
     if (v->material) {
       const urdf::Color& c = v->material->color;
-      const std::array<double, 4> rgba{c.r, c.g, c.b, c.a};
+      const std::array<double, 4> rgba{static_cast<double>(c.r), static_cast<double>(c.g), static_cast<double>(c.b),
+                                       static_cast<double>(c.a)};
       if (std::all_of(rgba.begin(), rgba.end(), [](double x) { return std::isfinite(x) && x >= 0.0 && x <= 1.0; })) {
         u.rgba = rgba;
       }

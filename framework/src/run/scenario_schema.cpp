@@ -121,12 +121,12 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                  if (r.has("theta0") && r.raw().get("theta0")->is_table()) {
                    const TableReader t = r.table("theta0");
                    const TableReader sub(t.file_ptr(), t.raw(), "theta0");
-                   Theta0Ik ik;
-                   ik.robot = c.s.robot.get();
-                   read_config(sub, Theta0Ik::schema(), ik);
+                   Theta0Ik theta_ik;
+                   theta_ik.robot = c.s.robot.get();
+                   read_config(sub, Theta0Ik::schema(), theta_ik);
                    sub.finish();
-                   c.s.theta0 = ik.seed;  // until the IK has run (the path reads where a relative path starts)
-                   c.ik = std::move(ik);
+                   c.s.theta0 = theta_ik.seed;  // until the IK has run (the path reads where a relative path starts)
+                   c.ik = std::move(theta_ik);
                    c.ik_where = r.location("theta0");
                    return;
                  }
@@ -143,19 +143,20 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
       entry<C>(
           "step", "number", "s", "", "tau, the control step",
           [](const TableReader& r, C& c) {
-            Scenario& s = c.s;
-            s.tau = r.number("step");
-            if (!(s.tau > 0.0 && s.tau <= s.duration)) r.fail("step", "expected a step 0 < tau <= duration");
-            if (!(s.duration / s.tau <= kMaxSteps)) {
+            Scenario& scenario = c.s;
+            scenario.tau = r.number("step");
+            if (!(scenario.tau > 0.0 && scenario.tau <= scenario.duration))
+              r.fail("step", "expected a step 0 < tau <= duration");
+            if (!(scenario.duration / scenario.tau <= kMaxSteps)) {
               std::ostringstream m;
               m << "expected at most " << static_cast<long long>(kMaxSteps)
-                << " steps, got duration / step = " << s.duration << " / " << s.tau << " = " << s.duration / s.tau
-                << " (use a longer step or a shorter duration)";
+                << " steps, got duration / step = " << scenario.duration << " / " << scenario.tau << " = "
+                << scenario.duration / scenario.tau << " (use a longer step or a shorter duration)";
               r.fail("step", m.str());
             }
-            if (std::abs(s.steps() * s.tau - s.duration) > 1e-9 * s.duration) {
+            if (std::abs(scenario.steps() * scenario.tau - scenario.duration) > 1e-9 * scenario.duration) {
               r.fail("step", "expected a step that divides the duration (T / tau = " +
-                                 std::to_string(s.duration / s.tau) + ")");
+                                 std::to_string(scenario.duration / scenario.tau) + ")");
             }
           },
           "0 < step <= duration, dividing it; duration / step <= 1e7")
@@ -168,11 +169,11 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                }),
       entry<C>("path", "table", "", "", "the desired path r_d(t); its keys are its type's (redres plugins)",
                [](const TableReader& r, C& c) {
-                 Scenario& s = c.s;
-                 KinematicsData k(*s.robot);
-                 compute_kinematics(*s.robot, s.theta0, k, KinematicsLevel::kPosition);
+                 Scenario& scenario = c.s;
+                 KinematicsData k(*scenario.robot);
+                 compute_kinematics(*scenario.robot, scenario.theta0, k, KinematicsLevel::kPosition);
                  PathContext pc;
-                 pc.dim = s.robot->kind() == ChainKind::kPlanar ? 2 : 3;
+                 pc.dim = scenario.robot->kind() == ChainKind::kPlanar ? 2 : 3;
                  pc.start.head(pc.dim) = k.f.head(pc.dim);
                  if (c.ik && c.ik->ik.from_path) {
                    // The target is where the path starts, which a relative path puts wherever the arm is.
@@ -186,18 +187,19 @@ const Schema<ScenarioReading>& ScenarioReading::schema() {
                  } else if (c.ik) {
                    pc.start.head(pc.dim) = c.ik->ik.position.head(pc.dim);  // where the IK puts the end effector
                  }
-                 pc.duration = s.duration;
+                 pc.duration = scenario.duration;
                  const TableReader path_table = r.table("path");
-                 s.path = make_path(TableReader(path_table.file_ptr(), path_table.raw(), "path"), pc);
+                 scenario.path = make_path(TableReader(path_table.file_ptr(), path_table.raw(), "path"), pc);
                })
           .required(),
       entry<C>("objectives", "array of tables [[objectives]]", "", "",
                "the weighted objectives, at least one; their keys are their type's (redres plugins)",
                [](const TableReader& r, C& c) {
-                 Scenario& s = c.s;
+                 Scenario& scenario = c.s;
                  // Reads `constraints` too: one scheme holds both.
-                 s.scheme = std::make_unique<Scheme>(Scheme::from_toml(r, *s.robot, s.duration, s.tau));
-                 check_scheme(r, s);
+                 scenario.scheme =
+                     std::make_unique<Scheme>(Scheme::from_toml(r, *scenario.robot, scenario.duration, scenario.tau));
+                 check_scheme(r, scenario);
                })
           .required(),
       entry<C>("constraints", "array of tables [[constraints]]", "", "none",

@@ -188,17 +188,17 @@ const Schema<Theta0Ik>& Theta0Ik::schema() {
            "where the iteration starts: the robot's home, zeros (clamped into the limits), or these joint "
            "positions (within the limits)",
            [](const TableReader& r, C& c) {
-             const RobotModel& robot = *c.robot;
-             c.seed = robot.home();
+             const RobotModel& model = *c.robot;
+             c.seed = model.home();
              if (!r.has("seed")) return;
              const toml::node& n = *r.raw().get("seed");
              const std::string expected =
-                 "expected \"home\", \"zeros\" or an array of " + std::to_string(robot.dof()) + " joint positions";
+                 "expected \"home\", \"zeros\" or an array of " + std::to_string(model.dof()) + " joint positions";
              if (const auto* text = n.as_string()) {
                c.seed_name = text->get();
                if (c.seed_name == "zeros") {
                  c.seed =
-                     Eigen::VectorXd::Zero(robot.dof()).cwiseMax(robot.lower_limits()).cwiseMin(robot.upper_limits());
+                     Eigen::VectorXd::Zero(model.dof()).cwiseMax(model.lower_limits()).cwiseMin(model.upper_limits());
                } else if (c.seed_name != "home") {
                  r.fail("seed", expected + ", got \"" + c.seed_name + "\"");
                }
@@ -206,7 +206,7 @@ const Schema<Theta0Ik>& Theta0Ik::schema() {
              }
              c.seed_name = "given";
              c.seed = read_joint_array(
-                 r, "seed", robot,
+                 r, "seed", model,
                  expected + ", got " + describe_type(n) +
                      (n.is_array() ? " of " + std::to_string(n.as_array()->size()) + " element(s)" : ""),
                  "theta0: ");

@@ -112,11 +112,12 @@ const Schema<Theta0Table>& Theta0Table::schema() {
                [](const TableReader& t, C& c) {
                  if (!t.has("list")) return;
                  if (t.has("samples")) t.fail("samples", "give either 'list' or 'samples', not both");
-                 const RobotModel& robot = *c.robot;
-                 const int n = robot.dof();
-                 const toml::array* list = t.raw().get("list")->as_array();
-                 if (list == nullptr || list->empty()) t.fail("list", "expected a non-empty array of configurations");
-                 for (const auto& entry : *list) {
+                 const RobotModel& model = *c.robot;
+                 const int n = model.dof();
+                 const toml::array* configurations = t.raw().get("list")->as_array();
+                 if (configurations == nullptr || configurations->empty())
+                   t.fail("list", "expected a non-empty array of configurations");
+                 for (const auto& entry : *configurations) {
                    const toml::array* q = entry.as_array();
                    if (q == nullptr || static_cast<int>(q->size()) != n) {
                      throw ConfigError(location_of(t.file(), entry), "key 'list': expected configurations of " +
@@ -135,8 +136,8 @@ const Schema<Theta0Table>& Theta0Table::schema() {
                        throw ConfigError(location_of(t.file(), el), "key 'list': " + std::string(e.what()));
                      }
                    }
-                   const bool inside = (theta.array() >= robot.lower_limits().array()).all() &&
-                                       (theta.array() <= robot.upper_limits().array()).all();
+                   const bool inside = (theta.array() >= model.lower_limits().array()).all() &&
+                                       (theta.array() <= model.upper_limits().array()).all();
                    if (!inside) throw ConfigError(location_of(t.file(), entry), "key 'list': outside the joint limits");
                    c.list.push_back(theta);
                  }
@@ -235,25 +236,25 @@ const Schema<SweepReading>& SweepReading::schema() {
                }),
       entry<C>("vary", "array of tables [[vary]] (below)", "", "none", "the axes of the grid",
                [](const TableReader& r, C& c) {
-                 SweepSpec& spec = c.spec;
+                 SweepSpec& sweep = c.spec;
                  if (r.has("vary")) {
                    for (const TableReader& t : r.tables("vary")) {
                      SweepAxis axis = read_axis(t);
-                     for (const auto& earlier : spec.axes) {
+                     for (const auto& earlier : sweep.axes) {
                        if (earlier.key == axis.key) {
                          t.fail("key", "'" + axis.key +
                                            "' is varied by an earlier [[vary]] already; one axis per key (a second "
                                            "would override the first one's values)");
                        }
                      }
-                     spec.axes.push_back(std::move(axis));
+                     sweep.axes.push_back(std::move(axis));
                    }
                  }
-                 if (!spec.zip) return;
-                 for (const auto& a : spec.axes) {
-                   if (a.values.size() != spec.axes.front().values.size()) {
-                     r.fail("combine", "\"zip\" needs axes of equal length: '" + spec.axes.front().key + "' has " +
-                                           std::to_string(spec.axes.front().values.size()) + " values, '" + a.key +
+                 if (!sweep.zip) return;
+                 for (const auto& a : sweep.axes) {
+                   if (a.values.size() != sweep.axes.front().values.size()) {
+                     r.fail("combine", "\"zip\" needs axes of equal length: '" + sweep.axes.front().key + "' has " +
+                                           std::to_string(sweep.axes.front().values.size()) + " values, '" + a.key +
                                            "' has " + std::to_string(a.values.size()));
                    }
                  }

@@ -55,7 +55,7 @@ std::unique_ptr<Path> path_for(const RobotModel& robot, const Eigen::VectorXd& t
   return make_path("helix", HelixConfig{.radius = 0.02, .pitch = 0.01, .turns = 1.0}, PathPlacement{}, ctx);
 }
 
-struct Case {
+struct RealTimeCase {
   const char* robot;
   M::Config manipulability;
   const char* engine;
@@ -67,7 +67,7 @@ TEST(ControllerRealTime, ThousandStepsWithEveryPerStepPluginAllocateNothing) {
   }
   // The push-rod arm (push_rod laws), a planar pose-task arm with every kind of velocity-limit law, and a 7-joint
   // spatial arm with a pose task; every manipulability measure and schedule, the expression schedule included.
-  const std::vector<Case> cases = {
+  const std::vector<RealTimeCase> cases = {
       {"robots/paper_pushrod_6dof.toml", {.schedule = M::Schedule::kSine}, "projection"},
       {"robots/paper_pushrod_6dof.toml", {.schedule = M::Schedule::kSmoothstep}, "newton"},
       {"tests/data/robots/planar_laws_pose.toml",
@@ -79,7 +79,7 @@ TEST(ControllerRealTime, ThousandStepsWithEveryPerStepPluginAllocateNothing) {
       {"robots/kuka_iiwa14.toml", {.p = 0.5, .measure = M::Measure::kYoshikawa}, "newton"},
       {"robots/kuka_iiwa14.toml", {.p = 0.1, .schedule = M::Schedule::kConstant}, "projection"},
   };
-  for (const Case& c : cases) {
+  for (const RealTimeCase& c : cases) {
     SCOPED_TRACE(std::string(c.robot) + " with " + c.engine);
     const RobotModel robot = load_robot(source_path(c.robot));
     const double T = 10.0, tau = 0.01;

@@ -70,12 +70,12 @@ const RecorderData& recorded(const Controller& c) {
   return *static_cast<const RecorderData*>(d.get());
 }
 
-struct Rig {
+struct StepRig {
   RobotModel robot = load_robot(source_path("robots/planar_4link.toml"));
   std::unique_ptr<Scheme> scheme;
   std::unique_ptr<LviEngine> engine = make_engine("newton");
   std::unique_ptr<Path> path;
-  explicit Rig(double speed) {
+  explicit StepRig(double speed) {
     std::vector<std::unique_ptr<Objective>> o;
     o.push_back(std::make_unique<MinVelocityNorm>(MinVelocityNorm::Config{}, robot));
     std::vector<std::unique_ptr<Constraint>> c;
@@ -94,7 +94,7 @@ struct Rig {
 };
 
 TEST(StepState, EachStepSeesTheCommandsHandedOutBeforeIt) {
-  Rig rig(1.0);
+  StepRig rig(1.0);
   Controller ctrl(rig.robot, *rig.scheme, *rig.engine, rig.path.get(), 1.0, 0.01);
   StepOutput out = ctrl.make_output();
   Eigen::VectorXd theta = rig.robot.home();
@@ -144,7 +144,7 @@ TEST(StepState, EachStepSeesTheCommandsHandedOutBeforeIt) {
 }
 
 TEST(StepState, HeunsSecondStageSeesTheSamePreviousCommandAndTheNextStepTheAverage) {
-  Rig rig(1.0);
+  StepRig rig(1.0);
   Controller ctrl(rig.robot, *rig.scheme, *rig.engine, rig.path.get(), 1.0, 0.01);
   StepOutput out = ctrl.make_output(), out2 = ctrl.make_output();
   Eigen::VectorXd theta = rig.robot.home();
@@ -164,7 +164,7 @@ TEST(StepState, HeunsSecondStageSeesTheSamePreviousCommandAndTheNextStepTheAvera
 
 TEST(StepState, AHeldStepLeavesAZeroCommand) {
   // A path far faster than the joints: steps fail and are held (theta_dot = 0), and the next step sees zeros.
-  Rig rig(40.0);
+  StepRig rig(40.0);
   Controller ctrl(rig.robot, *rig.scheme, *rig.engine, rig.path.get(), 1.0, 0.01);
   StepOutput out = ctrl.make_output();
   Eigen::VectorXd theta = rig.robot.home();

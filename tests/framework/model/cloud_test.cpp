@@ -28,21 +28,17 @@
 #include "redres/parsers/cloud_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
+#include "shape_samples.hpp"
 
 namespace redres {
 namespace {
+
+using testing::capsule;
 
 using testing::cloud_spec;
 using testing::sample_cloud;
 using testing::write_xyz;
 
-ShapeSpec capsule(double r, double l) {
-  ShapeSpec s;
-  s.shape = ShapeSpec::Kind::kCapsule;
-  s.radius = r;
-  s.length = l;
-  return s;
-}
 
 Eigen::Isometry3d random_pose(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);

@@ -12,21 +12,17 @@
 #include <gtest/gtest.h>
 
 #include "redres/model/collision.hpp"
+#include "shape_samples.hpp"
 
 namespace redres {
 namespace {
+
+using testing::capsule;
 
 ShapeSpec sphere(double r) {
   ShapeSpec s;
   s.shape = ShapeSpec::Kind::kSphere;
   s.radius = r;
-  return s;
-}
-ShapeSpec capsule(double r, double l) {
-  ShapeSpec s;
-  s.shape = ShapeSpec::Kind::kCapsule;
-  s.radius = r;
-  s.length = l;
   return s;
 }
 ShapeSpec cylinder(double r, double l) {

@@ -29,9 +29,12 @@
 #include "redres/run/scenario.hpp"
 #include "scenario_text.hpp"
 #include "test_util.hpp"
+#include "shape_samples.hpp"
 
 namespace redres {
 namespace {
+
+using testing::cube_obj;
 
 namespace fs = std::filesystem;
 using Eigen::Isometry3d;
@@ -640,21 +643,6 @@ TEST(ConvexDistance, AHullAgainstAPointCloud) {
   EXPECT_GT(reached, 0);  // some poses reach into the cloud
 }
 
-// A cube of side 2 centred on `c`, as an OBJ object named `name` (its vertices numbered from first + 1).
-std::string cube_obj(const std::string& name, const Vector3d& c, int first) {
-  std::string out = "o " + name + "\n";
-  for (int k = 0; k < 8; ++k) {
-    const Vector3d p = c + Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
-    out += "v " + std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + "\n";
-  }
-  const int f[12][3] = {{1, 3, 2}, {2, 3, 4}, {5, 6, 7}, {6, 8, 7}, {1, 2, 5}, {2, 6, 5},
-                        {3, 7, 4}, {4, 7, 8}, {1, 5, 3}, {3, 5, 7}, {2, 4, 6}, {4, 8, 6}};
-  for (const auto& t : f) {
-    out += "f " + std::to_string(t[0] + first) + " " + std::to_string(t[1] + first) + " " +
-           std::to_string(t[2] + first) + "\n";
-  }
-  return out;
-}
 
 const char* kArm = R"(<robot name="arm">
   <link name="base"/>

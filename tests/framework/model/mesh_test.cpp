@@ -15,9 +15,12 @@
 #include "redres/parsers/mesh_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
 #include "test_util.hpp"
+#include "shape_samples.hpp"
 
 namespace redres {
 namespace {
+
+using testing::cube_obj;
 
 namespace fs = std::filesystem;
 
@@ -85,21 +88,6 @@ TEST(FitCapsule, ARadiusNoLargerThanTheSmallestCircleAcrossTheAxis) {
   EXPECT_NEAR(*s.radius, 0.1, 1e-9);
 }
 
-// A cube of side 2 centred on `c`, as an OBJ object named `name`.
-std::string cube_obj(const std::string& name, const Eigen::Vector3d& c, int first) {
-  std::string out = "o " + name + "\n";
-  for (int k = 0; k < 8; ++k) {
-    const Eigen::Vector3d p = c + Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
-    out += "v " + std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + "\n";
-  }
-  const int f[12][3] = {{1, 3, 2}, {2, 3, 4}, {5, 6, 7}, {6, 8, 7}, {1, 2, 5}, {2, 6, 5},
-                        {3, 7, 4}, {4, 7, 8}, {1, 5, 3}, {3, 5, 7}, {2, 4, 6}, {4, 8, 6}};
-  for (const auto& t : f) {
-    out += "f " + std::to_string(t[0] + first) + " " + std::to_string(t[1] + first) + " " +
-           std::to_string(t[2] + first) + "\n";
-  }
-  return out;
-}
 
 TEST(Mesh, ReadThroughAssimpScaledWithItsPieces) {
   const fs::path dir = scratch_dir("mesh_read");

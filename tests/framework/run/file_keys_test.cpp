@@ -27,13 +27,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string read(const fs::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The listed keys of one table of one file.
 std::set<std::string> listed(const std::string& file, const std::string& table) {
   std::set<std::string> out;
@@ -83,7 +76,7 @@ TEST(FileKeys, TheDocsShowTheTablesTheSchemasMake) {
   for (const auto& [file, page] : {std::pair{"scenario", "docs/scenario_format.md"},
                                    std::pair{"robot", "docs/robot_format.md"}, std::pair{"sweep", "docs/sweeps.md"}}) {
     const std::string tables = file_keys_markdown(file);
-    EXPECT_NE(read(source_path(page)).find(tables), std::string::npos)
+    EXPECT_NE(read_text(source_path(page)).find(tables), std::string::npos)
         << page << " lacks the key tables of the " << file << " file (redres keys " << file
         << " --markdown prints them):\n"
         << tables;

@@ -20,15 +20,8 @@
 namespace redres {
 namespace {
 
-std::string read(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(OutputLists, TheDocsShowTheTablesTheListsMake) {
-  const std::string page = read(source_path("docs/output_formats.md"));
+  const std::string page = read_text(source_path("docs/output_formats.md"));
   const std::string columns = trajectory_columns_markdown();
   EXPECT_NE(page.find(columns), std::string::npos) << "docs/output_formats.md lacks the trajectory table:\n" << columns;
   const std::string fields = summary_fields_markdown();

@@ -104,6 +104,16 @@ std::string thrown(const std::exception_ptr& e) {
   }
 }
 
+// dlopen(library, RTLD_NOW | RTLD_LOCAL): RTLD_NOW, so that an unresolved symbol is reported here, not at the first
+// call in the middle of a run. dlopen is declared not to throw, so a compiler may drop the handler of a try around
+// it (clang does), and a library's initialiser's exception would pass it by; called through a volatile pointer of a
+// type that may throw, the callers' handlers stay.
+void* open_library(const std::filesystem::path& library) {
+  using OpenFn = void* (*)(const char*, int);
+  static OpenFn volatile dlopen_fn = &::dlopen;
+  return dlopen_fn(library.c_str(), RTLD_NOW | RTLD_LOCAL);
+}
+
 // An exception that the dynamic loader cannot pass on ends in std::terminate.
 [[noreturn]] void probe_terminate() {
   const std::exception_ptr e = std::current_exception();
@@ -141,7 +151,7 @@ Probe probe_library(const std::filesystem::path& library) {
     RegistrationScope scope{library.string(), {}, 0};
     current_registration_scope() = &scope;
     try {
-      void* handle = ::dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
+      void* handle = open_library(library);
       probe_write(handle != nullptr ? "K" : "D");
     } catch (...) {  // an exception that came through dlopen
       probe_write(("T" + thrown(std::current_exception())).c_str());
@@ -279,8 +289,7 @@ void load_plugin_library(const std::filesystem::path& library, const SourceLocat
   {
     const ScopeGuard guard(scope);
     try {
-      // RTLD_NOW: an unresolved symbol is reported here, not at the first call in the middle of a run.
-      handle = dlopen(canonical.c_str(), RTLD_NOW | RTLD_LOCAL);
+      handle = open_library(canonical);
     } catch (...) {  // the probe's load went well, this one did not: the library's initialisers differ each time
       for (RegistryBase* r : RegistryBase::all()) r->remove_origin(canonical.string());
       fail(where, library, "its static initialisers " + thrown(std::current_exception()));

@@ -27,8 +27,8 @@
 #include "redres/model/collision.hpp"
 #include "redres/parsers/cloud_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
-#include "test_util.hpp"
 #include "shape_samples.hpp"
+#include "test_util.hpp"
 
 namespace redres {
 namespace {
@@ -38,7 +38,6 @@ using testing::capsule;
 using testing::cloud_spec;
 using testing::sample_cloud;
 using testing::write_xyz;
-
 
 Eigen::Isometry3d random_pose(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);

@@ -28,8 +28,8 @@
 #include "redres/parsers/robot_toml.hpp"
 #include "redres/run/scenario.hpp"
 #include "scenario_text.hpp"
-#include "test_util.hpp"
 #include "shape_samples.hpp"
+#include "test_util.hpp"
 
 namespace redres {
 namespace {
@@ -642,7 +642,6 @@ TEST(ConvexDistance, AHullAgainstAPointCloud) {
   }
   EXPECT_GT(reached, 0);  // some poses reach into the cloud
 }
-
 
 const char* kArm = R"(<robot name="arm">
   <link name="base"/>

@@ -14,8 +14,8 @@
 #include "redres/model/mesh.hpp"
 #include "redres/parsers/mesh_file.hpp"
 #include "redres/parsers/robot_toml.hpp"
-#include "test_util.hpp"
 #include "shape_samples.hpp"
+#include "test_util.hpp"
 
 namespace redres {
 namespace {
@@ -87,7 +87,6 @@ TEST(FitCapsule, ARadiusNoLargerThanTheSmallestCircleAcrossTheAxis) {
   EXPECT_EQ(s.shape, ShapeSpec::Kind::kCapsule);
   EXPECT_NEAR(*s.radius, 0.1, 1e-9);
 }
-
 
 TEST(Mesh, ReadThroughAssimpScaledWithItsPieces) {
   const fs::path dir = scratch_dir("mesh_read");

@@ -47,8 +47,7 @@ const bool kRegistered = plant_registry().add(
 TEST(PlantInterface, APlantOfOneFileIsMadeByNameAndDrivenByTheOneLoop) {
   ASSERT_TRUE(kRegistered);
   const Scenario kinematic = load_scenario(source_path("configs/paper_r_tvcmm.toml"));
-  const Scenario half =
-      load_scenario(source_path("configs/paper_r_tvcmm.toml"), {"plant.kind=half_speed"});
+  const Scenario half = load_scenario(source_path("configs/paper_r_tvcmm.toml"), {"plant.kind=half_speed"});
   const RunResult a = simulate(kinematic);
   const RunResult b = simulate(half);
   ASSERT_EQ(a.trajectory.size(), b.trajectory.size());

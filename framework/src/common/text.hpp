@@ -2,6 +2,7 @@
 /// @file
 /// Small text helpers for messages (private to the framework).
 
+#include <cstdio>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -25,6 +26,13 @@ namespace redres {
   s.precision(10);
   s << v;
   return s.str();
+}
+
+/// An error code in hexadecimal, as EGL's and OpenGL's documentation write them ("0x3003").
+[[nodiscard]] inline std::string hex(long value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "0x%lx", static_cast<unsigned long>(value));
+  return text;
 }
 
 }  // namespace redres

@@ -4,26 +4,17 @@
 
 #include "plant/film_egl.hpp"
 
-#include <cstdio>
 #include <stdexcept>
 
 #include <EGL/eglext.h>
+
+#include "common/text.hpp"
 
 #ifndef EGL_PLATFORM_SURFACELESS_MESA
 #define EGL_PLATFORM_SURFACELESS_MESA 0x31DD
 #endif
 
 namespace redres::plant_detail {
-
-namespace {
-
-std::string hex(long value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "0x%lx", static_cast<unsigned long>(value));
-  return text;
-}
-
-}  // namespace
 
 EglContext::EglContext() {
   try {

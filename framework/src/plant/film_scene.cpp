@@ -6,20 +6,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
 
+#include "common/text.hpp"
+
 namespace redres::plant_detail {
 
 namespace {
-
-std::string hex(long value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "0x%lx", static_cast<unsigned long>(value));
-  return text;
-}
 
 constexpr double kAzimuth = 135.0;    // degrees
 constexpr double kElevation = -25.0;  // degrees: looking down

@@ -149,10 +149,6 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
   all_task_rows_ = std::all_of(task_row_.begin(), task_row_.end(), [](int i) { return i >= 0; });
   any_task_rows_ = std::any_of(task_row_.begin(), task_row_.end(), [](int i) { return i >= 0; });
   spatial_pose_ = robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows();
-  whole_task_ = !spatial_pose_ && rows() == robot.task_dim();
-  for (std::size_t r = 0; r < task_row_.size(); ++r) {
-    whole_task_ = whole_task_ && task_row_[r] == static_cast<int>(r) && reference_row_[r] == static_cast<int>(r);
-  }
   for (const auto* bounds : {&config_.lower, &config_.upper}) {
     if (*bounds && static_cast<int>((*bounds)->size()) != rows()) {
       throw FieldError(
@@ -292,21 +288,9 @@ void FrameTask::compute(const Context& ctx, TaskData& data) const {
   if (!own_frame) {
     // The end-effector task: every row is one of the robot's task rows.
     double pos2 = 0.0, rot2 = 0.0;
-    const Eigen::Index m = t.J.rows();
-    if (whole_task_ && ctx.order == ControlOrder::kVelocity && kin.J.rows() == m && kin.f.size() >= m) {
-      // The rows in the robot's order, at the velocity level: J, e = r_d - f and d = r_d_dot + K e at once (the same
-      // numbers, row by row, as write_task_row's).
-      t.J = kin.J;
-      t.error = ctx.r_d->head(m) - kin.f.head(m);
-      t.d = ctx.r_d_dot->head(m) + gain_.cwiseProduct(t.error);
-      for (Eigen::Index r = 0; r < m; ++r) {
-        (static_cast<int>(kinds_[static_cast<std::size_t>(r)]) < 3 ? pos2 : rot2) += t.error(r) * t.error(r);
-      }
-    } else {
-      for (int r = 0; r < rows(); ++r) {
-        const double e = write_task_row(ctx, r, task_row_[static_cast<std::size_t>(r)], e_path, t);
-        (static_cast<int>(kinds_[static_cast<std::size_t>(r)]) < 3 ? pos2 : rot2) += e * e;
-      }
+    for (int r = 0; r < rows(); ++r) {
+      const double e = write_task_row(ctx, r, task_row_[static_cast<std::size_t>(r)], e_path, t);
+      (static_cast<int>(kinds_[static_cast<std::size_t>(r)]) < 3 ? pos2 : rot2) += e * e;
     }
     own.position_error = std::sqrt(pos2);
     own.orientation_error = std::sqrt(rot2);

@@ -104,7 +104,6 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
   bool all_task_rows_ = false;  // every row is a task row: the frame's own pose and Jacobian are not needed
   bool any_task_rows_ = false;
   bool spatial_pose_ = false;  // the robot's reference has a spatial orientation (a rotation vector in rows 3 to 5)
-  bool whole_task_ = false;    // the rows are the robot's task rows in its order (a planar or position-only path)
   Eigen::VectorXd gain_;
   Eigen::Vector3d point_, axis_;
   std::optional<Eigen::Vector3d> axis_target_;

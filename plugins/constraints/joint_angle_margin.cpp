@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "redres/common/hot.hpp"
 #include "redres/run/trajectory.hpp"
 
 namespace redres {
@@ -29,7 +30,7 @@ std::unique_ptr<PluginData> JointAngleMargin::make_data() const {
   return std::make_unique<Workspace>(static_cast<int>(margin_.size()), 2);
 }
 
-void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
+REDRES_HOT void JointAngleMargin::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   REDRES_REQUIRE(data != nullptr, kType, "the controller made this plugin's data");
   Workspace& w = static_cast<Workspace&>(*data);
   Eigen::VectorXd& lo = w[0];

@@ -1,5 +1,6 @@
 #include "redres/constraints/joint_velocity_limits.hpp"
 
+#include "redres/common/hot.hpp"
 #include "redres/model/velocity_limit.hpp"
 
 namespace redres {
@@ -16,7 +17,7 @@ JointVelocityLimits::JointVelocityLimits(const Config& config, const RobotModel&
 
 std::unique_ptr<PluginData> JointVelocityLimits::make_data() const { return std::make_unique<Workspace>(n_, 2); }
 
-void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
+REDRES_HOT void JointVelocityLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   const double scale = config_.scale;
   if (ctx.order == ControlOrder::kVelocity && ctx.velocity_lower != nullptr && ctx.velocity_upper != nullptr) {
     if (scale == 1.0) {

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "redres/common/hot.hpp"
 #include "redres/run/trajectory.hpp"
 
 namespace redres {
@@ -36,10 +37,10 @@ TaskTracking::TaskTracking(const Config& config, const RobotModel& robot)
   task_.set_name(kType);
 }
 
-void TaskTracking::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
+REDRES_HOT void TaskTracking::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   REDRES_REQUIRE(data != nullptr, "task_tracking", "its data is the one make_data() made");
   auto& terms = static_cast<TaskData&>(*data);
-  task_.evaluate(ctx, terms);
+  task_.evaluate_unchecked(ctx, terms);  // its rows are the QP's, which the scheme scans
   write_task_terms(task_, terms.rows, builder);
 }
 

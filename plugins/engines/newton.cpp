@@ -37,6 +37,7 @@
 #include "redres/engines/newton.hpp"
 
 #include "newton_internal.hpp"
+#include "redres/common/hot.hpp"
 
 namespace redres {
 namespace newton_internal {
@@ -108,7 +109,7 @@ bool Newton::slack_rows_only(const QpProblem& qp) {
   return true;
 }
 
-void Newton::do_solve(const QpProblem& qp, SolverResult& result) {
+REDRES_HOT void Newton::do_solve(const QpProblem& qp, SolverResult& result) {
   // Inequality rows that are all zero with b >= 0 (the slack rows collision constraints leave for pairs out of
   // range) hold for every x with z = 0, so they do not stop the exact path.
   bool applicable = qp.w_diagonal && slack_rows_only(qp);
@@ -142,7 +143,7 @@ void Newton::do_solve(const QpProblem& qp, SolverResult& result) {
 }
 
 template <int kRows>
-void Newton::run(const QpProblem& qp, SolverResult& result) {
+REDRES_HOT void Newton::run(const QpProblem& qp, SolverResult& result) {
   if (!warm()) y_.setZero();
   int k = 0;
   double f2 = 0.0;
@@ -159,7 +160,7 @@ void Newton::run(const QpProblem& qp, SolverResult& result) {
   }
 }
 
-void Newton::finish(SolverResult& result, SolverStatus status, int iterations, double f2) const {
+REDRES_HOT void Newton::finish(SolverResult& result, SolverStatus status, int iterations, double f2) const {
   result.info.status = status;
   result.info.iterations = iterations;
   result.info.residual = std::sqrt(f2);

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "newton_internal.hpp"
+#include "redres/common/hot.hpp"
 
 namespace redres::newton_internal {
 
@@ -15,7 +16,7 @@ namespace redres::newton_internal {
 // breakpoints where some v_i crosses a bound). Returns +inf when phi' stays positive for ever: the dual is then
 // unbounded, which proves that J x = d cannot be met inside the bounds.
 template <int kRows>
-double Newton::exact_step(const QpProblem& qp) {
+REDRES_HOT double Newton::exact_step(const QpProblem& qp) {
   const int n = qp.n(), me = rows<kRows>(qp);
   const double* __restrict J = qp.J.data();
   const double* __restrict lo = qp.lo.data();

@@ -6,13 +6,14 @@
 #include <cstddef>
 
 #include "newton_internal.hpp"
+#include "redres/common/hot.hpp"
 
 namespace redres::newton_internal {
 
 // x(y), v(y), the free set, F(y) = J x(y) - d, G = J D W^-1 J' over the free joints (lower triangle, in G_) and
 // full_scale_ = the largest diagonal entry of J W^-1 J' (all joints), in one pass over the joints; returns |F|^2.
 template <int kRows>
-double Newton::evaluate(const QpProblem& qp) {
+REDRES_HOT double Newton::evaluate(const QpProblem& qp) {
   const int n = qp.n(), me = rows<kRows>(qp);
   const double* __restrict J = qp.J.data();
   const double* __restrict zeta = qp.zeta.data();
@@ -146,7 +147,7 @@ bool Newton::solve_newton_system(const QpProblem& qp, double prox) {
 // iterations taken in k. kInfeasible: the dual is unbounded along a step, or y left [-varpi, varpi] (then
 // clamped back); kStalled: no ascent, a Newton system that cannot be solved, or the iteration cap.
 template <int kRows>
-Newton::Reduced Newton::reduced_iterate(const QpProblem& qp, int& k, double& f2) {
+REDRES_HOT Newton::Reduced Newton::reduced_iterate(const QpProblem& qp, int& k, double& f2) {
   const int me = rows<kRows>(qp);
   double d_max = 0.0;
   for (int r = 0; r < me; ++r) d_max = std::max(d_max, std::abs(qp.d(r)));

@@ -22,6 +22,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "redres/common/hot.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/engines/projection.hpp"
 
@@ -53,7 +54,7 @@ class Projection final : public LviEngine {
     for (Eigen::VectorXd* v : {&uz_, &rz_, &ez_, &pz_}) v->setZero(m_i);
   }
 
-  void do_solve(const QpProblem& qp, SolverResult& result) override {
+  REDRES_HOT void do_solve(const QpProblem& qp, SolverResult& result) override {
     if (!warm()) {
       ux_.setZero();
       uy_.setZero();
@@ -103,7 +104,7 @@ class Projection final : public LviEngine {
   // lanes of an SSE2 register. The lanes are exactly the even/odd partial sums of iterate<>, and every operation
   // is the same IEEE operation in the same order (max/min with the operand order of std::max/std::min), so the
   // iterates are bit-identical to the scalar variants.
-  REDRES_NO_COVERAGE Outcome iterate_6x2_sse2(const QpProblem& qp) {
+  REDRES_HOT REDRES_NO_COVERAGE Outcome iterate_6x2_sse2(const QpProblem& qp) {
     const double varpi = settings().varpi;
     const double tol2 = settings().tolerance * settings().tolerance;
     const int max_iterations = settings().max_iterations;
@@ -188,7 +189,7 @@ class Projection final : public LviEngine {
 #endif
 
   template <bool kDiagonal, bool kInequalities, int kRows = 0, int kCols = 0>
-  REDRES_NO_COVERAGE Outcome iterate(const QpProblem& qp) {
+  REDRES_HOT REDRES_NO_COVERAGE Outcome iterate(const QpProblem& qp) {
     const int n = kCols > 0 ? kCols : qp.n(), me = kRows > 0 ? kRows : qp.m_eq(), mi = kInequalities ? qp.m_in() : 0;
     const double varpi = settings().varpi;
     const double tol2 = settings().tolerance * settings().tolerance;

@@ -1,4 +1,5 @@
 #include "redres/objectives/manipulability.hpp"
+#include "redres/common/hot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -61,7 +62,7 @@ void Manipulability::check_run(double T, double tau) const {
   }
 }
 
-double Manipulability::coefficient(double t, double T) const {
+REDRES_HOT double Manipulability::coefficient(double t, double T) const {
   const double p = config_.p;
   switch (config_.schedule) {
     case Schedule::kConstant: return p;
@@ -97,7 +98,7 @@ std::optional<double> Manipulability::potential(const Context& ctx) const {
   return -coefficient(ctx.t, ctx.T) * value;
 }
 
-void Manipulability::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
+REDRES_HOT void Manipulability::add_to(const Context& ctx, QpBuilder& builder, PluginData* /*data*/) const {
   const double p = coefficient(ctx.t, ctx.T);
   const KinematicsData& k = *ctx.kinematics;
   switch (config_.measure) {

@@ -1,4 +1,5 @@
 #include "redres/objectives/min_velocity_norm.hpp"
+#include "redres/common/hot.hpp"
 
 namespace redres {
 
@@ -12,7 +13,7 @@ MinVelocityNorm::MinVelocityNorm(const Config& config, const RobotModel& /*robot
 // W = I has no linear term: zeta stays zero, the gradient of a constant potential.
 std::optional<double> MinVelocityNorm::potential(const Context& /*ctx*/) const { return 0.0; }
 
-void MinVelocityNorm::add_to(const Context& /*ctx*/, QpBuilder& builder, PluginData* /*data*/) const {
+REDRES_HOT void MinVelocityNorm::add_to(const Context& /*ctx*/, QpBuilder& builder, PluginData* /*data*/) const {
   builder.add_identity();
 }
 

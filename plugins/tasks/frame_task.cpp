@@ -6,15 +6,13 @@
 
 #include <Eigen/Geometry>
 
+#include "redres/common/hot.hpp"
 #include "redres/model/frames.hpp"
 #include "redres/run/trajectory.hpp"
 
 namespace redres {
 
-namespace {
-
-constexpr const char* kRowNames[] = {"x", "y", "z", "wx", "wy", "wz", "axis_u", "axis_v"};
-
+/// A frame task's rows, with its pose at the first step and its errors.
 class FrameTaskData final : public TaskData {
  public:
   Eigen::Matrix<double, 6, Eigen::Dynamic> J6;   // the frame's [v; omega] Jacobian
@@ -24,6 +22,10 @@ class FrameTaskData final : public TaskData {
   Eigen::Vector3d a0 = Eigen::Vector3d::UnitZ();  // the axis's world direction at the start
   double position_error = 0.0, orientation_error = 0.0;
 };
+
+namespace {
+
+constexpr const char* kRowNames[] = {"x", "y", "z", "wx", "wy", "wz", "axis_u", "axis_v"};
 
 Eigen::Vector3d vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
@@ -148,6 +150,8 @@ FrameTask::FrameTask(const Config& config, const RobotModel& robot)
   }
   all_task_rows_ = std::all_of(task_row_.begin(), task_row_.end(), [](int i) { return i >= 0; });
   any_task_rows_ = std::any_of(task_row_.begin(), task_row_.end(), [](int i) { return i >= 0; });
+  in_order_ = all_task_rows_ && rows() == robot.task_dim();
+  for (int r = 0; r < rows() && in_order_; ++r) in_order_ = task_row_[static_cast<std::size_t>(r)] == r;
   spatial_pose_ = robot.kind() == ChainKind::kSpatial && robot.has_orientation_rows();
   for (const auto* bounds : {&config_.lower, &config_.upper}) {
     if (*bounds && static_cast<int>((*bounds)->size()) != rows()) {
@@ -229,8 +233,8 @@ void FrameTask::start(PluginData* data) const {
   own.position_error = own.orientation_error = 0.0;
 }
 
-double FrameTask::write_task_row(const Context& ctx, int r, int task_row, const Eigen::Vector3d& e_path,
-                                 TaskTerms& t) const {
+REDRES_HOT double FrameTask::write_task_row(const Context& ctx, int r, int task_row, const Eigen::Vector3d& e_path,
+                                            TaskTerms& t) const {
   // The robot's task row: J's row, e = r_d - f(theta) (a spatial orientation's: the rotation vector of R_d R'), the
   // path's velocity (and at the acceleration level its acceleration).
   const KinematicsData& kin = *ctx.kinematics;
@@ -261,8 +265,45 @@ double FrameTask::write_task_row(const Context& ctx, int r, int task_row, const 
   return e;
 }
 
-void FrameTask::compute(const Context& ctx, TaskData& data) const {
+REDRES_HOT void FrameTask::velocity_rows_in_order(const Context& ctx, FrameTaskData& own) const {
+  // The end-effector task at the velocity level, its rows the robot's task rows in their order (the paper's): J
+  // whole, then each row's e = r_d - f(theta) (a spatial orientation's: the rotation vector of R_d R') and
+  // d = r_d_dot + K e.
+  TaskTerms& t = own.rows;
+  const KinematicsData& kin = *ctx.kinematics;
+  const Eigen::Index reference = ctx.robot->reference_dim();
+  REDRES_REQUIRE(ctx.r_d != nullptr && ctx.r_d_dot != nullptr && ctx.r_d->size() == reference &&
+                     ctx.r_d_dot->size() == reference && kin.J.rows() == t.J.rows() && kin.J.cols() == t.J.cols(),
+                 "frame task",
+                 "the context carries the path's r_d and r_d_dot, one entry per reference row, and the robot's "
+                 "kinematics");
+  std::copy_n(kin.J.data(), kin.J.size(), t.J.data());
+  const double* r_d = ctx.r_d->data();
+  const double* r_d_dot = ctx.r_d_dot->data();
+  const double* f = kin.f.data();
+  Eigen::Vector3d e_path = Eigen::Vector3d::Zero();
+  if (spatial_pose_) e_path = orientation_error_vector(rotation_from_vector(ctx.r_d->tail<3>()), kin.ee_pose.linear());
+  double pos2 = 0.0, rot2 = 0.0;
+  const int k = rows();
+  for (int r = 0; r < k; ++r) {
+    const auto i = static_cast<std::size_t>(r);
+    const int ref = reference_row_[i];
+    const double e = spatial_pose_ && ref >= 3 ? e_path(ref - 3) : r_d[ref] - f[ref];
+    t.error(r) = e;
+    t.d(r) = r_d_dot[ref] + gain_(r) * e;
+    (static_cast<int>(kinds_[i]) < 3 ? pos2 : rot2) += e * e;
+  }
+  own.position_error = std::sqrt(pos2);
+  own.orientation_error = std::sqrt(rot2);
+}
+
+REDRES_HOT void FrameTask::compute(const Context& ctx, TaskData& data) const {
   auto& own = static_cast<FrameTaskData&>(data);
+  if (in_order_ && ctx.order == ControlOrder::kVelocity && mode() != TaskMode::kInequality &&
+      !(config_.damping > 0.0)) {
+    velocity_rows_in_order(ctx, own);
+    return;
+  }
   TaskTerms& t = own.rows;
   const RobotModel& robot = *ctx.robot;
   const KinematicsData& kin = *ctx.kinematics;

@@ -1,4 +1,5 @@
 #include "redres/velocity_limits/push_rod.hpp"
+#include "redres/common/hot.hpp"
 #include "redres/parsers/velocity_limit_registry.hpp"
 
 #include <cmath>
@@ -18,7 +19,7 @@ const Schema<PushRodLawConfig>& PushRodLawConfig::schema() {
   return s;
 }
 
-VelocityBounds PushRodLaw::bounds(double theta) const {
+REDRES_HOT VelocityBounds PushRodLaw::bounds(double theta) const {
   const double a = config_.a, b = config_.b;
   const double rate = config_.s * std::sqrt(a * a + b * b + 2.0 * a * b * std::sin(theta)) / (a * b * std::cos(theta));
   const double v_min = rate * config_.sigma_min;

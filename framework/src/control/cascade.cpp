@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "redres/common/hot.hpp"
 #include "redres/control/engine_registry.hpp"
 
 namespace redres {
@@ -130,6 +131,8 @@ Cascade::Cascade(const Scheme& scheme, const SchemeData& data, LviEngine& engine
   used_slot_.assign(levels_.size(), 0);
   note_.reserve(kDiagnosisCapacity);
   prox_ = Eigen::VectorXd::Zero(n_);
+  x_ = Eigen::VectorXd::Zero(n_);
+  first_ = levels_.front()->slots.front().get();
   Eigen::Index widest = n_;
   for (const auto& level : levels_) widest = std::max<Eigen::Index>(widest, n_ + level->in_tasks);
   keep_ = Eigen::VectorXd::Zero(widest);
@@ -371,12 +374,37 @@ void not_run(LevelInfo& level) {
 }
 }  // namespace
 
-bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eigen::VectorXd& x) {
-  REDRES_REQUIRE(x.size() == n_, "Cascade::solve", "x has n entries");
-  if (several_) {  // the parts every level's QP is assembled from (one level: Scheme::build() writes its QP at once)
-    scheme_->build_constraints(ctx, base_, data);
-    scheme_->evaluate_tasks(ctx, data);
+REDRES_HOT const Eigen::VectorXd* Cascade::solve_one(const Context& ctx, SchemeData& data, SolverInfo& info) {
+  // One level (the paper's scheme; the real-time path): Scheme::build() writes the step's QP in one pass, and the
+  // controller's engine solves it. Nothing is held, scaled or refined.
+  Slot& S = *first_;
+  scheme_->build(ctx, S.qp, data);
+  S.engine->solve_valid(S.qp, S.result);
+  const SolverInfo& got = S.result.info;
+  info.status = got.status;
+  info.iterations = got.iterations;
+  info.residual = got.residual;
+  info.engine = got.engine;
+  if (!got.diagnosis.empty() || !info.diagnosis.empty()) info.diagnosis.assign(got.diagnosis);  // within its reserve
+  LevelInfo& level = info_[0];
+  level.status = info.status;
+  level.iterations = info.iterations;
+  level.residual = info.residual;
+  level.task_error = 0.0;
+  if (!level.diagnosis.empty()) level.diagnosis.clear();
+  if (info.status != SolverStatus::kSolved) {
+    keep_diagnosis_capacity(level.diagnosis);
+    TextSink(level.diagnosis) << "the step's QP (priority " << levels_[0]->priority << ") failed";
+    return nullptr;
   }
+  if (!levels_[0]->tasks.empty()) level.task_error = task_error(0, data, S.result.x);
+  return &S.result.x;
+}
+
+const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& data, SolverInfo& info) {
+  // The parts every level's QP is assembled from.
+  scheme_->build_constraints(ctx, base_, data);
+  scheme_->evaluate_tasks(ctx, data);
   held_eq_ = held_in_ = 0;
   // Why the levels below are skipped, once one is: -1 none, 0 nothing left to decide, 1 a level failed.
   int skip = -1;
@@ -401,12 +429,8 @@ bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eige
     used_slot_[l] = held_eq_;
     Slot& S = *L.slots[static_cast<std::size_t>(held_eq_)];
     S.used_ls = false;
-    if (several_) {
-      obj_w_ = scheme_->build_objectives(ctx, static_cast<int>(l), obj_, data);
-      assemble(static_cast<int>(l), data, S.qp, false);
-    } else {
-      scheme_->build(ctx, S.qp, data);  // the same QP, written in one pass (the paper's; the real-time path)
-    }
+    obj_w_ = scheme_->build_objectives(ctx, static_cast<int>(l), obj_, data);
+    assemble(static_cast<int>(l), data, S.qp, false);
     S.engine->solve_valid(S.qp, S.result);  // assemble() wrote only checked entries
     if (l == 0) info = S.result.info;       // the step's outcome, before any proximal step
     level.iterations = S.result.info.iterations;
@@ -438,7 +462,7 @@ bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eige
         not_run(below);
         TextSink(below.diagnosis) << "skipped: priority " << L.priority << " failed";
       }
-      return false;
+      return nullptr;
     }
     if (answer != nullptr && least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone) {
       const bool first = !S.used_ls;
@@ -453,10 +477,10 @@ bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eige
       skip = 1;
       continue;
     }
-    x = answer->x.head(n_);
-    level.task_error = task_error(static_cast<int>(l), data, x);
+    x_ = answer->x.head(n_);
+    level.task_error = task_error(static_cast<int>(l), data, x_);
     if (l + 1 == levels_.size()) break;  // nothing below to hold it for
-    hold(static_cast<int>(l), data, x);
+    hold(static_cast<int>(l), data, x_);
     if (obj_w_ != QpBuilder::WrittenW::kNone || held_eq_ >= n_) {
       skip = 0;
       decided_by = static_cast<int>(l);
@@ -464,7 +488,7 @@ bool Cascade::solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eige
   }
   info.iterations = 0;
   for (const LevelInfo& level : info_) info.iterations += level.iterations;
-  return true;
+  return &x_;
 }
 
 }  // namespace redres

@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "redres/common/hot.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/control/path.hpp"
 
@@ -57,7 +58,6 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
   }
   level_ = scheme.kinematics_level();
   cascade_ = std::make_unique<Cascade>(scheme, *data_, engine);  // every scheme is a list of levels (one QP each)
-  x_ = Eigen::VectorXd::Zero(robot.dof());
   ctx_.T = T;
   ctx_.tau = tau;
   ctx_.robot = &robot;
@@ -142,7 +142,7 @@ void Controller::set_period(double tau) {
   ctx_.tau = tau;
 }
 
-void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out) {
+REDRES_HOT void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out) {
   REDRES_REQUIRE(path_ != nullptr, "Controller::step", "a path was given (or pass r_d and r_d_dot)");
   begin_step();
   reevaluate(theta, t, out);
@@ -164,7 +164,7 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta,
   ctx_.theta_dot_measured = nullptr;
 }
 
-void Controller::reevaluate(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out) {
+REDRES_HOT void Controller::reevaluate(const Eigen::Ref<const Eigen::VectorXd>& theta, double t, StepOutput& out) {
   REDRES_REQUIRE(path_ != nullptr, "Controller::step", "a path was given (or pass r_d and r_d_dot)");
   compute_kinematics(*robot_, theta, kin_, level_);
   const int p = path_->dim();
@@ -205,7 +205,7 @@ void Controller::step(const Eigen::Ref<const Eigen::VectorXd>& theta, double t,
   end_step(out);
 }
 
-void Controller::apply(const Eigen::VectorXd& x, StepOutput& out) {
+REDRES_HOT void Controller::apply(const Eigen::VectorXd& x, StepOutput& out) {
   const double tau = ctx_.tau;
   if (ctx_.order == ControlOrder::kVelocity) {
     out.theta_dot = x;
@@ -216,7 +216,7 @@ void Controller::apply(const Eigen::VectorXd& x, StepOutput& out) {
   }
 }
 
-void Controller::solve(double t, StepOutput& out) {
+REDRES_HOT void Controller::solve(double t, StepOutput& out) {
   REDRES_REQUIRE(out.theta_dot.size() == robot_->dof() && out.theta_ddot.size() == robot_->dof(), "Controller::step",
                  "out was made by make_output() (theta_dot and theta_ddot have n entries)");
   ctx_.t = t;
@@ -225,13 +225,13 @@ void Controller::solve(double t, StepOutput& out) {
   REDRES_REQUIRE(out.levels.size() == (several ? static_cast<std::size_t>(cascade_->level_count()) : 0),
                  "Controller::step", "out was made by make_output() (one LevelInfo per priority level, if several)");
   keep_diagnosis_capacity(out.info.diagnosis);  // a no-op unless the caller's output lost its reserve
-  bool solved = false;
+  const Eigen::VectorXd* answer = nullptr;
   try {
     // Every law once per step, read through the Context (and by braking, should the step fail).
     if (ctx_.acceleration_lower != nullptr) robot_->acceleration_limits(kin_.theta, acc_lo_, acc_hi_);
     if (ctx_.jerk_lower != nullptr) robot_->jerk_limits(kin_.theta, jerk_lo_, jerk_hi_);
     robot_->velocity_limits(kin_.theta, vlo_, vhi_);
-    solved = cascade_->solve(ctx_, *data_, out.info, x_);
+    answer = cascade_->solve(ctx_, *data_, out.info);
   } catch (const std::invalid_argument& e) {
     // A plugin or a law gave NaN or inf at this state (a user formula that is NaN in a narrow window): a failed step
     // that moves nothing, not the end of the run. The controller's own calls meet build()'s other conditions.
@@ -263,8 +263,8 @@ void Controller::solve(double t, StepOutput& out) {
     for (std::size_t l = 0; l < out.levels.size(); ++l)
       out.levels[l] = cascade_->levels()[l];  // reserved: no allocation
   }
-  if (solved) {
-    apply(x_, out);
+  if (answer != nullptr) {
+    apply(*answer, out);
     return;
   }
   // The step failed: the policy decides (never the unconverged iterate).

@@ -1,4 +1,5 @@
 #include "redres/control/path.hpp"
+#include "redres/common/hot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -39,8 +40,8 @@ PathSegment PathSegment::arc(const Eigen::Vector3d& centre, double radius, doubl
 namespace {
 
 // PathSegment::at with an optional second derivative; point and tangent do not depend on whether it is asked for.
-void segment_at(const PathSegment& seg, double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent,
-                Eigen::Vector3d* d2point) {
+REDRES_HOT void segment_at(const PathSegment& seg, double s, Eigen::Vector3d& point, Eigen::Vector3d& tangent,
+                           Eigen::Vector3d* d2point) {
   const double length = seg.length;
   if (seg.kind == PathSegment::Kind::kLine) {
     const Eigen::Vector3d dir = length > 0.0 ? Eigen::Vector3d((seg.b - seg.a) / length) : Eigen::Vector3d::Zero();
@@ -102,7 +103,7 @@ PathGeometry strokes_from(std::vector<PathSegment> segments, bool stroke_each) {
 namespace {
 
 // timing() with an optional second derivative; sigma and dsigma do not depend on whether it is asked for.
-void timing_impl(TimingLaw law, double u, double& sigma, double& dsigma, double* d2sigma) {
+REDRES_HOT void timing_impl(TimingLaw law, double u, double& sigma, double& dsigma, double* d2sigma) {
   u = std::clamp(u, 0.0, 1.0);
   switch (law) {
     case TimingLaw::kCycloidal:
@@ -167,8 +168,8 @@ Path::Path(PathGeometry geometry, int dim, double duration, TimingLaw law, Timin
   }
 }
 
-void Path::evaluate_3d(double t, Eigen::Vector3d& point, Eigen::Vector3d& velocity,
-                       Eigen::Vector3d* acceleration) const {
+REDRES_HOT void Path::evaluate_3d(double t, Eigen::Vector3d& point, Eigen::Vector3d& velocity,
+                                  Eigen::Vector3d* acceleration) const {
   const bool outside = t < 0.0 || t > duration_;
   t = std::clamp(t, 0.0, duration_);
   double s = 0.0, speed = 0.0;  // arc length from the path start, and ds/dt
@@ -211,7 +212,7 @@ void Path::evaluate_3d(double t, Eigen::Vector3d& point, Eigen::Vector3d& veloci
   }
 }
 
-void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot) const {
+REDRES_HOT void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot) const {
   REDRES_REQUIRE(r.size() == dim_ && r_dot.size() == dim_, "Path::evaluate", "r and r_dot have dim() entries");
   Eigen::Vector3d world, velocity;
   evaluate_3d(t, world, velocity, nullptr);
@@ -221,8 +222,8 @@ void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::V
   }
 }
 
-void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot,
-                    Eigen::Ref<Eigen::VectorXd> r_ddot) const {
+REDRES_HOT void Path::evaluate(double t, Eigen::Ref<Eigen::VectorXd> r, Eigen::Ref<Eigen::VectorXd> r_dot,
+                               Eigen::Ref<Eigen::VectorXd> r_ddot) const {
   REDRES_REQUIRE(r.size() == dim_ && r_dot.size() == dim_ && r_ddot.size() == dim_, "Path::evaluate",
                  "r, r_dot and r_ddot have dim() entries");
   Eigen::Vector3d world, velocity, acceleration;

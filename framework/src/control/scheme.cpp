@@ -1,4 +1,5 @@
 #include "redres/control/scheme.hpp"
+#include "redres/common/hot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -261,7 +262,7 @@ void Scheme::setup_constraints(QpProblem& qp, const SchemeData& data) const {
   name_sources(qp, data);
 }
 
-void Scheme::build(const Context& ctx, QpProblem& qp, SchemeData& data) const {
+REDRES_HOT void Scheme::build(const Context& ctx, QpProblem& qp, SchemeData& data) const {
   REDRES_REQUIRE(!cascaded(), "Scheme::build",
                  "the scheme has one priority level (with several, the Controller solves one QP per level)");
   REDRES_REQUIRE(qp.n() == robot_->dof() && qp.m_eq() == m_eq_ && qp.m_in() == m_in_, "Scheme::build",
@@ -301,7 +302,7 @@ QpBuilder::WrittenW Scheme::build_objectives(const Context& ctx, int level, QpPr
   return written;
 }
 
-void Scheme::check_inputs(const Context& ctx, const SchemeData& data) const {
+REDRES_HOT void Scheme::check_inputs(const Context& ctx, const SchemeData& data) const {
   REDRES_REQUIRE(ctx.kinematics != nullptr && ctx.robot == robot_, "Scheme::build",
                  "ctx.robot is the scheme's robot and ctx.kinematics is set");
   REDRES_REQUIRE(ctx.kinematics->level >= kinematics_level_, "Scheme::build",
@@ -311,8 +312,8 @@ void Scheme::check_inputs(const Context& ctx, const SchemeData& data) const {
                  "Scheme::build", "data was made by this scheme's make_data()");
 }
 
-void Scheme::check_built(const Context& ctx, QpProblem& qp, SchemeData& data, bool full_w,
-                         bool constraints_only) const {
+REDRES_HOT void Scheme::check_built(const Context& ctx, QpProblem& qp, SchemeData& data, bool full_w,
+                                    bool constraints_only) const {
   // One scan of everything the plugins can have written (bounds are checked as they are intersected; W off its
   // diagonal keeps clear()'s zeros unless a plugin wrote there).
   const Eigen::Index n = qp.W.rows();
@@ -335,8 +336,8 @@ void Scheme::check_built(const Context& ctx, QpProblem& qp, SchemeData& data, bo
                          "reproduce (a plugin whose output changes between two calls at one state)");
 }
 
-bool Scheme::contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked,
-                            bool constraints_only) const {
+REDRES_HOT bool Scheme::contribute_all(const Context& ctx, QpProblem& qp, SchemeData& data, bool checked,
+                                       bool constraints_only) const {
   qp.clear();
   QpBuilder builder(qp);
   bool full_w = false;  // some plugin wrote off the diagonal of W

@@ -1,4 +1,5 @@
 #include "redres/control/task.hpp"
+#include "redres/common/hot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -64,10 +65,9 @@ namespace {
 }
 }  // namespace
 
-void Task::evaluate(const Context& ctx, TaskData& data) const {
-  TaskTerms& t = data.rows;
-  t.damping = 0.0;
-  compute(ctx, data);
+REDRES_HOT void Task::evaluate(const Context& ctx, TaskData& data) const {
+  evaluate_unchecked(ctx, data);
+  const TaskTerms& t = data.rows;
   // One scan; the slow path names the entry.
   double acc = finite_probe(t.J.data(), t.J.size()) + finite_probe(t.error.data(), t.error.size());
   if (mode_ == TaskMode::kInequality) {
@@ -99,7 +99,7 @@ void Task::evaluate(const Context& ctx, TaskData& data) const {
   bad_rows(*this, "damping term", 0, -1, t.damping);
 }
 
-int write_task_terms(const Task& task, const TaskTerms& t, QpBuilder& builder, int slack) {
+REDRES_HOT int write_task_terms(const Task& task, const TaskTerms& t, QpBuilder& builder, int slack) {
   const Eigen::Index n = t.J.cols();
   const bool least_squares = slack >= 0;
   switch (task.mode()) {

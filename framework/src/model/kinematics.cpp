@@ -1,4 +1,5 @@
 #include "redres/model/kinematics.hpp"
+#include "redres/common/hot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -161,8 +162,8 @@ namespace detail {
 // The stages of compute_kinematics(); a struct so that they may use KinematicsData's workspace.
 struct KinematicsKernels {
   // Checks the sizes and copies theta into data.theta, checking that it is finite on the way.
-  static void check_and_copy(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
-                             KinematicsData& data) {
+  REDRES_HOT static void check_and_copy(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
+                                        KinematicsData& data) {
     const int n = model.dof();
     REDRES_REQUIRE(
         theta.size() == n, "compute_kinematics",
@@ -265,7 +266,7 @@ struct KinematicsKernels {
   }
 
   // Planar kernel: frames, f, and (when `jacobian`) J, in two passes over the joints.
-  static void forward_planar(const RobotModel& model, KinematicsData& data, bool jacobian) {
+  REDRES_HOT static void forward_planar(const RobotModel& model, KinematicsData& data, bool jacobian) {
     const int n = model.dof();
     const double* theta = data.theta.data();
     double* origins = data.origins.data();
@@ -474,8 +475,8 @@ struct KinematicsKernels {
     }
   }
 
-  static void compute(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta, KinematicsData& data,
-                      KinematicsLevel level, bool kernels) {
+  REDRES_HOT static void compute(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& theta,
+                                 KinematicsData& data, KinematicsLevel level, bool kernels) {
     check_and_copy(model, theta, data);
     const bool planar = kernels && model.kind() == ChainKind::kPlanar;
     if (planar) {

@@ -2,6 +2,7 @@
 
 #include "common/text.hpp"
 #include "model/transforms.hpp"
+#include "redres/common/hot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -257,8 +258,9 @@ RobotModel::RobotModel(RobotSpec spec) : spec_(std::move(spec)) {
   }
 }
 
-void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> lower,
-                                 Eigen::Ref<Eigen::VectorXd> upper) const {
+REDRES_HOT void RobotModel::velocity_limits(const Eigen::Ref<const Eigen::VectorXd>& theta,
+                                            Eigen::Ref<Eigen::VectorXd> lower,
+                                            Eigen::Ref<Eigen::VectorXd> upper) const {
   const int n = dof();
   REDRES_REQUIRE(theta.size() == n && lower.size() == n && upper.size() == n, "RobotModel::velocity_limits",
                  "theta, lower and upper have size dof() = " + std::to_string(n));

@@ -1,4 +1,5 @@
 #include "redres/model/velocity_limit.hpp"
+#include "redres/common/hot.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -12,7 +13,8 @@ toml::table VelocityLimitLaw::config() const {
   return out;
 }
 
-std::optional<UndefinedAt> check_velocity_law(const VelocityLimitLaw& law, double lo, double hi, double bound) {
+REDRES_HOT std::optional<UndefinedAt> check_velocity_law(const VelocityLimitLaw& law, double lo, double hi,
+                                                         double bound) {
   if (auto bad = law.undefined_in(lo, hi)) return bad;
   for (int k = 0; k < kVelocityLawSamples; ++k) {
     const double theta =

@@ -3,6 +3,7 @@
 /// diagnosed in diagnosis.cpp, from the row fit of row_fit.cpp.
 
 #include "redres/qp/lvi.hpp"
+#include "redres/common/hot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -57,7 +58,7 @@ void LviEngine::setup(int n, int m_e, int m_i, SolverResult& result) {
   do_setup(n, m_e, m_i);
 }
 
-void LviEngine::check_sizes(const QpProblem& qp, const SolverResult& result) const {
+REDRES_HOT void LviEngine::check_sizes(const QpProblem& qp, const SolverResult& result) const {
   REDRES_REQUIRE(n_ > 0, "LviEngine::solve", "setup() was called");
   REDRES_REQUIRE(qp.n() == n_ && qp.m_eq() == m_e_ && qp.m_in() == m_i_, "LviEngine::solve",
                  "the QP has the sizes given to setup() (n " + std::to_string(n_) + ", m_e " + std::to_string(m_e_) +
@@ -72,12 +73,12 @@ void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
   run(qp, result);
 }
 
-void LviEngine::solve_valid(const QpProblem& qp, SolverResult& result) {
+REDRES_HOT void LviEngine::solve_valid(const QpProblem& qp, SolverResult& result) {
   check_sizes(qp, result);
   run(qp, result);
 }
 
-void LviEngine::run(const QpProblem& qp, SolverResult& result) {
+REDRES_HOT void LviEngine::run(const QpProblem& qp, SolverResult& result) {
   SolverInfo& info = result.info;
   info.diagnosis.clear();
   info.iterations = 0;

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "redres/common/error.hpp"
+#include "redres/common/hot.hpp"
 
 namespace redres {
 
@@ -24,7 +25,7 @@ void QpProblem::resize(int n, int m_e, int m_i) {
   clear();
 }
 
-void QpProblem::clear() {
+REDRES_HOT void QpProblem::clear() {
   if (w_diagonal) {
     // Only the diagonal can be non-zero (the flag's invariant): zero it alone.
     const Eigen::Index nn = W.rows();

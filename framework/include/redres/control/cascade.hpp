@@ -62,11 +62,13 @@ class Cascade {
   ~Cascade();
 
   /// Solves one step: the constraints' and the tasks' rows once, then each level in turn. `info` becomes the first
-  /// level's engine's outcome, with the iterations of every level; levels() each level's; x the answer of the lowest
-  /// level solved. Returns whether the first level solved (when it did not, x is unchanged and no level below ran).
-  /// Throws std::invalid_argument as Scheme::build() does, naming the plugin that gave a non-finite entry.
-  /// Allocation-free.
-  bool solve(const Context& ctx, SchemeData& data, SolverInfo& info, Eigen::VectorXd& x);
+  /// level's engine's outcome, with the iterations of every level; levels() each level's. Returns the answer of the
+  /// lowest level solved (n joint velocities or accelerations, valid until the next call), or nullptr when the first
+  /// level did not solve (then no level below ran). Throws std::invalid_argument as Scheme::build() does, naming the
+  /// plugin that gave a non-finite entry. Allocation-free.
+  const Eigen::VectorXd* solve(const Context& ctx, SchemeData& data, SolverInfo& info) {
+    return several_ ? solve_levels(ctx, data, info) : solve_one(ctx, data, info);
+  }
   /// Each level's outcome at the last step, highest first.
   [[nodiscard]] const std::vector<LevelInfo>& levels() const noexcept { return info_; }
   /// The QP that level l solved last, and its engine's result (level 0: the step's QP, which a failure policy reads).
@@ -86,6 +88,8 @@ class Cascade {
   void hold(int l, const SchemeData& data, const Eigen::VectorXd& x);
   [[nodiscard]] double task_error(int l, const SchemeData& data, const Eigen::VectorXd& x) const;
   void describe_level(int l, TextSink& out) const;
+  const Eigen::VectorXd* solve_one(const Context& ctx, SchemeData& data, SolverInfo& info);
+  const Eigen::VectorXd* solve_levels(const Context& ctx, SchemeData& data, SolverInfo& info);
   void refine(QpProblem& qp, LviEngine& engine, SolverResult& r, int& iterations);
   [[nodiscard]] const Slot& last_slot(int level) const;
 
@@ -107,6 +111,8 @@ class Cascade {
   bool least_squares_terms_ = false;                 // the last assembled level has terms in W (scaled)
   Eigen::VectorXd prox_;                             // the centre of the last proximal step
   Eigen::VectorXd keep_;                             // the answer before a proximal step
+  Eigen::VectorXd x_;                                // several levels: the answer of the lowest level solved
+  Slot* first_ = nullptr;                            // one level: its only slot
 };
 
 }  // namespace redres

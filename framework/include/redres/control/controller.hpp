@@ -191,7 +191,6 @@ class Controller {
   double recover_error_ = 1e-3;       // kBrake: the position error above which the elastic QP goes first
   ElasticFallback fallback_;          // the elastic QP of kRelax and kBrake, with its engine
   std::unique_ptr<Cascade> cascade_;  // the scheme's priority levels, one QP each (never null)
-  Eigen::VectorXd x_;                 // the answer of the lowest level solved
 };
 
 }  // namespace redres

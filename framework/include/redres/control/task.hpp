@@ -88,6 +88,12 @@ class Task : public Plugin {
   /// Computes this step's rows into `data` (what make_data() made) and checks them: every entry finite, else
   /// std::invalid_argument naming the task, the row and the entry. Allocation-free.
   void evaluate(const Context& ctx, TaskData& data) const;
+  /// The same without the check, for a caller that scans the rows where it writes them (a constraint's QP rows,
+  /// which Scheme::check_built() scans and, should an entry be non-finite, names by plugin and row).
+  void evaluate_unchecked(const Context& ctx, TaskData& data) const {
+    data.rows.damping = 0.0;
+    compute(ctx, data);
+  }
 
   /// Checks the task's own keys against its mode (e.g. `lower` only with mode = "inequality"); throws FieldError
   /// naming the key. make_task() calls it once the common keys are set. Default: nothing.

@@ -58,6 +58,8 @@ struct FrameTaskConfig {
   static const Schema<FrameTaskConfig>& schema();
 };
 
+class FrameTaskData;
+
 /// A task on a frame.
 class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginOutput {
  public:
@@ -92,6 +94,8 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
   // Writes row r as the robot's task row `task_row` (J, error, d; e_path: the orientation error of a spatial pose
   // task's rows); returns its error.
   double write_task_row(const Context& ctx, int r, int task_row, const Eigen::Vector3d& e_path, TaskTerms& t) const;
+  // compute() for the rows of in_order_ at the velocity level, equality or soft, undamped (the paper's task).
+  void velocity_rows_in_order(const Context& ctx, FrameTaskData& own) const;
   [[nodiscard]] bool has_position_rows() const;
   [[nodiscard]] bool has_orientation_rows() const;
 
@@ -103,6 +107,7 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
   std::vector<int> task_row_, reference_row_;
   bool all_task_rows_ = false;  // every row is a task row: the frame's own pose and Jacobian are not needed
   bool any_task_rows_ = false;
+  bool in_order_ = false;      // row r is the robot's task row r, for every task row (the end-effector task's J whole)
   bool spatial_pose_ = false;  // the robot's reference has a spatial orientation (a rotation vector in rows 3 to 5)
   Eigen::VectorXd gain_;
   Eigen::Vector3d point_, axis_;

@@ -112,7 +112,7 @@ bool Newton::slack_rows_only(const QpProblem& qp) {
 REDRES_HOT void Newton::do_solve(const QpProblem& qp, SolverResult& result) {
   // Inequality rows that are all zero with b >= 0 (the slack rows collision constraints leave for pairs out of
   // range) hold for every x with z = 0, so they do not stop the exact path.
-  bool applicable = qp.w_diagonal && slack_rows_only(qp);
+  bool applicable = w_diagonal() && slack_rows_only(qp);
   if (applicable) {
     // W rarely changes between steps (W = I in the paper): reuse 1 / W_ii when it has not.
     const int n = qp.n();

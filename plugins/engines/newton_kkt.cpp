@@ -189,7 +189,7 @@ bool Newton::exact_step_lands(const QpProblem& qp, double& e2) {
   }
   // Y = W_FF^-1 B' (in yt_) and h = W_FF^-1 r_x (in h_).
   for (int f = 0; f < nf; ++f) h_(f) = rhs_(free_x_[static_cast<std::size_t>(f)]);
-  if (qp.w_diagonal) {
+  if (w_diagonal()) {
     for (int f = 0; f < nf; ++f) {
       const std::ptrdiff_t j = free_x_[static_cast<std::size_t>(f)];
       const double iw = 1.0 / W[j * (n + 1)];

@@ -60,26 +60,29 @@ class Projection final : public LviEngine {
       uy_.setZero();
       uz_.setZero();
     }
-    // The variants differ only in which loops exist; each performs the same floating-point operations in the
-    // same order, so the iterates are identical.
+    // Eq. 15 until ||e(u)|| <= tolerance; then the answer (x projected onto the box) must pass the certificate
+    // (LviEngine::certify). Where it does not (the box projection moved x, or the data's scale makes the absolute
+    // test too loose), the same iteration continues from where it stopped with a test 100 times tighter, within
+    // the same iteration cap. The paper's steps pass at the first test.
+    const double tol2 = settings().tolerance * settings().tolerance;  // the engine's own test
+    tol2_ = tol2;
+    int total = 0;
     Outcome out;
-    if (qp.w_diagonal && qp.m_in() == 0 && qp.m_eq() == 2 && qp.n() == 6) {
-#if defined(__SSE2__)
-      out = iterate_6x2_sse2(qp);  // the paper's case: two joints per SSE2 register
-#else
-      out = iterate<true, false, 2, 6>(qp);  // the paper's case: every loop unrolls
-#endif
-    } else if (qp.w_diagonal && qp.m_in() == 0 && qp.m_eq() == 2) {
-      out = iterate<true, false, 2>(qp);
-    } else if (qp.w_diagonal) {
-      out = qp.m_in() == 0 ? iterate<true, false>(qp) : iterate<true, true>(qp);
-    } else {
-      out = qp.m_in() == 0 ? iterate<false, false>(qp) : iterate<false, true>(qp);
+    for (;;) {
+      budget_ = settings().max_iterations - total;
+      out = dispatch(qp);
+      total += out.iterations;
+      result.x = ux_.cwiseMax(qp.lo).cwiseMin(qp.hi);
+      result.y = uy_;
+      result.z = uz_;
+      if (out.broke_down || out.e2 > tol2_ || total >= settings().max_iterations) break;
+      if (certify(qp, result).verdict() == SolverStatus::kSolved) break;
+      if (tol2_ < 1e-28) break;  // below rounding: the certificate reports what is left
+      tol2_ *= 1e-4;
     }
     SolverInfo& info = result.info;
-    info.iterations = out.iterations;
+    info.iterations = total;
     info.residual = std::sqrt(out.e2);
-    const double tol2 = settings().tolerance * settings().tolerance;
     if (out.broke_down) {
       info.status = SolverStatus::kNumericalError;
       keep_diagnosis_capacity(info.diagnosis);
@@ -88,9 +91,6 @@ class Projection final : public LviEngine {
     } else {
       info.status = out.e2 <= tol2 ? SolverStatus::kSolved : SolverStatus::kMaxIterations;
     }
-    result.x = ux_.cwiseMax(qp.lo).cwiseMin(qp.hi);
-    result.y = uy_;
-    result.z = uz_;
   }
 
   struct Outcome {
@@ -99,6 +99,21 @@ class Projection final : public LviEngine {
     bool broke_down = false;
   };
 
+  // The variants differ only in which loops exist; each performs the same floating-point operations in the same
+  // order, so the iterates are identical.
+  Outcome dispatch(const QpProblem& qp) {
+    if (w_diagonal() && qp.m_in() == 0 && qp.m_eq() == 2 && qp.n() == 6) {
+#if defined(__SSE2__)
+      return iterate_6x2_sse2(qp);  // the paper's case: two joints per SSE2 register
+#else
+      return iterate<true, false, 2, 6>(qp);  // the paper's case: every loop unrolls
+#endif
+    }
+    if (w_diagonal() && qp.m_in() == 0 && qp.m_eq() == 2) return iterate<true, false, 2>(qp);
+    if (w_diagonal()) return qp.m_in() == 0 ? iterate<true, false>(qp) : iterate<true, true>(qp);
+    return qp.m_in() == 0 ? iterate<false, false>(qp) : iterate<false, true>(qp);
+  }
+
 #if defined(__SSE2__)
   // The paper's case (diagonal W, 6 joints, 2 rows, no inequality rows) with the even and odd joints in the two
   // lanes of an SSE2 register. The lanes are exactly the even/odd partial sums of iterate<>, and every operation
@@ -106,8 +121,8 @@ class Projection final : public LviEngine {
   // iterates are bit-identical to the scalar variants.
   REDRES_HOT REDRES_NO_COVERAGE Outcome iterate_6x2_sse2(const QpProblem& qp) {
     const double varpi = settings().varpi;
-    const double tol2 = settings().tolerance * settings().tolerance;
-    const int max_iterations = settings().max_iterations;
+    const double tol2 = tol2_;
+    const int max_iterations = budget_;
     const double* J = qp.J.data();  // column-major 2 x 6
     __m128d j0[3], j1[3], w[3], zeta[3], lo[3], hi[3], x[3];
     for (int p = 0; p < 3; ++p) {
@@ -192,8 +207,8 @@ class Projection final : public LviEngine {
   REDRES_HOT REDRES_NO_COVERAGE Outcome iterate(const QpProblem& qp) {
     const int n = kCols > 0 ? kCols : qp.n(), me = kRows > 0 ? kRows : qp.m_eq(), mi = kInequalities ? qp.m_in() : 0;
     const double varpi = settings().varpi;
-    const double tol2 = settings().tolerance * settings().tolerance;
-    const int max_iterations = settings().max_iterations;
+    const double tol2 = tol2_;
+    const int max_iterations = budget_;
     const double* __restrict W = qp.W.data();
     const double* __restrict J = qp.J.data();
     const double* __restrict A = qp.A.data();
@@ -319,6 +334,8 @@ class Projection final : public LviEngine {
     return out;
   }
 
+  double tol2_ = 0.0;  // the current stopping test ||e||^2 <= tol2_
+  int budget_ = 0;     // iterations left in this solve
   Eigen::VectorXd ux_, uy_, uz_, rx_, ry_, rz_, ex_, ey_, ez_, px_, py_, pz_, ry2_, py2_;
 };
 

@@ -46,6 +46,10 @@ def test_a_controller_from_typed_configs_meets_its_task_rows():
     qp = ctrl.qp
     assert qp["W"].shape == (7, 7) and qp["J"].shape == (3, 7)
     assert np.array_equal(ctrl.f, k.f)
+    # The certificate's figures: the rows' miss, computed here from the QP, and both residuals within the limits.
+    miss = np.max(np.abs(qp["J"] @ theta_dot - qp["d"]))
+    assert abs(info.primal_residual - miss) <= 1e-12 and info.primal_residual <= 1e-10 + 1e-9 * np.max(np.abs(qp["d"]))
+    assert 0.0 <= info.dual_residual <= 1e-8 and info.complementarity == 0.0
 
 
 def test_a_path_is_placed_at_the_start_and_followed():

@@ -283,12 +283,14 @@ struct StepInfo {
   int iterations = 0;
   double residual = 0.0;
   std::vector<LevelStepInfo> levels;  // a scheme with several priority levels: each level's outcome
+  double primal_residual = 0.0, dual_residual = 0.0, complementarity = 0.0;  // the certificate's figures
   [[nodiscard]] bool ok() const { return status == "solved"; }
 };
 
 StepInfo info_of(const StepOutput& out) {
   const SolverInfo& i = out.info;
-  StepInfo info{to_string(i.status), std::string(i.engine), i.diagnosis, i.iterations, i.residual, {}};
+  StepInfo info{to_string(i.status), std::string(i.engine), i.diagnosis,      i.iterations, i.residual, {},
+                i.primal_residual,   i.dual_residual,       i.complementarity};
   for (const LevelInfo& l : out.levels) {
     info.levels.push_back({l.priority, to_string(l.status), l.diagnosis, l.iterations, l.residual, l.task_error});
   }
@@ -742,7 +744,15 @@ PYBIND11_MODULE(_redres, m) {
         return "LevelInfo(priority=" + std::to_string(l.priority) + ", status='" + l.status + "')";
       });
   py::class_<StepInfo>(m, "StepInfo", "One step's solver outcome.")
-      .def_readonly("status", &StepInfo::status, "'solved', 'max_iterations', 'infeasible' or 'numerical_error'")
+      .def_readonly("status", &StepInfo::status,
+                    "'solved' (the engine stopped and its answer passed the certificate), 'max_iterations', "
+                    "'infeasible', 'numerical_error', 'inaccurate_primal', 'inaccurate_dual', "
+                    "'inaccurate_complementarity', 'invalid_problem', 'relaxed' or 'braked'")
+      .def_readonly("primal_residual", &StepInfo::primal_residual,
+                    "the certificate's largest miss of a row or bound (docs/engines.md)")
+      .def_readonly("dual_residual", &StepInfo::dual_residual, "the certificate's largest stationarity residual")
+      .def_readonly("complementarity", &StepInfo::complementarity,
+                    "the certificate's largest force of an inequality row that is not active")
       .def_property_readonly("ok", &StepInfo::ok, "status == 'solved'")
       .def_readonly("iterations", &StepInfo::iterations, "the engine's iterations (all levels together)")
       .def_readonly("residual", &StepInfo::residual, "||e(u)||_2 of the LVI at the answer")

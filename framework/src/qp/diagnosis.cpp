@@ -165,6 +165,11 @@ void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& i
       diagnose_rows(qp, fit, settings_.tolerance, false, s);
       s << ": this step's multipliers are larger than varpi (raise [solver] varpi, or keep the arm away "
         << "from this configuration)";
+    } else if (reported == SolverStatus::kInaccuratePrimal || reported == SolverStatus::kInaccurateDual ||
+               reported == SolverStatus::kInaccurateComplementarity) {
+      s << info.engine << " stopped after " << info.iterations << (info.iterations == 1 ? " iteration" : " iterations")
+        << ", but its answer is not certified: " << note_ << "; ";
+      diagnose_rows(qp, fit, settings_.tolerance, false, s);
     } else {
       s << info.engine;
       if (reported == SolverStatus::kMaxIterations && note_.empty()) {

@@ -22,6 +22,9 @@ const char* to_string(SolverStatus status) {
     case SolverStatus::kInvalidProblem: return "invalid_problem";
     case SolverStatus::kRelaxed: return "relaxed";
     case SolverStatus::kBraked: return "braked";
+    case SolverStatus::kInaccuratePrimal: return "inaccurate_primal";
+    case SolverStatus::kInaccurateDual: return "inaccurate_dual";
+    case SolverStatus::kInaccurateComplementarity: return "inaccurate_complementarity";
   }
   return "unknown";
 }
@@ -70,11 +73,13 @@ REDRES_HOT void LviEngine::check_sizes(const QpProblem& qp, const SolverResult& 
 void LviEngine::solve(const QpProblem& qp, SolverResult& result) {
   check_sizes(qp, result);
   qp.validate();
+  w_diagonal_ = qp.w_diagonal && off_diagonal_zero(qp.W);  // a QP filled by hand may have left the flag
   run(qp, result);
 }
 
 REDRES_HOT void LviEngine::solve_valid(const QpProblem& qp, SolverResult& result) {
   check_sizes(qp, result);
+  w_diagonal_ = qp.w_diagonal;  // kept by QpBuilder and clear() for a QP built through them
   run(qp, result);
 }
 
@@ -83,6 +88,7 @@ REDRES_HOT void LviEngine::run(const QpProblem& qp, SolverResult& result) {
   info.diagnosis.clear();
   info.iterations = 0;
   info.engine = name();
+  info.primal_residual = info.dual_residual = info.complementarity = 0.0;
 
   bool conflicting = false;
   const double* lo = qp.lo.data();
@@ -112,6 +118,18 @@ REDRES_HOT void LviEngine::run(const QpProblem& qp, SolverResult& result) {
   bool capped = false;
   for (int r = 0; r < m_e_; ++r) capped |= std::abs(result.y(r)) >= cap;
   for (int r = 0; r < m_i_; ++r) capped |= result.z(r) >= cap;
+  // `solved` is a certificate: whatever the engine's own test, the answer is checked in the QP's units.
+  const Certificate certificate = certify(qp, result);
+  info.primal_residual = certificate.primal;
+  info.dual_residual = certificate.dual;
+  info.complementarity = certificate.complementarity;
+  if (info.status == SolverStatus::kSolved && !capped && certificate.verdict() != SolverStatus::kSolved) {
+    info.status = certificate.verdict();
+    keep_diagnosis_capacity(info.diagnosis);
+    info.diagnosis.clear();
+    TextSink text(info.diagnosis);
+    describe(certificate, qp, text);
+  }
   if (info.status != SolverStatus::kSolved || capped) {
     if (diagnoses_) diagnose_failure(qp, capped, info);
     warm_ = false;
@@ -130,8 +148,14 @@ void LviEngine::set_settings(const SolverSettings& s) {
 const Schema<SolverSettings>& SolverSettings::schema() {
   using C = SolverSettings;
   static const Schema<C> s{
-      {field("tolerance", &C::tolerance, "", "stopping test ||e(u)||_2 <= tolerance (below 1e-14 rounding decides)",
+      {field("tolerance", &C::tolerance, "",
+             "stopping test ||e(u)||_2 <= tolerance (below 1e-14 rounding decides), and the certificate's absolute "
+             "limit",
              between(1e-14, 1.0)),
+       field("relative_tolerance", &C::relative_tolerance, "",
+             "the certificate behind `solved`: each residual (primal, dual, complementarity) within tolerance + "
+             "relative_tolerance x the size of the data it compares",
+             between(0.0, 1e-2)),
        field("varpi", &C::varpi, "", "bound on the duals standing for infinity", between(1.0, 1e12)),
        field("max_iterations", &C::max_iterations, "", "iteration cap per solve", at_least<int>(1)),
        field("warm_start", &C::warm_start, "", "start each solve from the previous u")}};

@@ -25,6 +25,7 @@
 
 #include "redres/config/config.hpp"
 #include "redres/config/toml_reader.hpp"
+#include "redres/qp/certificate.hpp"
 #include "redres/qp/qp.hpp"
 #include "redres/qp/row_fit.hpp"  // RowFit, best_row_fit: the test behind `infeasible`
 #include "redres/qp/solver_status.hpp"
@@ -33,10 +34,12 @@ namespace redres {
 
 /// Settings shared by every engine (the scenario's [solver] table).
 struct SolverSettings {
-  double tolerance = 1e-6;     //!< stopping test ||e(u)||_2 <= tolerance (the paper's 1e-6)
-  double varpi = 1e6;          //!< bound on the duals standing for infinity (the paper's 1e6)
-  int max_iterations = 20000;  //!< iteration cap per solve
-  bool warm_start = true;      //!< start from the previous solve's u
+  double tolerance = 1e-6;  //!< stopping test ||e(u)||_2 <= tolerance (the paper's 1e-6), and the certificate's
+                            //!< absolute limit (redres/qp/certificate.hpp)
+  double relative_tolerance = 1e-9;  //!< the certificate's relative limit, times the size of the data it compares
+  double varpi = 1e6;                //!< bound on the duals standing for infinity (the paper's 1e6)
+  int max_iterations = 20000;        //!< iteration cap per solve
+  bool warm_start = true;            //!< start from the previous solve's u
 
   static const Schema<SolverSettings>& schema();
 };
@@ -52,6 +55,9 @@ struct SolverInfo {
   std::string_view engine;                      //!< the engine that actually ran (a fallback names itself);
                                                 //!< compares by value; refers to the engine's static name
   std::string diagnosis;                        //!< empty when solved; otherwise which joint, bound, plugin
+  double primal_residual = 0.0;                 //!< the certificate's figures for the returned answer (infinity
+  double dual_residual = 0.0;                   //!< norms; redres/qp/certificate.hpp); 0 when no answer was
+  double complementarity = 0.0;                 //!< checked (a bound conflict, a QP not built)
 };
 
 /// The answer: x = theta_dot and the duals. Sized once by LviEngine::setup.
@@ -77,10 +83,11 @@ class LviEngine {
   /// bound conflict as infeasible, runs the engine, and diagnoses a failure. After an infeasible or failed solve
   /// the warm start is reset, so that runaway duals do not slow the next steps down.
   void solve(const QpProblem& qp, SolverResult& result);
-  /// solve() for a QP whose values are known to be valid: every entry of W, zeta, J, d, A and b finite, and no
-  /// bound NaN (what QpProblem::validate() checks). Scheme::build() gives such a QP: it checks every entry the
-  /// plugins wrote, and the entries no plugin writes keep clear()'s zeros. The Controller solves
-  /// with it, so that no entry is scanned twice per step. Sizes are still checked.
+  /// solve() for a QP whose values are known to be valid: every entry of W, zeta, J, d, A and b finite, no bound
+  /// NaN (what QpProblem::validate() checks), and w_diagonal true only if W has nothing off its diagonal (what
+  /// QpBuilder and clear() keep; solve() checks it against W). Scheme::build() gives such a QP: it checks every
+  /// entry the plugins wrote, and the entries no plugin writes keep clear()'s zeros. The Controller solves with it,
+  /// so that no entry is scanned twice per step. Sizes are still checked.
   void solve_valid(const QpProblem& qp, SolverResult& result);
   /// Forgets the warm start.
   void reset() { warm_ = false; }
@@ -102,6 +109,14 @@ class LviEngine {
  protected:
   /// Whether `result` holds a previous solution to start from.
   [[nodiscard]] bool warm() const noexcept { return warm_ && settings_.warm_start; }
+  /// Whether the QP being solved has nothing off W's diagonal: QpProblem::w_diagonal, verified against W by
+  /// solve() (a QP filled by hand may leave the flag as it was). Engines read this, never the flag.
+  [[nodiscard]] bool w_diagonal() const noexcept { return w_diagonal_; }
+  /// The certificate of `result` against `qp` at the settings' limits (an engine may check an iterate before it
+  /// stops; solve() checks every answer).
+  [[nodiscard]] Certificate certify(const QpProblem& qp, const SolverResult& result) const {
+    return redres::certify(qp, result, w_diagonal_, settings_.tolerance, settings_.relative_tolerance);
+  }
 
  private:
   virtual void do_setup(int n, int m_e, int m_i) = 0;
@@ -115,6 +130,7 @@ class LviEngine {
 
   SolverSettings settings_;
   bool warm_ = false;
+  bool w_diagonal_ = true;
   bool diagnoses_ = true;
   int n_ = 0, m_e_ = 0, m_i_ = 0;
   RowFitter fitter_;  // the best fit of the rows inside the bounds, for failed solves

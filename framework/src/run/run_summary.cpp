@@ -329,11 +329,11 @@ const std::vector<SummaryField>& summary_fields() {
       {"solver.on_infeasible", "string", "the policy: `\"hold\"`, `\"stop\"`, `\"relax\"` or `\"brake\"`",
        [](const S& s) { return text(s.solver.on_infeasible); }},
       {"solver.held_steps", "integer",
-       "failed steps held with theta_dot = 0 (the rows whose `solver_status` is neither 0 nor 6, before T)",
+       "failed steps held with theta_dot = 0 (the rows before T whose `solver_status` is none of 0, 6 and 7)",
        [](const S& s) { return count(s.solver.held_steps); }},
       {"solver.braked_steps", "integer",
-       "failed steps that braked (`solver_status` 7): the arm decelerated within its acceleration limits; counted in "
-       "`solver.failures`",
+       "failed steps that braked: every row whose `solver_status` is 7 (the last row's too); the arm decelerated "
+       "within its acceleration limits; counted in `solver.failures`",
        [](const S& s) { return count(s.solver.braked_steps); }},
       {"solver.relaxed_steps", "integer",
        "steps solved with the rows relaxed (`solver_status` 6); they are not failures",

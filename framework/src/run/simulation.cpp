@@ -211,13 +211,10 @@ void run_on(const Scenario& s, const PlantType& type, RunResult& run, const Prog
     double* row = rows.write(k, t, theta, out);
     plant->record(row + static_cast<std::ptrdiff_t>(plant_first));
     run.trajectory.append_row(row);
+    if (out.info.status == SolverStatus::kBraked) ++run.braked_steps;  // every braked row, the last one's too
     if (!step_goes_on(s, log, run, k, steps, t, out, progress, stop)) break;
-    if (!moves(out.info.status)) {
-      ++run.held_steps;  // theta_dot = 0 (the controller never hands out an unconverged iterate)
-    } else if (out.info.status == SolverStatus::kBraked) {
-      ++run.braked_steps;
-    }
-    motion.limits_of_step(ctrl);  // before a second stage evaluates the laws at another state
+    if (!moves(out.info.status)) ++run.held_steps;  // theta_dot = 0 (never an unconverged iterate)
+    motion.limits_of_step(ctrl);                    // before a second stage evaluates the laws at another state
     if (!plant->advance(out, t, loop_step, applied, failure)) {
       if (!failure.empty() && run.failures++ == 0) run.first_failure = "t = " + std::to_string(t) + " s: " + failure;
       run.stopped = true;

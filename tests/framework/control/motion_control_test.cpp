@@ -291,6 +291,11 @@ TEST(NoVelocityJump, EveryShippedScenarioAndForcedFailures) {
       if (forced) {
         EXPECT_GT(run.braked_steps, 0);
       }
+      // braked_steps counts every braked row, the last one's too.
+      const std::size_t status = run.trajectory.column("solver_status");
+      int braked_rows = 0;
+      for (std::size_t r = 0; r < run.trajectory.size(); ++r) braked_rows += run.trajectory(r, status) == 7.0 ? 1 : 0;
+      EXPECT_EQ(run.braked_steps, braked_rows);
       ++checked;
     }
   }

@@ -36,7 +36,10 @@ const std::vector<TrajectoryColumnGroup>& trajectory_column_groups() {
        "the plugin), 6 `relaxed` (`on_infeasible = \"relax\"`: the QP failed and the elastic QP with the equality rows "
        "relaxed was solved; theta_dot is its answer), 7 `braked` (the step failed and decelerated every joint along "
        "the previous command within its acceleration limits; theta_dot is the braking command, and the arm moves with "
-       "it). A failed step that did not brake (every status but 0, 6 and 7) records theta_dot = 0: the arm is held, "
+       "it), 8 `inaccurate_primal`, 9 `inaccurate_dual`, 10 `inaccurate_complementarity` (the engine stopped, but its "
+       "answer failed that check of the certificate behind `solved`, "
+       "[engines.md](engines.md#what-solved-guarantees-the-certificate); a failed step). A failed step that did not "
+       "brake (every status but 0, 6 and 7) records theta_dot = 0: the arm is held, "
        "never moved by an unconverged iterate (4 `not_run` exists in the status enum, for a solver "
        "result before its first solve; every recorded row has been solved, so a finished run never records it)",
        V::kStatus},

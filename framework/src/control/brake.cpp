@@ -43,7 +43,8 @@ BrakeScale braking_scale(const BrakeInput& in) {
   if (in.jerk_lower != nullptr && in.jerk_upper != nullptr) {
     const Eigen::VectorXd& j_lo = *in.jerk_lower;
     const Eigen::VectorXd& j_hi = *in.jerk_upper;
-    double lo = s_lo, hi = s_hi;
+    // Braking never speeds the arm up: the jerk limits are kept only by a scale of at most 1.
+    double lo = s_lo, hi = std::min(s_hi, std::max(1.0, s_lo));
     int jerk_decides = decides;
     for (Eigen::Index j = 0; j < n; ++j) {
       if (!usable_joint(j, j_lo, j_hi)) continue;
@@ -57,9 +58,8 @@ BrakeScale braking_scale(const BrakeInput& in) {
     if (!out.jerk_yields) {
       out.scale = lo;
       decides = jerk_decides;
-    } else {
-      out.scale = std::clamp(lo, s_lo, s_hi);  // as near the jerk limits as the acceleration and velocity limits allow
-    }
+    }  // else the acceleration limits' scale s_lo: an arm that was accelerating faster than the jerk limits can turn
+       // round in one step brakes at once
   }
   out.deciding_joint = decides;
   return out;

@@ -75,6 +75,58 @@ TEST(BrakingLaw, AJerkLimitSlowsTheTurnToBraking) {
   EXPECT_FALSE(s.jerk_yields);
 }
 
+TEST(BrakingLaw, AnArmThatWasAcceleratingDeceleratesAtOnce) {
+  // Both joints were accelerating along their motion at 8 rad/s^2 (joint 1: 0.92 -> 1 rad/s; joint 2: -1.92 -> -2);
+  // jerk limit 100 rad/s^3 turns that round by at most 1 rad/s^2 in a step of 10 ms, so keeping it would take s > 1
+  // (the arm speeding up). The jerk limits yield; s is the acceleration limits' 0.95, as without jerk limits.
+  BrakeCase c = two_joints();
+  c.j_lo.setConstant(-100.0);
+  c.j_hi.setConstant(100.0);
+  c.prev2 = Eigen::Vector2d(0.92, -1.92);
+  const BrakeScale s = braking_scale(c.input(true));
+  EXPECT_TRUE(s.jerk_yields);
+  EXPECT_NEAR(s.scale, 0.95, 1e-15);
+  EXPECT_EQ(s.deciding_joint, 1);
+  // Accelerating at 0.5 rad/s^2 only: the jerk limit reaches -0.5 rad/s^2 in one step, and holds (s < 1).
+  c.prev2 = Eigen::Vector2d(1.0 - 0.005, -2.0 + 0.005);
+  const BrakeScale gentle = braking_scale(c.input(true));
+  EXPECT_FALSE(gentle.jerk_yields);
+  EXPECT_NEAR(gentle.scale, 1.0 - 0.01 * 0.5 / 2.0, 1e-12);  // joint 2 (2 rad/s) may lose 0.005 rad/s
+  EXPECT_LT(gentle.scale, 1.0);
+}
+
+// With jerk limits and any previous acceleration, braking never speeds the arm up, and keeps the acceleration limits.
+RC_GTEST_PROP(BrakingLaw, WithJerkLimitsTheArmNeverSpeedsUp, ()) {
+  const int n = *rc::gen::inRange(1, 8);
+  BrakeCase c;
+  c.tau = *rc::gen::element(0.001, 0.01);
+  for (Eigen::VectorXd* v : {&c.b, &c.a_lo, &c.a_hi, &c.v_lo, &c.v_hi, &c.j_lo, &c.j_hi, &c.prev, &c.prev2}) {
+    v->resize(n);
+  }
+  for (int j = 0; j < n; ++j) {
+    c.b(j) = *rc::gen::inRange(-2000, 2001) / 1000.0;
+    c.a_hi(j) = *rc::gen::inRange(1, 2001) / 100.0;
+    c.a_lo(j) = -*rc::gen::inRange(1, 2001) / 100.0;
+    c.v_hi(j) = 2.5;
+    c.v_lo(j) = -2.5;
+    c.j_hi(j) = *rc::gen::inRange(10, 5001);
+    c.j_lo(j) = -*rc::gen::inRange(10, 5001);
+    c.prev(j) = c.b(j);
+    c.prev2(j) = c.b(j) - c.tau * *rc::gen::inRange(-2000, 2001) / 100.0;  // a_prev within +-20 rad/s^2
+  }
+  const BrakeScale s = braking_scale(c.input(true));
+  RC_ASSERT(s.scale >= 0.0);
+  RC_ASSERT(s.scale <= 1.0);
+  for (int j = 0; j < n; ++j) {
+    const double a = (s.scale - 1.0) * c.b(j) / c.tau;
+    RC_ASSERT(a >= c.a_lo(j) - 1e-9 && a <= c.a_hi(j) + 1e-9);
+    if (!s.jerk_yields) {
+      const double a_prev = (c.prev(j) - c.prev2(j)) / c.tau;
+      RC_ASSERT(a >= a_prev + c.tau * c.j_lo(j) - 1e-6 && a <= a_prev + c.tau * c.j_hi(j) + 1e-6);
+    }
+  }
+}
+
 TEST(BrakingLaw, JointsThatSetNothingAreLeftOut) {
   BrakeCase c = two_joints();
   c.b(0) = 0.0;                                          // at rest

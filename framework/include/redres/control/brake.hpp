@@ -3,9 +3,11 @@
 /// The braking law of a step that is not solved (FailurePolicy::kBrake, docs/motion.md), on its own so that it can be
 /// called and tested without a controller: the command is theta_dot = s b, b the joint velocity before the step and
 /// s >= 0 one scale for every joint (the arm slows along the path it was on). s is the smallest scale that keeps every
-/// joint's acceleration limits, its velocity limits and, where all of them can hold, its jerk limits from the previous
-/// acceleration. s = 1 keeps the velocity and always meets the acceleration limits; s > 1 is taken only when the jerk
-/// limits ask for it (an arm that is accelerating cannot turn to braking at once).
+/// joint's acceleration limits, its velocity limits and, where all of them can hold with s <= 1, its jerk limits from
+/// the previous acceleration. Braking never speeds the arm up: s < 1 wherever a joint moves and its deceleration limit
+/// is below zero. An arm that was accelerating faster than its jerk limits can turn round in one step (a_prev >
+/// -tau j^- for the joint) cannot keep them and brake; the jerk limits then yield (`jerk_yields`) and s is the
+/// acceleration limits' smallest scale.
 
 #include <Eigen/Core>
 

@@ -39,6 +39,39 @@ void require_finite_numbers(const nlohmann::json& j, const std::string& path) {
   }
 }
 
+// The spells in which the task was not met as asked (solver_status not 0), the longest of them, and when the run
+// came back from it.
+void task_losses(const Trajectory& tr, double tau, SolverStats& out) {
+  const std::size_t c_t = tr.column("t"), c_status = tr.column("solver_status"), rows = tr.size();
+  std::size_t lost = 0, best_start = 0, best_length = 0;
+  for (std::size_t r = 0; r < rows;) {
+    if (tr(r, c_status) == 0.0) {
+      ++r;
+      continue;
+    }
+    const std::size_t start = r;
+    while (r < rows && tr(r, c_status) != 0.0) ++r;
+    ++out.task_lost_spells;
+    lost += r - start;
+    if (r - start > best_length) {
+      best_start = start;
+      best_length = r - start;
+    }
+  }
+  out.task_lost_time = static_cast<double>(lost) * tau;
+  if (best_length == 0) return;
+  std::ostringstream msg;
+  msg.precision(6);
+  const std::size_t end = best_start + best_length;  // the first row after the spell, if any
+  msg << "t = " << tr(best_start, c_t) << " s to " << tr(end - 1, c_t) << " s (" << best_length << " steps); ";
+  if (end < rows) {
+    msg << "back at " << tr(end, c_t) << " s";
+  } else {
+    msg << "not back by the end";
+  }
+  out.longest_task_loss = msg.str();
+}
+
 }  // namespace
 
 RunSummary summarise(const Scenario& s, const RunResult& run) {
@@ -131,6 +164,7 @@ RunSummary summarise(const Scenario& s, const RunResult& run) {
   out.solver.relaxed_steps = run.relaxed_steps;
   out.solver.max_relaxed_task_error = run.max_relaxed_task_error;
   out.solver.first_relaxed = run.first_relaxed;
+  task_losses(tr, s.tau, out.solver);
   out.wall_time_s = run.wall_time_s;
   out.plant_kind = s.plant.kind;
   if (run.plant) {
@@ -346,6 +380,16 @@ const std::vector<SummaryField>& summary_fields() {
        "`t = <t> s: rows relaxed (weight ...), missed by ... at most, after <status>: <diagnosis>` for the first "
        "relaxed step; empty if none",
        [](const S& s) { return text(s.solver.first_relaxed); }},
+      {"solver.task_lost_time", "number",
+       "how long the task was not met as asked: the rows whose `solver_status` is not 0 (relaxed, braked, held or "
+       "failed) times tau (s)",
+       [](const S& s) { return SummaryValue(s.solver.task_lost_time); }},
+      {"solver.task_lost_spells", "integer", "the runs of consecutive such rows",
+       [](const S& s) { return count(s.solver.task_lost_spells); }},
+      {"solver.longest_task_loss", "string",
+       "`t = <a> s to <b> s (<k> steps); back at <c> s` for the longest run of such rows, `<c>` the first solved row "
+       "after it, or `...; not back by the end`; empty if none",
+       [](const S& s) { return text(s.solver.longest_task_loss); }},
       {"plant.kind", "string",
        "`kinematic` or `mujoco` ([plant] kind; docs/plant.md); the `plant.*` figures below "
        "are empty (or 0) on the kinematic plant",

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "redres/control/controller.hpp"
 #include "redres/control/engine_registry.hpp"
 #include "redres/parsers/robot_toml.hpp"
+#include "redres/run/run_summary.hpp"
 #include "redres/run/scenario.hpp"
 #include "redres/run/simulation.hpp"
 #include "scenario_text.hpp"
@@ -231,6 +233,27 @@ void expect_recovery(const std::string& policy) {
   EXPECT_GT(during, 5e-3) << policy << ": the blocked arm falls behind";
   EXPECT_LT(late, 1e-3) << policy << ": and tracks again once nothing blocks it";
   EXPECT_LT(late, during / 20.0) << policy;
+  // The summary says how long the task was lost (every row not solved as asked: braked, then relaxed while catching
+  // up) and when it came back.
+  const SolverStats stats = summarise(s, run).solver;
+  const std::size_t cs = run.trajectory.column("solver_status");
+  long lost = 0;
+  double back = -1.0;
+  for (std::size_t r = 0; r < run.trajectory.size(); ++r) {
+    const bool solved = run.trajectory(r, cs) == 0.0;
+    lost += solved ? 0 : 1;
+    if (solved && back < 0.0 && run.trajectory(r, ct) > 2.5) back = run.trajectory(r, ct);
+  }
+  EXPECT_NEAR(stats.task_lost_time, static_cast<double>(lost) * s.tau, 1e-12) << policy;
+  EXPECT_GE(lost, 50 + run.relaxed_steps) << policy;
+  EXPECT_GE(stats.task_lost_spells, 1) << policy;
+  EXPECT_EQ(stats.longest_task_loss.rfind("t = 2 s to ", 0), 0u) << policy << ": " << stats.longest_task_loss;
+  std::ostringstream back_text;
+  back_text << "back at " << back << " s";
+  EXPECT_NE(stats.longest_task_loss.find(back_text.str()), std::string::npos)
+      << policy << ": " << stats.longest_task_loss;
+  EXPECT_GT(back, 2.5) << policy;
+  EXPECT_LT(back, 4.5) << policy;
 }
 
 TEST(Brake, ARunRecoversAfterAWindowOfFailedStepsUnderBrake) { expect_recovery("brake"); }

@@ -36,6 +36,10 @@ struct SolverStats {
   int braked_steps = 0;                 //!< failed steps that braked ("brake", or "relax" where the elastic QP failed)
   double max_relaxed_task_error = 0.0;  //!< the largest max_r |J_r theta_dot - d_r| of a relaxed step
   std::string first_relaxed;            //!< "t = ...: <diagnosis>" of the first relaxed step, or empty
+  /// The rows whose solver_status is not 0 (relaxed, braked, held or failed): the task was not met as asked.
+  double task_lost_time = 0.0;    //!< their number times tau (s)
+  int task_lost_spells = 0;       //!< runs of consecutive such rows
+  std::string longest_task_loss;  //!< "t = a s to b s (k steps); back at c s" (or "; not back by the end"), or empty
 };
 
 /// A collision shape of a link, in that link's frame (the frames of frames.csv).

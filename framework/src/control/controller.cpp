@@ -82,8 +82,9 @@ Controller::Controller(const RobotModel& robot, const Scheme& scheme, LviEngine&
     ctx_.r_d_ddot = &r_d_ddot_;
     ctx_.theta_dot = &v_;
   }
-  // A robot with acceleration limits never stops at once: a failed step brakes.
-  if (robot.has_acceleration_limits()) set_failure_policy(FailurePolicy::kBrake);
+  // The default policy recovers: a robot with acceleration limits brakes (and catches up by the elastic QP), one
+  // without relaxes its rows. Neither stops at once.
+  set_failure_policy(robot.has_acceleration_limits() ? FailurePolicy::kBrake : FailurePolicy::kRelax);
 }
 
 StepOutput Controller::make_output() const {

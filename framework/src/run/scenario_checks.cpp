@@ -20,7 +20,7 @@ namespace {
 // The [solver] table's keys that are the run's, not the engine's: what a failed step does. Read through a schema,
 // like the engine's keys, so that `redres plugins` lists them with their defaults and rules.
 struct SolverPolicy {
-  FailurePolicy on_infeasible = FailurePolicy::kHold;
+  FailurePolicy on_infeasible = FailurePolicy::kRelax;
   double relax_weight = 1e4;
   double recover_error = 1e-3;
   double max_task_error = 0.01;
@@ -31,7 +31,7 @@ struct SolverPolicy {
                "what a step whose QP is not solved does: hold (theta_dot = 0; `continue` is the same), stop (the run "
                "ends there), relax (solves the elastic QP, rows relaxed, every bound kept), brake (decelerates within "
                "the acceleration limits, then catches up; docs/motion.md). Default: brake for a robot with "
-               "acceleration limits (which refuses hold), else hold"),
+               "acceleration limits (which refuses hold), else relax"),
          field("relax_weight", &C::relax_weight, "",
                "rho of the elastic QP; only with on_infeasible = \"relax\" or \"brake\"",
                rule<double>("a weight in [1, 1e8]", [](double w) { return w >= 1.0 && w <= 1e8; })),
@@ -59,7 +59,7 @@ namespace scenario_detail {
 
 void read_solver(const TableReader& r, Scenario& s) {
   const bool limits = s.robot->has_acceleration_limits();
-  s.on_infeasible = limits ? FailurePolicy::kBrake : FailurePolicy::kHold;
+  s.on_infeasible = limits ? FailurePolicy::kBrake : FailurePolicy::kRelax;
   if (!r.has("solver")) {
     s.engine = EngineSpec{};  // projection, with the default settings
     return;
@@ -68,12 +68,15 @@ void read_solver(const TableReader& r, Scenario& s) {
   const TableReader solver(t.file_ptr(), t.raw(), "solver");
   SolverPolicy policy;
   read_config(solver, SolverPolicy::schema(), policy);
-  if (solver.has("on_infeasible")) s.on_infeasible = policy.on_infeasible;
+  if (solver.has("on_infeasible")) {
+    s.on_infeasible = policy.on_infeasible;
+    s.on_infeasible_given = true;
+  }
   s.relax_weight = policy.relax_weight;
   s.recover_error = policy.recover_error;
   s.max_task_error = policy.max_task_error;
   const std::string chosen = solver.has("on_infeasible") ? std::string(solver.string("on_infeasible"))
-                                                         : std::string(limits ? "brake" : "hold") + "\", the default";
+                                                         : std::string(limits ? "brake" : "relax") + "\", the default";
   if (s.on_infeasible == FailurePolicy::kHold && limits) {
     solver.fail("on_infeasible", "\"" + chosen + "\" stops every joint at once, a velocity jump that robot '" +
                                      s.robot->name() +

@@ -124,8 +124,11 @@ StartReport check_start(const Scenario& s) {
   KinematicsData k(robot);
   report.sigma_min = task_sigma_min(robot, theta, k);
   report.w = k.w;
-  // Under on_infeasible = "relax" a singular start is allowed: the elastic QP moves the arm out of it.
-  if (!(report.sigma_min >= kSingularTolerance) && s.on_infeasible != FailurePolicy::kRelax) {
+  // Under on_infeasible = "relax", chosen by name, a singular start is allowed: the elastic QP moves the arm out of it.
+  // The default policy (relax too, for a robot without acceleration limits) does not allow it: a new user learns of
+  // the singular start before the run rather than from its relaxed steps.
+  if (!(report.sigma_min >= kSingularTolerance) &&
+      !(s.on_infeasible == FailurePolicy::kRelax && s.on_infeasible_given)) {
     double sigma = 0.0;
     const Eigen::VectorXd near = nearby_regular(robot, theta, k, sigma);
     std::string suggestion = "on_infeasible = \"relax\" lets the run start there";

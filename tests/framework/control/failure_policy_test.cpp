@@ -210,7 +210,8 @@ const std::string kStretched =
 TEST(FailureDiagnosis, AStretchedArmIsASingularConfigurationNotAnInfeasibleStep) {
   const auto file = write_scenario("stretched", kStretched);
   for (const char* engine : {"newton", "nlopt", "projection"}) {
-    Scenario s = load_scenario(file, {"solver.engine=\"" + std::string(engine) + "\""});
+    Scenario s =
+        load_scenario(file, {"solver.engine=\"" + std::string(engine) + "\"", "solver.on_infeasible=\"hold\""});
     const RunResult run = simulate(s);
     ASSERT_GT(run.failures, 0) << engine;
     const std::string& first = run.first_failure;
@@ -318,7 +319,7 @@ TEST(OnInfeasible, RelaxGetsPastASingularStartInsideEveryLimit) {
   EXPECT_EQ(sum.solver.relaxed_steps, run.relaxed_steps);
   EXPECT_LT(sum.max_position_error, 5e-3);  // past the singularity the task is tracked again
   // The same start held: the arm never leaves the singularity and ends far from the circle.
-  Scenario held = load_scenario(file);
+  Scenario held = load_scenario(file, {"solver.on_infeasible=\"hold\""});
   const RunSummary hs = summarise(held, simulate(held));
   EXPECT_GT(hs.max_position_error, 0.05);
 }
@@ -388,8 +389,10 @@ TEST(OnInfeasible, PolicyKeysAreChecked) {
   EXPECT_NE(message({"solver.on_infeasible=\"relax\"", "solver.relax_weight=0.5"})
                 .find("key 'relax_weight': expected a weight in [1, 1e8], got 0.5"),
             std::string::npos);
-  EXPECT_NE(message({"solver.relax_weight=100"}).find("is used only with on_infeasible = \"relax\""),
+  EXPECT_NE(message({"solver.on_infeasible=\"hold\"", "solver.relax_weight=100"})
+                .find("is used only with on_infeasible = \"relax\""),
             std::string::npos);
+  EXPECT_EQ(load_scenario(file, {"solver.relax_weight=100"}).relax_weight, 100.0);  // the default policy relaxes
   Scenario s = load_scenario(file, {"solver.on_infeasible=\"relax\"", "solver.relax_weight=100"});
   EXPECT_EQ(s.relax_weight, 100.0);
 }

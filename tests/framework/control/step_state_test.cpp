@@ -163,9 +163,11 @@ TEST(StepState, HeunsSecondStageSeesTheSamePreviousCommandAndTheNextStepTheAvera
 }
 
 TEST(StepState, AHeldStepLeavesAZeroCommand) {
-  // A path far faster than the joints: steps fail and are held (theta_dot = 0), and the next step sees zeros.
+  // A path far faster than the joints: steps fail and are held (theta_dot = 0, the policy chosen by name), and the
+  // next step sees zeros.
   StepRig rig(40.0);
   Controller ctrl(rig.robot, *rig.scheme, *rig.engine, rig.path.get(), 1.0, 0.01);
+  ctrl.set_failure_policy(FailurePolicy::kHold);
   StepOutput out = ctrl.make_output();
   Eigen::VectorXd theta = rig.robot.home();
   int held = 0;

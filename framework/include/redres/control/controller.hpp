@@ -114,7 +114,8 @@ class Controller {
   /// and the position error (m, > 0) above which kBrake tries the elastic QP first. kStop gives up at once as kHold
   /// does (a robot with acceleration limits brakes); the caller's loop ends there. Throws std::invalid_argument for
   /// kBrake or kHold on a robot that has (kHold) or lacks (kBrake) acceleration limits on every joint. The default is
-  /// kBrake for a robot with acceleration limits, else kHold. Allocates: call it before the loop.
+  /// kBrake for a robot with acceleration limits, else kRelax (the arm keeps moving within its bounds and returns to
+  /// the task once it is feasible again); kHold stays available by name. Allocates: call it before the loop.
   void set_failure_policy(FailurePolicy policy, double relax_weight = 1e4, double recover_error = 1e-3);
   [[nodiscard]] FailurePolicy failure_policy() const noexcept { return policy_; }
   /// Forgets the engine's warm start and a captured (not an explicitly set) orientation reference.
@@ -187,7 +188,7 @@ class Controller {
   Eigen::VectorXd v_;                  // acceleration level: the joint velocity at this step
   Eigen::VectorXd acc_lo_, acc_hi_;    // the acceleration limits at theta, once per step (robots that have them)
   Eigen::VectorXd jerk_lo_, jerk_hi_;  // the jerk limits at theta, once per step (robots that have them)
-  FailurePolicy policy_ = FailurePolicy::kHold;
+  FailurePolicy policy_ = FailurePolicy::kHold;  // the constructor sets the default (kBrake or kRelax)
   double recover_error_ = 1e-3;       // kBrake: the position error above which the elastic QP goes first
   ElasticFallback fallback_;          // the elastic QP of kRelax and kBrake, with its engine
   std::unique_ptr<Cascade> cascade_;  // the scheme's priority levels, one QP each (never null)

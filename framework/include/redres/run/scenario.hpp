@@ -63,7 +63,9 @@ struct Scenario {
   Eigen::Vector3d orientation_turn = Eigen::Vector3d::Zero();
   /// [solver] on_infeasible: what a step whose QP is not solved does (control/failure_policy.hpp); a failed step never
   /// integrates the engine's unconverged iterate, and under kStop the run ends there, with every row up to that step.
-  FailurePolicy on_infeasible = FailurePolicy::kHold;
+  /// The file's default: kBrake for a robot with acceleration limits, else kRelax.
+  FailurePolicy on_infeasible = FailurePolicy::kRelax;
+  bool on_infeasible_given = false;  //!< the file (or --set) named on_infeasible; the start check reads it
   double relax_weight = 1e4;     //!< [solver] relax_weight: rho of the elastic QP under "relax" and "brake" (1 to 1e8)
   double recover_error = 1e-3;   //!< [solver] recover_error (m): under "brake", the elastic QP goes first above it
   double max_task_error = 0.01;  //!< [solver] max_task_error (m): a larger position error makes the run no success

@@ -11,7 +11,7 @@ packages=(
   libmujoco-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri libpng-dev libgif-dev
   libjs-three chromium
   libgtest-dev libgmock-dev librapidcheck-dev libbenchmark-dev liborocos-kdl-dev
-  python3 python3-dev python3-matplotlib python3-numpy python3-pil python3-h5py
+  python3 python3-dev python3-matplotlib python3-numpy python3-pil python3-h5py python3-cvxopt
   pybind11-dev python3-pybind11 python3-pytest python3-pip python3-setuptools python3-wheel python3-venv mypy
   "$@"
 )

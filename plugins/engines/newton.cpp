@@ -44,6 +44,9 @@ namespace newton_internal {
 
 void Newton::do_setup(int n, int m_e, int m_i) {
   x_.setZero(n);
+  box_x_.setZero(n);
+  box_g_.setZero(n);
+  box_at_.assign(static_cast<std::size_t>(n), 0);
   free_.assign(static_cast<std::size_t>(n), 0);
   v_.setZero(n);
   jtd_.setZero(n);
@@ -130,6 +133,9 @@ REDRES_HOT void Newton::do_solve(const QpProblem& qp, SolverResult& result) {
   }
   if (!applicable) {
     if (general_solve(qp, result)) return;
+    // Bounds and equality rows (inequality rows slack or none), where the general path did not settle: the primal
+    // active-set method.
+    if (slack_rows_only(qp) && box_solve(qp, result)) return;
     result.info.diagnosis = "newton's general path did not settle";
     run_fallback(qp, result, 0, std::numeric_limits<double>::infinity(), u_.head(qp.n()));
     return;

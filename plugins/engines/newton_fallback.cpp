@@ -51,6 +51,32 @@ void Newton::run_fallback(const QpProblem& qp, SolverResult& result, int newton_
     y_ = result.y;
     return;
   }
+  // Projection stopped short (its iteration cap, or an answer the certificate refused): its answer, on a W whose
+  // smallest eigenvalues leave it far from the optimum in x, usually has the right active set, and the exact step
+  // from it lands (polish()).
+  const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
+  lo_u_.head(n) = qp.lo;
+  hi_u_.head(n) = qp.hi;
+  lo_u_.segment(n, me).setConstant(-settings().varpi);
+  hi_u_.segment(n, me).setConstant(settings().varpi);
+  lo_u_.tail(mi).setZero();
+  hi_u_.tail(mi).setConstant(settings().varpi);
+  set_norms(qp);
+  u_.head(n) = fallback_result_.x;  // its duals were cleared with its failure: the first exact step restores them
+  u_.segment(n, me) = fallback_result_.y;
+  u_.tail(mi) = fallback_result_.z;
+  double e2 = natural_residual2(qp, u_);
+  if (std::sqrt(e2) <= target_at(u_) || polish(qp, e2)) {
+    result.x = u_.head(n).cwiseMax(qp.lo).cwiseMin(qp.hi);
+    result.y = u_.segment(n, me);
+    result.z = u_.tail(mi);
+    result.info.status = SolverStatus::kSolved;
+    result.info.iterations = newton_iterations + fb.iterations;
+    result.info.residual = std::sqrt(e2);
+    result.info.diagnosis.clear();
+    y_ = result.y;
+    return;
+  }
   // Neither solved it: the step stays newton's, with the better of the two answers.
   if (fb.residual < newton_residual) {
     result.x = fallback_result_.x;

@@ -36,6 +36,7 @@ inline double box(double v, double lo, double hi) { return std::min(std::max(v, 
 constexpr int kMaxNewtonIterations = 100;
 constexpr int kMaxOuterIterations = 50;   // the general path's method of multipliers
 constexpr int kMaxInnerIterations = 100;  // Newton steps per augmented Lagrangian minimisation
+constexpr int kMaxPolishSteps = 30;       // exact steps from the fallback's answer (polish())
 
 class Newton final : public LviEngine {
  public:
@@ -82,6 +83,10 @@ class Newton final : public LviEngine {
   void set_norms(const QpProblem& qp);
   double target_at(const Eigen::VectorXd& w) const;
   bool exact_step_lands(const QpProblem& qp, double& e2);
+  // A QP whose only constraints are the bounds (rows slack or none), by the primal active-set method.
+  bool box_solve(const QpProblem& qp, SolverResult& result);
+  // Exact steps from u_ (e2 its residual) while each lowers the residual, until one lands.
+  bool polish(const QpProblem& qp, double& e2);
   double natural_residual2(const QpProblem& qp, const Eigen::VectorXd& w);
   void apply_m(const QpProblem& qp, const Eigen::VectorXd& w, Eigen::VectorXd& out) const;
 
@@ -101,6 +106,10 @@ class Newton final : public LviEngine {
   // W_FF^-1 B', W_FF's factor, the Schur complement S and its unknowns w, and W_FF^-1 r_x.
   Eigen::VectorXd u_, mu_, e_, rhs_, du_, lo_u_, hi_u_;
   Eigen::VectorXd trial_;
+  double trial_e2_ = 0.0;
+  Eigen::VectorXd box_x_, box_g_;    // box_solve(): x and the gradient W x + zeta
+  std::vector<signed char> box_at_;  // box_solve(): -1 at lo, +1 at hi, 0 free  // the residual of exact_step_lands()'s
+                                     // last trial (infinity when it made none)
   std::vector<int> free_x_, free_w_;
   Eigen::MatrixXd bt_, yt_, wff_, s_kkt_;
   Eigen::VectorXd w_, h_;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "newton_internal.hpp"
 
@@ -156,6 +157,7 @@ void cholesky_solve(const double* a, Eigen::Index lda, Eigen::Index m, double* v
 // S = B W_FF^-1 B', S w = r_w - B W_FF^-1 r_x, dx_F = W_FF^-1 (r_x + B' w). Its size is that of the live rows, not
 // of all of them: slack inequality rows (z = 0 on its bound) never enter it. Storage is sized at setup.
 bool Newton::exact_step_lands(const QpProblem& qp, double& e2) {
+  trial_e2_ = std::numeric_limits<double>::infinity();
   const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
   const Eigen::Index N = u_.size();
   // The clamped components' moves in du_ (zero at the free ones), the free joints and duals by index.
@@ -234,10 +236,146 @@ bool Newton::exact_step_lands(const QpProblem& qp, double& e2) {
   if (!du_.allFinite()) return false;
   trial_ = u_ + du_;
   const double landed = natural_residual2(qp, trial_);
+  trial_e2_ = landed;
   if (!(std::sqrt(landed) <= target_at(trial_))) return false;
   u_.swap(trial_);
   e2 = landed;
   return true;
+}
+
+// The primal active-set method for min x'Wx/2 + zeta'x subject to J x = d and lo <= x <= hi (W symmetric positive
+// definite, no inequality rows that bind). From a feasible point (the rows' best fit inside the bounds, which meets
+// them), Newton's step to the minimiser on the current face (the joints at a bound held there, J p = 0 through the
+// Schur complement J_F W_FF^-1 J_F'), cut at the first bound it meets, which joins the face; at a face's minimiser,
+// the bound whose multiplier (W x + zeta - J'y at that joint) has the wrong sign is released. Each face's minimiser
+// is lower than the last, so no face recurs, and the method ends at the optimum in finitely many steps. On a W with
+// eigenvalues near zero the face's step is long, and the cut keeps it inside the box, where the exact step of the
+// natural map overshoots.
+bool Newton::box_solve(const QpProblem& qp, SolverResult& result) {
+  const int n = qp.n(), me = qp.m_eq();
+  const double* __restrict W = qp.W.data();
+  const double* __restrict J = qp.J.data();
+  if (me > 0) {
+    const RowFit& fit = row_fit(qp);
+    if (!(fit.equality_miss <= 1e-12 * (1.0 + qp.d.lpNorm<Eigen::Infinity>()))) return false;
+    box_x_ = fit.x;
+  } else {
+    for (int i = 0; i < n; ++i) box_x_(i) = warm() && result.x.size() == n ? result.x(i) : 0.0;
+  }
+  for (int i = 0; i < n; ++i) {
+    box_x_(i) = box(box_x_(i), qp.lo(i), qp.hi(i));
+    box_at_[static_cast<std::size_t>(i)] = box_x_(i) == qp.lo(i) ? -1 : box_x_(i) == qp.hi(i) ? 1 : 0;
+  }
+  w_.head(me).setZero();  // the rows' multipliers y of the last face
+  bool at_minimiser = false;
+  for (int iteration = 0; iteration < 20 * n + 50; ++iteration) {
+    box_g_.noalias() = qp.W * box_x_;
+    box_g_ += qp.zeta;
+    if (at_minimiser) {
+      // The bounds' multipliers r = g - J'y: at lo r must not be negative, at hi not positive.
+      int release = -1;
+      double worst = 1e-15 * (1.0 + box_g_.lpNorm<Eigen::Infinity>());
+      for (int i = 0; i < n; ++i) {
+        const signed char at = box_at_[static_cast<std::size_t>(i)];
+        if (at == 0 || qp.lo(i) == qp.hi(i)) continue;
+        double r = box_g_(i);
+        for (int c = 0; c < me; ++c) r -= J[c + static_cast<std::ptrdiff_t>(i) * me] * w_(c);
+        const double wrong = at < 0 ? -r : r;
+        if (wrong > worst) {
+          worst = wrong;
+          release = i;
+        }
+      }
+      if (release < 0) {
+        result.x = box_x_;
+        result.y = w_.head(me);
+        result.z.setZero();
+        result.info.status = SolverStatus::kSolved;
+        result.info.iterations = iteration;
+        result.info.residual = 0.0;
+        return true;
+      }
+      box_at_[static_cast<std::size_t>(release)] = 0;
+    }
+    // Newton's step on the free joints: p_F = W_FF^-1 (J_F' y - g_F) with J_F p_F = d - J x (0 but for rounding),
+    // i.e. S y = J_F W_FF^-1 g_F + d - J x.
+    int nf = 0;
+    for (int i = 0; i < n; ++i) {
+      if (box_at_[static_cast<std::size_t>(i)] == 0) free_x_[static_cast<std::size_t>(nf++)] = i;
+    }
+    if (me > nf) return false;  // the rows fix the free joints: J_F has no full row rank
+    for (int b = 0; b < nf; ++b) {
+      const std::ptrdiff_t jb = free_x_[static_cast<std::size_t>(b)];
+      h_(b) = box_g_(jb);
+      for (int c = 0; c < me; ++c) yt_(b, c) = J[c + jb * me];
+      for (int a = b; a < nf; ++a) wff_(a, b) = W[free_x_[static_cast<std::size_t>(a)] + jb * n];
+    }
+    if (!cholesky_in_place(wff_.data(), wff_.rows(), nf, 0.0)) return false;
+    cholesky_solve(wff_.data(), wff_.rows(), nf, h_.data());  // W_FF^-1 g_F
+    double scale = 0.0;
+    for (int c = 0; c < me; ++c) {
+      double t = 0.0;
+      for (int f = 0; f < nf; ++f) t += yt_(f, c) * h_(f);
+      double miss = qp.d(c);  // and d - J x: the step also takes back what rounding moved the rows by
+      for (int i = 0; i < n; ++i) miss -= J[c + static_cast<std::ptrdiff_t>(i) * me] * box_x_(i);
+      w_(c) = t + miss;  // J_F W_FF^-1 g_F + (d - J x)
+      cholesky_solve(wff_.data(), wff_.rows(), nf, yt_.data() + static_cast<std::ptrdiff_t>(c) * yt_.rows());
+    }
+    for (int c = 0; c < me; ++c) {
+      for (int r = c; r < me; ++r) {
+        double t = 0.0;
+        for (int f = 0; f < nf; ++f)
+          t += J[r + static_cast<std::ptrdiff_t>(free_x_[static_cast<std::size_t>(f)]) * me] * yt_(f, c);
+        s_kkt_(r, c) = t;
+      }
+      scale = std::max(scale, s_kkt_(c, c));
+    }
+    if (me > 0) {
+      if (!cholesky_in_place(s_kkt_.data(), s_kkt_.rows(), me, scale)) return false;
+      cholesky_solve(s_kkt_.data(), s_kkt_.rows(), me, w_.data());
+    }
+    for (int f = 0; f < nf; ++f) {
+      double t = -h_(f);
+      for (int c = 0; c < me; ++c) t += yt_(f, c) * w_(c);
+      h_(f) = t;  // p_F
+    }
+    double alpha = 1.0;
+    int blocking = -1;
+    bool up = false;  // the blocking joint meets its upper bound
+    for (int f = 0; f < nf; ++f) {
+      const int i = free_x_[static_cast<std::size_t>(f)];
+      const double p = h_(f);
+      const double reach = p > 0.0 ? (qp.hi(i) - box_x_(i)) / p : p < 0.0 ? (qp.lo(i) - box_x_(i)) / p : alpha;
+      if (reach < alpha) {
+        alpha = std::max(reach, 0.0);
+        blocking = i;
+        up = p > 0.0;
+      }
+    }
+    if (!std::isfinite(alpha) || !h_.head(nf).allFinite()) return false;
+    for (int f = 0; f < nf; ++f) {
+      const int i = free_x_[static_cast<std::size_t>(f)];
+      box_x_(i) = box(box_x_(i) + alpha * h_(f), qp.lo(i), qp.hi(i));
+    }
+    if (blocking >= 0) {
+      box_x_(blocking) = up ? qp.hi(blocking) : qp.lo(blocking);
+      box_at_[static_cast<std::size_t>(blocking)] = up ? 1 : -1;
+    }
+    at_minimiser = blocking < 0;
+  }
+  return false;
+}
+
+// Semismooth Newton on the natural map from u_, undamped but kept only while it lowers ||e||: where the active set of
+// u_ is nearly right (an answer another engine stopped short with), the exact step lands within a few steps.
+bool Newton::polish(const QpProblem& qp, double& e2) {
+  for (int k = 0; k < kMaxPolishSteps; ++k) {
+    if (exact_step_lands(qp, e2)) return true;
+    if (!(trial_e2_ < e2)) return false;  // no step, or no progress
+    u_.swap(trial_);                      // mu_ and e_ are the trial's (natural_residual2 ran last on it)
+    e2 = trial_e2_;
+  }
+  return false;
 }
 
 // out = M w: [W x - J' y + A' z; J x; -A x] for w = [x; y; z] (no temporaries).

@@ -52,6 +52,7 @@ from ._redres import (  # noqa: F401  (re-exported)
     StepQp,
     check_plugins,
     mujoco_available,
+    solve_qp,
     trajectory_column_groups,
 )
 

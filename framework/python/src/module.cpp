@@ -268,6 +268,75 @@ py::list typed_rows(const SweepTable& table, const SweepSpec& spec) {
   return rows;
 }
 
+// --- QPs ---------------------------------------------------------------------------------------------------------
+
+py::dict qp_dict(const QpProblem& qp) {
+  py::dict d;
+  d["W"] = Eigen::MatrixXd(qp.W);
+  d["zeta"] = Eigen::VectorXd(qp.zeta);
+  d["J"] = Eigen::MatrixXd(qp.J);
+  d["d"] = Eigen::VectorXd(qp.d);
+  d["A"] = Eigen::MatrixXd(qp.A);
+  d["b"] = Eigen::VectorXd(qp.b);
+  d["lo"] = Eigen::VectorXd(qp.lo);
+  d["hi"] = Eigen::VectorXd(qp.hi);
+  return d;
+}
+
+// redres.solve_qp: one QP given as qp_dict's keys, solved by a named engine from a cold start.
+py::dict solve_qp(const py::dict& given, const std::string& engine, double tolerance, int max_iterations) {
+  const auto matrix = [&](const char* key) { return given[key].cast<Eigen::MatrixXd>(); };
+  const auto vector = [&](const char* key) { return given[key].cast<Eigen::VectorXd>(); };
+  for (const char* key : {"W", "zeta", "J", "d", "lo", "hi"}) {
+    if (!given.contains(key)) throw std::invalid_argument(std::string("solve_qp: the QP has no '") + key + "'");
+  }
+  const Eigen::MatrixXd W = matrix("W"), J = matrix("J");
+  const Eigen::Index n = W.rows();
+  const Eigen::MatrixXd A = given.contains("A") ? matrix("A") : Eigen::MatrixXd(0, n);
+  QpProblem qp;
+  qp.resize(static_cast<int>(n), static_cast<int>(J.rows()), static_cast<int>(A.rows()));
+  const auto fill = [](auto& into, const auto& from, const char* key) {
+    if (into.rows() != from.rows() || into.cols() != from.cols()) {
+      throw std::invalid_argument(std::string("solve_qp: '") + key + "' is " + std::to_string(from.rows()) + " x " +
+                                  std::to_string(from.cols()) + ", expected " + std::to_string(into.rows()) + " x " +
+                                  std::to_string(into.cols()));
+    }
+    into = from;
+  };
+  fill(qp.W, W, "W");
+  fill(qp.zeta, vector("zeta"), "zeta");
+  fill(qp.J, J, "J");
+  fill(qp.d, vector("d"), "d");
+  fill(qp.A, A, "A");
+  fill(qp.b, given.contains("b") ? vector("b") : Eigen::VectorXd(0), "b");
+  fill(qp.lo, vector("lo"), "lo");
+  fill(qp.hi, vector("hi"), "hi");
+  qp.validate();
+  SolverSettings settings;
+  settings.tolerance = tolerance;
+  settings.max_iterations = max_iterations;
+  std::unique_ptr<LviEngine> solver = make_engine(engine, settings);
+  SolverResult r;
+  solver->setup(qp.n(), qp.m_eq(), qp.m_in(), r);
+  {
+    py::gil_scoped_release release;
+    solver->solve(qp, r);  // checks W's structure itself: a dense W is solved as dense
+  }
+  py::dict out;
+  out["x"] = Eigen::VectorXd(r.x);
+  out["y"] = Eigen::VectorXd(r.y);
+  out["z"] = Eigen::VectorXd(r.z);
+  out["status"] = to_string(r.info.status);
+  out["engine"] = std::string(r.info.engine);
+  out["iterations"] = r.info.iterations;
+  out["residual"] = r.info.residual;
+  out["primal_residual"] = r.info.primal_residual;
+  out["dual_residual"] = r.info.dual_residual;
+  out["complementarity"] = r.info.complementarity;
+  out["diagnosis"] = r.info.diagnosis;
+  return out;
+}
+
 // --- controllers -------------------------------------------------------------------------------------------------
 
 // One step's SolverInfo, with the engine's name owned.
@@ -922,19 +991,26 @@ PYBIND11_MODULE(_redres, m) {
           "qp",
           [](py::handle p) {
             PyController& c = live(p);
-            const QpProblem qp = in_turn(c, "Controller.qp", [](Controller& k) { return QpProblem(k.qp()); });
-            py::dict d;
-            d["W"] = Eigen::MatrixXd(qp.W);
-            d["zeta"] = Eigen::VectorXd(qp.zeta);
-            d["J"] = Eigen::MatrixXd(qp.J);
-            d["d"] = Eigen::VectorXd(qp.d);
-            d["A"] = Eigen::MatrixXd(qp.A);
-            d["b"] = Eigen::VectorXd(qp.b);
-            d["lo"] = Eigen::VectorXd(qp.lo);
-            d["hi"] = Eigen::VectorXd(qp.hi);
-            return d;
+            return qp_dict(in_turn(c, "Controller.qp", [](Controller& k) { return QpProblem(k.qp()); }));
           },
-          "the last step's QP (copies): W, zeta, J, d, A, b, lo, hi");
+          "the last step's QP (copies): W, zeta, J, d, A, b, lo, hi (the first priority level's)")
+      .def(
+          "level_qp",
+          [](py::handle p, int level) {
+            PyController& c = live(p);
+            return qp_dict(in_turn(c, "Controller.level_qp", [level](Controller& k) {
+              const int levels = static_cast<int>(k.levels().levels().size());
+              if (level < 0 || level >= std::max(levels, 1)) {
+                throw std::invalid_argument("Controller.level_qp: level " + std::to_string(level) +
+                                            " is not one of the scheme's " + std::to_string(std::max(levels, 1)) +
+                                            " priority levels");
+              }
+              return QpProblem(k.levels().problem(level));
+            }));
+          },
+          py::arg("level"),
+          "the last step's QP of priority level `level` (0 is the first; a lower level's rows hold the levels above "
+          "it at their optima), as `qp` gives it");
 
   m.def(
       "_sweep",
@@ -995,6 +1071,11 @@ PYBIND11_MODULE(_redres, m) {
       },
       "The standard columns of trajectory.csv (and of a Result), group by group: name (or prefix), count ('1', "
       "'n' per joint, 'm_ref' per reference row), unit and meaning; the same list the C++ run fills its rows from.");
+  m.def("solve_qp", &solve_qp, py::arg("qp"), py::arg("engine") = "newton", py::arg("tolerance") = 1e-9,
+        py::arg("max_iterations") = 100000,
+        "Solves one QP (a dict with Controller.qp's keys; A and b may be left out) with the named engine from a cold "
+        "start. Returns x, y, z, status ('solved' only when the certificate holds), engine, iterations, residual, "
+        "primal_residual, dual_residual, complementarity and diagnosis.");
   m.def("_registry", &registry_listing);
   m.def("_plugin_kinds", &kinds_listing);
   m.def(

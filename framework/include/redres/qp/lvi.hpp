@@ -105,6 +105,9 @@ class LviEngine {
   /// and the inequality rows' excesses), as the LVI residual measures them. The one decision behind every
   /// `infeasible` status. For failed solves only; the fit allocates nothing (a RowFitter sized by setup()).
   [[nodiscard]] bool rows_unmeetable(const QpProblem& qp);
+  /// The best fit of qp's rows inside its bounds (RowFitter; allocation-free), valid until the next fit: a point of
+  /// the feasible set when the rows can be met.
+  [[nodiscard]] const RowFit& row_fit(const QpProblem& qp) { return fitter_.fit(qp); }
 
  protected:
   /// Whether `result` holds a previous solution to start from.

@@ -59,7 +59,7 @@ void JointJerkLimits::add_to(const Context& ctx, QpBuilder& builder, PluginData*
     d.lo(j) = ctx.velocity_to_x(v(j) + tau * a_lo, j);
     d.hi(j) = ctx.velocity_to_x(v(j) + tau * a_hi, j);
   }
-  builder.intersect_bounds(d.lo, d.hi);
+  builder.yield_bounds(d.lo, d.hi);
 }
 
 namespace {

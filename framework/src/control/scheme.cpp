@@ -58,6 +58,11 @@ Scheme::Scheme(const RobotModel& robot, std::vector<std::unique_ptr<Objective>> 
     m_eq_ += e;
     m_in_ += i;
   }
+  for (int yielding = 0; yielding < 2; ++yielding) {
+    for (std::size_t k = 0; k < constraints_.size(); ++k) {
+      if (constraints_[k]->yields_bounds() == (yielding == 1)) constraint_order_.push_back(k);
+    }
+  }
   m_eq_c_ = m_eq_;
   m_in_c_ = m_in_;
   for (const auto& t : tasks_) {
@@ -357,9 +362,11 @@ REDRES_HOT bool Scheme::contribute_all(const Context& ctx, QpProblem& qp, Scheme
     }
     full_w = full_w || builder.written_w() == QpBuilder::WrittenW::kFull;
   }
-  for (std::size_t k = 0; k < constraints_.size(); ++k) {
+  // Constraints whose bounds yield come last (constraint_order_); sources are numbered in the list's order.
+  const int first_constraint = source;
+  for (const std::size_t k : constraint_order_) {
     // Inactive constraints leave their rows empty: 0 x = 0 and 0 x <= 0 are always met.
-    builder.begin(source++, 1.0, eq_offset_[k], eq_rows_[k], in_offset_[k], in_rows_[k]);
+    builder.begin(first_constraint + static_cast<int>(k), 1.0, eq_offset_[k], eq_rows_[k], in_offset_[k], in_rows_[k]);
     PluginData* own = data.constraints[k].get();
     if (checked) {
       constraints_[k]->contribute(ctx, builder, own);

@@ -161,6 +161,63 @@ TEST(JerkLimits, BoundTheChangeOfAccelerationFromTheLastTwoCommands) {
   EXPECT_NEAR(out.theta_dot(0), ctrl.qp().lo(0), 1e-9);
 }
 
+// Joint centering drives joints 1 and 4 at full speed onto their position limits (no angle margin). Near the limit
+// the braking term of joint_acceleration_limits asks for more deceleration than the jerk limit allows in one step;
+// the jerk bounds yield (they are added last and clipped to the others), so no step is infeasible, the positions and
+// accelerations stay within their limits, and the jerk exceeds its limit only on those steps.
+TEST(JerkLimits, YieldToTheBrakingTermAtAPositionLimit) {
+  const auto robot = panda();
+  const int n = robot->dof();
+  Eigen::VectorXd ref = robot->home();
+  ref(0) = robot->upper_limits()(0) + 1.0;
+  ref(3) = robot->upper_limits()(3) + 1.0;
+  std::ostringstream centering;
+  centering << "lambda = 20.0\ntheta_ref = [";
+  for (int j = 0; j < n; ++j) centering << (j > 0 ? ", " : "") << ref(j);
+  centering << "]\n";
+  // The jerk limits listed first: the scheme still adds them after the others.
+  const auto scheme =
+      scheme_from_text(constraint_entry("joint_jerk_limits") + objective_entry("min_velocity_norm") +
+                           objective_entry("joint_centering", centering.str()) +
+                           constraint_entry("joint_velocity_limits") + constraint_entry("joint_acceleration_limits"),
+                       *robot);
+  auto engine = make_engine("newton");
+  const double tau = 0.001;
+  Controller ctrl(*robot, *scheme, *engine, nullptr, 3.0, tau);
+  StepOutput out = ctrl.make_output();
+  const Eigen::VectorXd r = Eigen::VectorXd::Zero(robot->reference_dim());
+  Eigen::VectorXd theta = robot->home(), prev = Eigen::VectorXd::Zero(n), prev2 = prev;
+  Eigen::VectorXd a_lo(n), a_hi(n), j_lo(n), j_hi(n);
+  int over_jerk = 0;
+  for (int k = 0; k <= 3000; ++k) {
+    ctrl.step(theta, k * tau, r, r, out);
+    ASSERT_EQ(out.info.status, SolverStatus::kSolved) << "t = " << k * tau << ": " << out.info.diagnosis;
+    robot->acceleration_limits(theta, a_lo, a_hi);
+    robot->jerk_limits(theta, j_lo, j_hi);
+    bool jerk_exceeded = false;
+    for (int j = 0; j < n; ++j) {
+      const double a = (out.theta_dot(j) - prev(j)) / tau, a_prev = (prev(j) - prev2(j)) / tau;
+      EXPECT_GE(a, a_lo(j) - 1e-6) << "t = " << k * tau << ", joint " << j + 1;
+      EXPECT_LE(a, a_hi(j) + 1e-6) << "t = " << k * tau << ", joint " << j + 1;
+      const double jerk = (a - a_prev) / tau;
+      jerk_exceeded = jerk_exceeded || jerk < j_lo(j) * (1.0 + 1e-9) - 1e-6 || jerk > j_hi(j) * (1.0 + 1e-9) + 1e-6;
+    }
+    over_jerk += jerk_exceeded ? 1 : 0;
+    theta += tau * out.theta_dot;
+    ASSERT_LE(theta(0), robot->upper_limits()(0) + 1e-9) << "t = " << k * tau;
+    ASSERT_LE(theta(3), robot->upper_limits()(3) + 1e-9) << "t = " << k * tau;
+    prev2 = prev;
+    prev = out.theta_dot;
+  }
+  // Both joints reached their limits and stopped there.
+  EXPECT_GT(theta(0), robot->upper_limits()(0) - 1e-3);
+  EXPECT_GT(theta(3), robot->upper_limits()(3) - 1e-3);
+  EXPECT_LT(prev.norm(), 1e-6);
+  // The yielding happened (the case is exercised) and stayed rare.
+  EXPECT_GE(over_jerk, 1);
+  EXPECT_LE(over_jerk, 20);
+}
+
 TEST(Brake, AFailedStepDeceleratesAlongThePreviousCommandWithinTheLimits) {
   const auto robot = panda();
   const int n = robot->dof();

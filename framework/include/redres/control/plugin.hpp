@@ -176,6 +176,10 @@ class Constraint : public Plugin {
   void contribute_unchecked(const Context& ctx, QpBuilder& builder, PluginData* data) const {
     if (active()) add_to(ctx, builder, data);
   }
+  /// Whether its bounds yield to every other constraint's: the scheme adds it after them, and it writes its bounds
+  /// with QpBuilder::yield_bounds(), which clips them to the bounds already there (joint_jerk_limits: a smoothness
+  /// limit that gives way to position, velocity and acceleration bounds instead of making the step infeasible).
+  [[nodiscard]] virtual bool yields_bounds() const { return false; }
   /// Number of equality rows it writes (fixed at setup).
   [[nodiscard]] virtual int equality_rows(const RobotModel& robot) const {
     (void)robot;

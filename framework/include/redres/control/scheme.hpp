@@ -127,6 +127,7 @@ class Scheme {
   std::vector<std::unique_ptr<const Task>> tasks_;
   std::vector<SchemeLevelSpec> levels_;
   std::vector<int> eq_offset_, eq_rows_, in_offset_, in_rows_;
+  std::vector<std::size_t> constraint_order_;  // the order of their contributions: those whose bounds yield last
   std::vector<int> task_eq_offset_, task_eq_rows_, task_in_offset_, task_in_rows_;  // one level: the tasks' rows
   std::vector<bool> task_active_;  // active when the scheme was built (only those are in levels_ and the QP)
   int m_eq_ = 0, m_in_ = 0, m_eq_c_ = 0, m_in_c_ = 0;

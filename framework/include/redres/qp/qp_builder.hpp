@@ -103,6 +103,18 @@ class QpBuilder {
       for (Eigen::Index i = 0; i < n; ++i) intersect_bound(static_cast<int>(i), a[i], b[i]);  // throws at the first
     }
   }
+  /// intersect_bounds() for bounds that yield to those already there: each is first clipped into the current
+  /// [lo_i, hi_i] (a lower bound above hi_i becomes hi_i), so that they never conflict. For a constraint whose
+  /// yields_bounds() is true; the scheme adds such constraints after the others.
+  void yield_bounds(Eigen::Ref<Eigen::VectorXd> lower, Eigen::Ref<Eigen::VectorXd> upper) {
+    const Eigen::Index n = qp_->lo.size();
+    if (lower.size() != n || upper.size() != n) bad_size("QpBuilder::yield_bounds", "lower and upper have n entries");
+    for (Eigen::Index i = 0; i < n; ++i) {
+      lower[i] = std::min(lower[i], qp_->hi[i]);  // NaN stays NaN (min returns its first argument): still refused
+      upper[i] = std::max(upper[i], qp_->lo[i]);
+    }
+    intersect_bounds(lower, upper);
+  }
   /// The same for one joint.
   void intersect_bound(int joint, double lower, double upper) {
     if (joint < 0 || joint >= qp_->n() || std::isnan(lower) || std::isnan(upper)) bad_bound(joint, lower, upper);

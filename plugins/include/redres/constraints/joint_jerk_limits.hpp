@@ -29,6 +29,9 @@ class JointJerkLimits final : public Configured<Constraint, JointJerkLimitsConfi
   /// Throws std::invalid_argument naming the first joint of `robot` without a jerk limit.
   JointJerkLimits(const Config& config, const RobotModel& robot);
   [[nodiscard]] bool supports(ControlOrder /*order*/) const override { return true; }
+  /// Its bounds yield to every other constraint's (docs/motion.md): a joint that must brake harder than the jerk
+  /// limit allows, to stay within its position, velocity or acceleration bounds, brakes.
+  [[nodiscard]] bool yields_bounds() const override { return true; }
   [[nodiscard]] std::unique_ptr<PluginData> make_data() const override;
 
  private:

@@ -10,6 +10,11 @@
 namespace redres {
 
 namespace {
+// How much more tightly the levels below the first are solved than the first (Cascade's constructor).
+constexpr double kHeldTighter = 1e-4;
+}  // namespace
+
+namespace {
 // A held row whose part outside the rows held before it is below this (relative to its norm) adds nothing.
 constexpr double kDependent = 1e-6;
 }  // namespace
@@ -102,7 +107,11 @@ Cascade::Cascade(const Scheme& scheme, const SchemeData& data, LviEngine& engine
   held_d_ = Eigen::VectorXd::Zero(held_J_.rows());
   held_A_ = Eigen::MatrixXd::Zero(held_in, n_);
   held_b_ = Eigen::VectorXd::Zero(held_in);
-  const SolverSettings& settings = engine.settings();
+  // The levels below the first hold the optima of those above as rows: they are solved kHeldTighter times more
+  // tightly than the first (1e-10 at the default 1e-6), so that a lower level cannot gain what a higher one loses
+  // by the tolerance (docs/tasks.md).
+  SolverSettings settings = engine.settings();
+  settings.tolerance = std::max(1e-14, settings.tolerance * kHeldTighter);
   for (std::size_t l = 0; l < levels_.size(); ++l) {
     Level& L = *levels_[l];
     for (int rank = 0; rank <= L.held_eq; ++rank) {

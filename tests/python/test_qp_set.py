@@ -168,3 +168,21 @@ def test_a_lower_level_never_gains_what_a_higher_one_loses():
     print(f"\npriority 0 held to {worst:.2g} over {s.steps + 1} steps; level 1 relaxed on {relaxed}")
     assert relaxed > 0  # the case is exercised: level 1 cannot be met
     assert worst <= 1e-9
+
+
+def test_a_level_its_engine_cannot_solve_is_tried_by_newton_before_least_squares():
+    """projection with 5 iterations per solve: where the first level still gets solved, a lower level that
+    projection leaves at its iteration cap is solved by newton (before it would be relaxed into least squares)."""
+    s = redres.Scenario.load(source("configs/panda_tool_elbow_posture.toml"),
+                             overrides={"solver.engine": "projection", "solver.max_iterations": 5})
+    ctrl = redres.Controller.from_scenario(s)
+    theta = s.theta0.copy()
+    by_newton = 0
+    for k in range(200):
+        theta_dot, info = ctrl.step(theta, k * s.step)
+        if info.levels[0].status == "solved":
+            assert all(level.status == "solved" for level in info.levels), [l.diagnosis for l in info.levels]
+            by_newton += sum("max_iterations with projection, solved by newton" in level.diagnosis
+                             for level in info.levels[1:])
+        theta = theta + s.step * theta_dot
+    assert by_newton >= 1

@@ -46,7 +46,11 @@ struct Cascade::Slot {
   QpProblem qp, ls;
   std::unique_ptr<LviEngine> own, ls_engine;  // the level's engines (the first level's is the controller's)
   LviEngine* engine = nullptr;
-  SolverResult result, ls_result;
+  // Below the first level, when the level's engine is not newton: newton, tried on the level's QP when that engine
+  // fails without finding the rows unmeetable, before the least-squares retry. newton itself goes on to projection
+  // (its fallback) and is not followed by nlopt, which allocates in every solve.
+  std::unique_ptr<LviEngine> next;
+  SolverResult result, ls_result, next_result;
   bool used_ls = false;  // the last step's answer came from the least-squares retry
 };
 
@@ -122,6 +126,10 @@ Cascade::Cascade(const Scheme& scheme, const SchemeData& data, LviEngine& engine
       } else {
         slot->own = make_engine(std::string(engine.name()), settings);
         slot->engine = slot->own.get();
+        if (engine.name() != "newton") {
+          slot->next = make_engine("newton", settings);
+          slot->next->setup(slot->qp.n(), slot->qp.m_eq(), slot->qp.m_in(), slot->next_result);
+        }
       }
       slot->engine->setup(slot->qp.n(), slot->qp.m_eq(), slot->qp.m_in(), slot->result);
       if (L.has_ls) {
@@ -199,6 +207,7 @@ void Cascade::reset() {
     for (auto& slot : level->slots) {
       slot->engine->reset();
       if (slot->ls_engine) slot->ls_engine->reset();
+      if (slot->next) slot->next->reset();
     }
   }
 }
@@ -446,7 +455,22 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
     level.residual = S.result.info.residual;
     level.status = S.result.info.status;
     SolverResult* answer = nullptr;
-    if (S.result.info.status == SolverStatus::kSolved) {
+    LviEngine* solved_by = S.engine;
+    if (S.result.info.status != SolverStatus::kSolved && S.result.info.status != SolverStatus::kInfeasible && S.next) {
+      // The level's engine stopped short on a QP whose rows can be met: the next engine tries it.
+      S.next->solve_valid(S.qp, S.next_result);
+      level.iterations += S.next_result.info.iterations;
+      if (S.next_result.info.status == SolverStatus::kSolved) {
+        text << to_string(S.result.info.status) << " with " << S.engine->name() << ", solved by " << S.next->name();
+        level.status = SolverStatus::kSolved;
+        level.residual = S.next_result.info.residual;
+        answer = &S.next_result;
+        solved_by = S.next.get();
+      }
+    }
+    if (answer != nullptr) {
+      // solved by the next engine
+    } else if (S.result.info.status == SolverStatus::kSolved) {
       answer = &S.result;
     } else if (L.has_ls) {
       assemble(static_cast<int>(l), data, S.ls, true);
@@ -475,7 +499,7 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
     }
     if (answer != nullptr && least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone) {
       const bool first = !S.used_ls;
-      refine(first ? S.qp : S.ls, first ? *S.engine : *S.ls_engine, *answer, level.iterations);
+      refine(first ? S.qp : S.ls, first ? *solved_by : *S.ls_engine, *answer, level.iterations);
       level.residual = answer->info.residual;
     }
     if (answer == nullptr) {

@@ -1,7 +1,10 @@
 #include "redres/qp/qp_builder.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "redres/common/error.hpp"
 
@@ -31,10 +34,35 @@ void QpBuilder::add_least_squares(const Eigen::Ref<const Eigen::MatrixXd>& J,
                  "J has at most n columns and d has one entry per row of J");
   const double s = weight_ * w;
   Eigen::MatrixXd& W = qp_->W;
+  // Each column's rows from its first to its last non-zero entry: two columns whose spans do not overlap have a zero
+  // inner product, so a posture's J = I costs O(n k), not O(n^2 k). The sums run over the overlap in the same order as
+  // over every row (the terms left out are exact zeros, except that 0 x inf or 0 x NaN is no longer summed: a
+  // non-finite J is refused by the checked build all the same). Up to kSpans columns (a stack array), else every row.
+  constexpr Eigen::Index kSpans = 128;
+  std::array<std::pair<Eigen::Index, Eigen::Index>, kSpans> span;
+  const bool spans = n <= kSpans && J.allFinite();
+  if (spans) {
+    for (Eigen::Index c = 0; c < n; ++c) {
+      Eigen::Index first = k, last = -1;
+      for (Eigen::Index i = 0; i < k; ++i) {
+        if (J(i, c) != 0.0) {
+          first = std::min(first, i);
+          last = i;
+        }
+      }
+      span[static_cast<std::size_t>(c)] = {first, last};
+    }
+  }
   for (Eigen::Index c = 0; c < n; ++c) {
     for (Eigen::Index r = 0; r < n; ++r) {
+      Eigen::Index from = 0, to = k - 1;
+      if (spans) {
+        from = std::max(span[static_cast<std::size_t>(r)].first, span[static_cast<std::size_t>(c)].first);
+        to = std::min(span[static_cast<std::size_t>(r)].second, span[static_cast<std::size_t>(c)].second);
+        if (from > to) continue;  // a zero inner product: W keeps its entry
+      }
       double g = 0.0;
-      for (Eigen::Index i = 0; i < k; ++i) g += J(i, r) * J(i, c);
+      for (Eigen::Index i = from; i <= to; ++i) g += J(i, r) * J(i, c);
       W(r, c) += s * g;
       if (r != c && g != 0.0) qp_->w_diagonal = false;
     }

@@ -8,6 +8,7 @@
 // BM_MotionStep/<config>_<variant>: configs/panda_helix_fast.toml (`fast`) and configs/panda_helix.toml (`helix`)
 // with the robot's acceleration and jerk constraints switched on and off (`none`: both listed with active = false;
 // `acceleration`, `jerk`, `both`), for the cost per step of each against the run without them (issue 25).
+// BM_ChainLevels/<one|three>: a 28-joint chain at one priority level and at three (below).
 
 #include <algorithm>
 #include <chrono>
@@ -85,6 +86,15 @@ void BM_MotionStep(benchmark::State& state, const std::string& config, bool acce
   BM_ScenarioFileStep(state, motion_variant(config, acceleration, jerk));
 }
 // The 10x helix, where the limits bind (the exact QP fails and the elastic QP is solved on about 600 steps) ...
+// BM_ChainLevels/<one|three>: tests/data/scenarios/chain28_*.toml, a 28-joint chain with its right hand's pose at one
+// level, and the same with the left hand held at priority 1 and a soft posture at 2 (issue 42: three levels cost at
+// most 3 times one).
+void BM_ChainLevels(benchmark::State& state, const char* which) {
+  BM_ScenarioFileStep(state, source_path(std::string("tests/data/scenarios/chain28_") + which + ".toml"));
+}
+BENCHMARK_CAPTURE(BM_ChainLevels, one, "one")->Iterations(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ChainLevels, three, "three")->Iterations(5)->Unit(benchmark::kMillisecond);
+
 BENCHMARK_CAPTURE(BM_MotionStep, fast_none, "panda_helix_fast", false, false)
     ->Iterations(5)
     ->Unit(benchmark::kMillisecond);

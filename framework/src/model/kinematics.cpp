@@ -319,7 +319,7 @@ struct KinematicsKernels {
   // Planar kernel: column j of J is z x (p_e - p_j) = (-(e_y - p_jy), e_x - p_jx) in the x and y rows, 1 in the phi
   // row. M = m, as in gradient_planar.
   template <int M>
-  static void jacobian_planar(const RobotModel& model, KinematicsData& data) {
+  [[gnu::noinline]] REDRES_HOT static void jacobian_planar(const RobotModel& model, KinematicsData& data) {
     const int n = model.dof();
     const double ex = data.ee_pose.translation().x(), ey = data.ee_pose.translation().y();
     int rows[M];
@@ -338,7 +338,7 @@ struct KinematicsKernels {
   // Planar kernel: w = det(J J') (with adj(J J') for the gradient). M is the number of task rows m (1 to 3), fixed at
   // compile time so that the loops over the rows unroll.
   template <int M>
-  static void measure_planar(const RobotModel& model, KinematicsData& data) {
+  [[gnu::noinline]] REDRES_HOT static void measure_planar(const RobotModel& model, KinematicsData& data) {
     const int n = model.dof();
     constexpr int m = M;
     const double* J = data.J.data();
@@ -365,7 +365,7 @@ struct KinematicsKernels {
 
   // Planar kernel: w (measure_planar<M>) and grad w in O(m n) from the prefix and suffix sums of the class comment.
   template <int M>
-  static void gradient_planar(const RobotModel& model, KinematicsData& data) {
+  [[gnu::noinline]] REDRES_HOT static void gradient_planar(const RobotModel& model, KinematicsData& data) {
     measure_planar<M>(model, data);
     const int n = model.dof();
     constexpr int m = M;

@@ -55,12 +55,7 @@ void Newton::run_fallback(const QpProblem& qp, SolverResult& result, int newton_
   // smallest eigenvalues leave it far from the optimum in x, usually has the right active set, and the exact step
   // from it lands (polish()).
   const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
-  lo_u_.head(n) = qp.lo;
-  hi_u_.head(n) = qp.hi;
-  lo_u_.segment(n, me).setConstant(-settings().varpi);
-  hi_u_.segment(n, me).setConstant(settings().varpi);
-  lo_u_.tail(mi).setZero();
-  hi_u_.tail(mi).setConstant(settings().varpi);
+  set_omega(qp);
   set_norms(qp);
   u_.head(n) = fallback_result_.x;  // its duals were cleared with its failure: the first exact step restores them
   u_.segment(n, me) = fallback_result_.y;

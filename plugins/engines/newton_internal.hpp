@@ -80,6 +80,7 @@ class Newton final : public LviEngine {
 
   // newton_kkt.cpp
   bool general_solve(const QpProblem& qp, SolverResult& result);
+  void set_omega(const QpProblem& qp);
   void set_norms(const QpProblem& qp);
   double target_at(const Eigen::VectorXd& w) const;
   bool exact_step_lands(const QpProblem& qp, double& e2);

@@ -29,13 +29,7 @@ namespace redres::newton_internal {
 // the rows cannot be met inside the bounds) or the iteration caps are reached.
 bool Newton::general_solve(const QpProblem& qp, SolverResult& result) {
   const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
-  const double varpi = settings().varpi;
-  lo_u_.head(n) = qp.lo;
-  hi_u_.head(n) = qp.hi;
-  lo_u_.segment(n, me).setConstant(-varpi);
-  hi_u_.segment(n, me).setConstant(varpi);
-  lo_u_.tail(mi).setZero();
-  hi_u_.tail(mi).setConstant(varpi);
+  set_omega(qp);
   int iterations = 0;
   if (warm()) {
     u_.head(n) = result.x;
@@ -70,6 +64,18 @@ bool Newton::general_solve(const QpProblem& qp, SolverResult& result) {
   ++iterations;
   if (exact_step_lands(qp, e2)) return solved(e2);
   return augmented_lagrangian(qp, iterations) && (e2 = natural_residual2(qp, u_), solved(e2));
+}
+
+// Omega of the LVI (eq. 14) into lo_u_, hi_u_: the bounds for x, +-varpi for y, [0, varpi] for z.
+void Newton::set_omega(const QpProblem& qp) {
+  const int n = qp.n(), me = qp.m_eq(), mi = qp.m_in();
+  const double varpi = settings().varpi;
+  lo_u_.head(n) = qp.lo;
+  hi_u_.head(n) = qp.hi;
+  lo_u_.segment(n, me).setConstant(-varpi);
+  hi_u_.segment(n, me).setConstant(varpi);
+  lo_u_.tail(mi).setZero();
+  hi_u_.tail(mi).setConstant(varpi);
 }
 
 // Infinity norms of W, J, J', A and A' for target_at(), once per solve (loops: no temporaries).

@@ -456,22 +456,22 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
     level.status = S.result.info.status;
     SolverResult* answer = nullptr;
     LviEngine* solved_by = S.engine;
-    if (S.result.info.status != SolverStatus::kSolved && S.result.info.status != SolverStatus::kInfeasible && S.next) {
-      // The level's engine stopped short on a QP whose rows can be met: the next engine tries it.
+    const SolverStatus status = S.result.info.status;
+    // Where the level's engine stopped short on a QP whose rows can be met, the next engine tries it.
+    const auto next_solves = [&] {
+      if (status == SolverStatus::kInfeasible || !S.next) return false;
       S.next->solve_valid(S.qp, S.next_result);
       level.iterations += S.next_result.info.iterations;
-      if (S.next_result.info.status == SolverStatus::kSolved) {
-        text << to_string(S.result.info.status) << " with " << S.engine->name() << ", solved by " << S.next->name();
-        level.status = SolverStatus::kSolved;
-        level.residual = S.next_result.info.residual;
-        answer = &S.next_result;
-        solved_by = S.next.get();
-      }
-    }
-    if (answer != nullptr) {
-      // solved by the next engine
-    } else if (S.result.info.status == SolverStatus::kSolved) {
+      return S.next_result.info.status == SolverStatus::kSolved;
+    };
+    if (status == SolverStatus::kSolved) {
       answer = &S.result;
+    } else if (next_solves()) {
+      text << to_string(status) << " with " << S.engine->name() << ", solved by " << S.next->name();
+      level.status = SolverStatus::kSolved;
+      level.residual = S.next_result.info.residual;
+      answer = &S.next_result;
+      solved_by = S.next.get();
     } else if (L.has_ls) {
       assemble(static_cast<int>(l), data, S.ls, true);
       S.ls_engine->solve_valid(S.ls, S.ls_result);

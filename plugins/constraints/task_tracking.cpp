@@ -39,8 +39,10 @@ TaskTracking::TaskTracking(const Config& config, const RobotModel& robot)
 
 REDRES_HOT void TaskTracking::add_to(const Context& ctx, QpBuilder& builder, PluginData* data) const {
   REDRES_REQUIRE(data != nullptr, "task_tracking", "its data is the one make_data() made");
+  // The paper's task goes straight into the QP's rows; any other through the task's rows. The scheme scans the QP.
+  if (task_.write_rows_in_order(ctx, data, builder)) return;
   auto& terms = static_cast<TaskData&>(*data);
-  task_.evaluate_unchecked(ctx, terms);  // its rows are the QP's, which the scheme scans
+  task_.evaluate_unchecked(ctx, terms);
   write_task_terms(task_, terms.rows, builder);
 }
 

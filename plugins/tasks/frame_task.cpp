@@ -265,10 +265,11 @@ REDRES_HOT double FrameTask::write_task_row(const Context& ctx, int r, int task_
   return e;
 }
 
-REDRES_HOT void FrameTask::velocity_rows_in_order(const Context& ctx, FrameTaskData& own) const {
+REDRES_HOT void FrameTask::velocity_rows_in_order(const Context& ctx, FrameTaskData& own, double* J_out,
+                                                  Eigen::Index ld, double* d_out) const {
   // The end-effector task at the velocity level, its rows the robot's task rows in their order (the paper's): J
-  // whole, then each row's e = r_d - f(theta) (a spatial orientation's: the rotation vector of R_d R') and
-  // d = r_d_dot + K e.
+  // whole (into J_out, column-major with leading dimension ld), then each row's e = r_d - f(theta) (a spatial
+  // orientation's: the rotation vector of R_d R') and d = r_d_dot + K e (into d_out).
   TaskTerms& t = own.rows;
   const KinematicsData& kin = *ctx.kinematics;
   const Eigen::Index reference = ctx.robot->reference_dim();
@@ -277,31 +278,50 @@ REDRES_HOT void FrameTask::velocity_rows_in_order(const Context& ctx, FrameTaskD
                  "frame task",
                  "the context carries the path's r_d and r_d_dot, one entry per reference row, and the robot's "
                  "kinematics");
-  std::copy_n(kin.J.data(), kin.J.size(), t.J.data());
+  const int k = rows();
+  const Eigen::Index n = kin.J.cols();
+  const double* __restrict from = kin.J.data();
+  double* __restrict to = J_out;
+  if (ld == k) {
+    for (Eigen::Index i = 0; i < k * n; ++i) to[i] = from[i];
+  } else {
+    for (Eigen::Index c = 0; c < n; ++c) {
+      for (int r = 0; r < k; ++r) to[c * ld + r] = from[c * k + r];
+    }
+  }
   const double* r_d = ctx.r_d->data();
   const double* r_d_dot = ctx.r_d_dot->data();
   const double* f = kin.f.data();
   Eigen::Vector3d e_path = Eigen::Vector3d::Zero();
   if (spatial_pose_) e_path = orientation_error_vector(rotation_from_vector(ctx.r_d->tail<3>()), kin.ee_pose.linear());
   double pos2 = 0.0, rot2 = 0.0;
-  const int k = rows();
   for (int r = 0; r < k; ++r) {
     const auto i = static_cast<std::size_t>(r);
     const int ref = reference_row_[i];
     const double e = spatial_pose_ && ref >= 3 ? e_path(ref - 3) : r_d[ref] - f[ref];
     t.error(r) = e;
-    t.d(r) = r_d_dot[ref] + gain_(r) * e;
+    d_out[r] = r_d_dot[ref] + gain_(r) * e;
     (static_cast<int>(kinds_[i]) < 3 ? pos2 : rot2) += e * e;
   }
   own.position_error = std::sqrt(pos2);
   own.orientation_error = std::sqrt(rot2);
 }
 
+REDRES_HOT bool FrameTask::write_rows_in_order(const Context& ctx, PluginData* data, QpBuilder& builder) const {
+  if (!(in_order_ && ctx.order == ControlOrder::kVelocity && mode() == TaskMode::kEquality)) return false;
+  auto& own = static_cast<FrameTaskData&>(*data);
+  auto J = builder.equality_matrix();
+  REDRES_REQUIRE(J.rows() == rows() && J.cols() == own.rows.J.cols(), "frame task",
+                 "the builder holds one equality row per task row");
+  velocity_rows_in_order(ctx, own, J.data(), J.outerStride(), builder.equality_rhs().data());
+  return true;
+}
+
 REDRES_HOT void FrameTask::compute(const Context& ctx, TaskData& data) const {
   auto& own = static_cast<FrameTaskData&>(data);
   if (in_order_ && ctx.order == ControlOrder::kVelocity && mode() != TaskMode::kInequality &&
       !(config_.damping > 0.0)) {
-    velocity_rows_in_order(ctx, own);
+    velocity_rows_in_order(ctx, own, own.rows.J.data(), own.rows.J.rows(), own.rows.d.data());
     return;
   }
   TaskTerms& t = own.rows;

@@ -10,8 +10,8 @@
 /// of rows (`task = ["x", "y", "z", "wx"]`) keeps those rows of the error and of J: S J x = S (r_d_dot + K e).
 ///
 /// It is the frame task (tasks/frame_task.hpp) on the frame "end_effector" with reference "path" and the robot's task
-/// rows, by another name: that task computes the rows, and the one writer of task rows (write_task_terms) puts them
-/// into the QP. As a constraint it holds at every priority level of a cascade, as a hard equality.
+/// rows, by another name: that task computes the rows and puts them into the QP (at the velocity level straight into
+/// the QP's rows, FrameTask::write_rows_in_order; otherwise through write_task_terms, the writer of every task). As a constraint it holds at every priority level of a cascade, as a hard equality.
 /// Reports to the run summary, for tasks with orientation rows: `max_orientation_error` (rad), the largest
 /// orientation error over the run (the angle between the desired and the actual orientation; for a subset, the norm
 /// of the rotation-vector error's task rows).

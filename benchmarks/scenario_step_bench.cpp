@@ -9,6 +9,8 @@
 // with the robot's acceleration and jerk constraints switched on and off (`none`: both listed with active = false;
 // `acceleration`, `jerk`, `both`), for the cost per step of each against the run without them (issue 25).
 // BM_ChainLevels/<one|three>: a 28-joint chain at one priority level and at three (below).
+// BM_HumanoidLevels/<one|three>: a 29-joint humanoid's waist and right arm at one level and at three, the middle one
+// unmeetable (below).
 
 #include <algorithm>
 #include <chrono>
@@ -94,6 +96,15 @@ void BM_ChainLevels(benchmark::State& state, const char* which) {
 }
 BENCHMARK_CAPTURE(BM_ChainLevels, one, "one")->Iterations(5)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ChainLevels, three, "three")->Iterations(5)->Unit(benchmark::kMillisecond);
+// BM_HumanoidLevels/<one|three>: tests/data/scenarios/humanoid29_*.toml, the right hand's pose at one level, and the
+// same with the left hand (a side branch, which only the waist moves) sent to a target at priority 1, which it cannot
+// reach (the level is relaxed at every step), and a soft posture at 2 (issue 42: three levels cost at most 3 times
+// one).
+void BM_HumanoidLevels(benchmark::State& state, const char* which) {
+  BM_ScenarioFileStep(state, source_path(std::string("tests/data/scenarios/humanoid29_") + which + ".toml"));
+}
+BENCHMARK_CAPTURE(BM_HumanoidLevels, one, "one")->Iterations(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_HumanoidLevels, three, "three")->Iterations(5)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_CAPTURE(BM_MotionStep, fast_none, "panda_helix_fast", false, false)
     ->Iterations(5)

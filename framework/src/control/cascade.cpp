@@ -133,6 +133,7 @@ Cascade::Cascade(const Scheme& scheme, const SchemeData& data, LviEngine& engine
       }
       slot->engine->setup(slot->qp.n(), slot->qp.m_eq(), slot->qp.m_in(), slot->result);
       if (L.has_ls) {
+        slot->engine->set_singular_values(false);  // a failure is retried in least squares; the text is added then
         size_level(static_cast<int>(l), slot->ls, true, rank);
         slot->ls_engine = make_engine(std::string(engine.name()), settings);
         slot->ls_engine->setup(slot->ls.n(), slot->ls.m_eq(), slot->ls.m_in(), slot->ls_result);
@@ -343,6 +344,30 @@ double Cascade::task_error(int l, const SchemeData& data, const Eigen::VectorXd&
   return worst;
 }
 
+double Cascade::hard_miss(int l, const SchemeData& data, const Eigen::VectorXd& x) const {
+  // The 2-norm of what the level's equality and inequality tasks miss (its soft tasks are never met exactly), as the
+  // engines' `infeasible` measures a fit of the rows (RowFit::miss_norm).
+  const Level& L = *levels_[static_cast<std::size_t>(l)];
+  double sum = 0.0;
+  for (int k : L.tasks) {
+    const Task& t = *scheme_->tasks()[static_cast<std::size_t>(k)];
+    if (t.mode() == TaskMode::kSoft) continue;
+    const TaskTerms& terms = static_cast<const TaskData&>(*data.tasks[static_cast<std::size_t>(k)]).rows;
+    for (int r = 0; r < t.rows(); ++r) {
+      const double v = terms.J.row(r).dot(x.head(n_));
+      double e = 0.0;
+      if (t.mode() == TaskMode::kInequality) {
+        if (t.has_upper(r)) e = std::max(e, v - terms.hi(r));
+        if (t.has_lower(r)) e = std::max(e, terms.lo(r) - v);
+      } else {
+        e = v - terms.d(r);
+      }
+      sum += e * e;
+    }
+  }
+  return std::sqrt(sum);
+}
+
 void Cascade::describe_level(int l, TextSink& out) const {
   const Level& L = *levels_[static_cast<std::size_t>(l)];
   out << "priority " << L.priority << " (";
@@ -446,45 +471,79 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
     }
     used_slot_[l] = held_eq_;
     Slot& S = *L.slots[static_cast<std::size_t>(held_eq_)];
+    const bool relaxed_before = S.used_ls && L.has_ls;  // this slot's level was relaxed at the last step
     S.used_ls = false;
     obj_w_ = scheme_->build_objectives(ctx, static_cast<int>(l), obj_, data);
-    assemble(static_cast<int>(l), data, S.qp, false);
-    S.engine->solve_valid(S.qp, S.result);  // assemble() wrote only checked entries
-    if (l == 0) info = S.result.info;       // the step's outcome, before any proximal step
-    level.iterations = S.result.info.iterations;
-    level.residual = S.result.info.residual;
-    level.status = S.result.info.status;
     SolverResult* answer = nullptr;
     LviEngine* solved_by = S.engine;
-    const SolverStatus status = S.result.info.status;
-    // Where the level's engine stopped short on a QP whose rows can be met, the next engine tries it.
-    const auto next_solves = [&] {
-      if (status == SolverStatus::kInfeasible || !S.next) return false;
-      S.next->solve_valid(S.qp, S.next_result);
-      level.iterations += S.next_result.info.iterations;
-      return S.next_result.info.status == SolverStatus::kSolved;
-    };
-    if (status == SolverStatus::kSolved) {
-      answer = &S.result;
-    } else if (next_solves()) {
-      text << to_string(status) << " with " << S.engine->name() << ", solved by " << S.next->name();
-      level.status = SolverStatus::kSolved;
-      level.residual = S.next_result.info.residual;
-      answer = &S.next_result;
-      solved_by = S.next.get();
-    } else if (L.has_ls) {
+    // Whether the QP assembled last has least-squares terms and no objective: then its answer is refined.
+    const auto refines = [&] { return least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone; };
+    bool ls_solved = false;  // S.ls_result is this step's least squares (refined where refines)
+    const auto solve_ls = [&] {
       assemble(static_cast<int>(l), data, S.ls, true);
       S.ls_engine->solve_valid(S.ls, S.ls_result);
       level.iterations += S.ls_result.info.iterations;
-      if (S.ls_result.info.status == SolverStatus::kSolved) {
-        answer = &S.ls_result;
-        S.used_ls = true;
-        level.residual = S.ls_result.info.residual;
-        text << "its tasks cannot all be met below the higher levels (" << to_string(S.result.info.status)
+      if (S.ls_result.info.status == SolverStatus::kSolved && refines()) {
+        refine(S.ls, *S.ls_engine, S.ls_result, level.iterations);
+      }
+      ls_solved = true;
+    };
+    const auto relax = [&] {
+      answer = &S.ls_result;
+      S.used_ls = true;
+      level.residual = S.ls_result.info.residual;
+      level.status = SolverStatus::kRelaxed;
+    };
+    if (relaxed_before) {
+      // Relaxed at the last step: the least squares first. With the levels above held, its answer is the best the
+      // level's rows can be met; where it still misses them by more than the tolerance, they cannot be met and it is
+      // the level's answer (the exact QP would only find its rows infeasible). Once it meets them, the exact QP is
+      // solved as at any other step.
+      solve_ls();
+      const double miss =
+          S.ls_result.info.status == SolverStatus::kSolved ? hard_miss(static_cast<int>(l), data, S.ls_result.x) : 0.0;
+      if (miss > S.ls_engine->settings().tolerance) {
+        relax();
+        text << "its tasks cannot all be met below the higher levels (in least squares they still miss by " << miss
              << "): solved in least squares";
-        level.status = SolverStatus::kRelaxed;
-      } else {
-        note_.assign(S.ls_result.info.diagnosis);
+      }
+    }
+    if (answer == nullptr) {
+      assemble(static_cast<int>(l), data, S.qp, false);
+      S.engine->solve_valid(S.qp, S.result);  // assemble() wrote only checked entries
+      if (l == 0) info = S.result.info;       // the step's outcome, before any proximal step
+      level.iterations += S.result.info.iterations;
+      level.residual = S.result.info.residual;
+      level.status = S.result.info.status;
+      const SolverStatus status = S.result.info.status;
+      // Where the level's engine stopped short on a QP whose rows can be met, the next engine tries it.
+      const auto next_solves = [&] {
+        if (status == SolverStatus::kInfeasible || !S.next) return false;
+        S.next->solve_valid(S.qp, S.next_result);
+        level.iterations += S.next_result.info.iterations;
+        return S.next_result.info.status == SolverStatus::kSolved;
+      };
+      if (status == SolverStatus::kSolved) {
+        answer = &S.result;
+      } else if (next_solves()) {
+        text << to_string(status) << " with " << S.engine->name() << ", solved by " << S.next->name();
+        level.status = SolverStatus::kSolved;
+        level.residual = S.next_result.info.residual;
+        answer = &S.next_result;
+        solved_by = S.next.get();
+      } else if (L.has_ls) {
+        if (!ls_solved) solve_ls();
+        if (S.ls_result.info.status == SolverStatus::kSolved) {
+          relax();
+          text << "its tasks cannot all be met below the higher levels (" << to_string(S.result.info.status)
+               << "): solved in least squares";
+        } else {
+          note_.assign(S.ls_result.info.diagnosis);
+        }
+      }
+      if (answer != nullptr && !S.used_ls && refines()) {
+        refine(S.qp, *solved_by, *answer, level.iterations);
+        level.residual = answer->info.residual;
       }
     }
     if (answer == nullptr && l == 0) {
@@ -497,15 +556,14 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
       }
       return nullptr;
     }
-    if (answer != nullptr && least_squares_terms_ && obj_w_ == QpBuilder::WrittenW::kNone) {
-      const bool first = !S.used_ls;
-      refine(first ? S.qp : S.ls, first ? *solved_by : *S.ls_engine, *answer, level.iterations);
-      level.residual = answer->info.residual;
-    }
+    if (answer != nullptr && S.used_ls) level.residual = answer->info.residual;
     if (answer == nullptr) {
       describe_level(static_cast<int>(l), text);
       text << " not solved: " << to_string(S.result.info.status) << ": " << S.result.info.diagnosis;
-      if (L.has_ls) text << "; in least squares too: " << to_string(S.ls_result.info.status) << ": " << note_;
+      if (L.has_ls) {
+        S.engine->describe_singular_rows(S.qp, text);
+        text << "; in least squares too: " << to_string(S.ls_result.info.status) << ": " << note_;
+      }
       text << "; the step keeps the answer of the levels above";
       skip = 1;
       continue;

@@ -143,11 +143,14 @@ void singular_rows(const QpProblem& qp, RowFitter& fitter, TextSink& s) {
 bool LviEngine::rows_unmeetable(const QpProblem& qp) { return fitter_.fit(qp).miss_norm() > settings_.tolerance; }
 
 void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info) {
+  diagnose_failure(qp, capped, info, fitter_.fit(qp));
+}
+
+void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info, const RowFit& fit) {
   // One decision gives both the status and the text: the rows are infeasible exactly when the best fit of the rows
   // inside the bounds misses them (RowFitter); otherwise the engine failed on a QP that has a solution, and the
   // text says how, with the residual compared to the tolerance only in the direction it holds. The text is written
   // into the diagnosis's reserved storage (the engine's own note is kept aside in note_ meanwhile): no allocation.
-  const RowFit& fit = fitter_.fit(qp);
   const bool unmeetable = fit.miss_norm() > settings_.tolerance;
   note_.assign(info.diagnosis);  // note_ is reserved: a copy, so each string keeps its own storage
   keep_diagnosis_capacity(info.diagnosis);
@@ -185,7 +188,9 @@ void LviEngine::diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& i
       diagnose_rows(qp, fit, settings_.tolerance, false, s);
     }
   }
-  singular_rows(qp, fitter_, s);
+  if (singular_values_) singular_rows(qp, fitter_, s);
 }
+
+void LviEngine::describe_singular_rows(const QpProblem& qp, TextSink& out) { singular_rows(qp, fitter_, out); }
 
 }  // namespace redres

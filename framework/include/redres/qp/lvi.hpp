@@ -90,7 +90,10 @@ class LviEngine {
   /// so that no entry is scanned twice per step. Sizes are still checked.
   void solve_valid(const QpProblem& qp, SolverResult& result);
   /// Forgets the warm start.
-  void reset() { warm_ = false; }
+  void reset() {
+    warm_ = false;
+    last_infeasible_ = false;
+  }
   /// Engine name ("projection", ...): the registry type, a static string.
   [[nodiscard]] virtual std::string_view name() const = 0;
   /// The settings.
@@ -100,6 +103,13 @@ class LviEngine {
   /// Whether a failed solve is diagnosed (the default). An engine that runs another as its fallback turns the
   /// other's off: it diagnoses the step once itself, naming both.
   void set_diagnoses(bool on) noexcept { diagnoses_ = on; }
+  /// Whether a failure's diagnosis ends with the equality rows' rank and conditioning (a singular value decomposition
+  /// of J; the default). A cascade's level that is solved again in least squares when it fails turns it off: the
+  /// text is read only if that fails too, and then describe_singular_rows() adds it.
+  void set_singular_values(bool on) noexcept { singular_values_ = on; }
+  /// Writes the equality rows' rank and conditioning where they are singular or nearly so (nothing otherwise), as a
+  /// failure's diagnosis ends.
+  void describe_singular_rows(const QpProblem& qp, TextSink& out);
   /// Whether the rows of `qp` cannot be met inside its bounds at the settings' tolerance: the best fit of the rows
   /// inside the bounds (best_row_fit) misses them by more than the tolerance in 2-norm (the equality rows' misses
   /// and the inequality rows' excesses), as the LVI residual measures them. The one decision behind every
@@ -130,11 +140,15 @@ class LviEngine {
   void run(const QpProblem& qp, SolverResult& result);  // solve() after its checks
   // The status and the diagnosis of a failed solve, from one decision (the row fit); runs only after a failure.
   void diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info);
+  // The same with the rows' best fit at hand (fitter_.fit(qp)'s).
+  void diagnose_failure(const QpProblem& qp, bool capped, SolverInfo& info, const RowFit& fit);
 
   SolverSettings settings_;
   bool warm_ = false;
+  bool last_infeasible_ = false;  // the last solve ended `infeasible`: the next first checks the rows' fit
   bool w_diagonal_ = true;
   bool diagnoses_ = true;
+  bool singular_values_ = true;
   int n_ = 0, m_e_ = 0, m_i_ = 0;
   RowFitter fitter_;  // the best fit of the rows inside the bounds, for failed solves
   std::string note_;  // a failed solve's own note, while the diagnosis is written around it (reserved at setup)

@@ -266,7 +266,7 @@ REDRES_HOT double FrameTask::write_task_row(const Context& ctx, int r, int task_
 }
 
 REDRES_HOT void FrameTask::velocity_rows_in_order(const Context& ctx, FrameTaskData& own, double* J_out,
-                                                  Eigen::Index ld, double* d_out) const {
+                                                  Eigen::Index ld, double* d_out, bool norms) const {
   // The end-effector task at the velocity level, its rows the robot's task rows in their order (the paper's): J
   // whole (into J_out, column-major with leading dimension ld), then each row's e = r_d - f(theta) (a spatial
   // orientation's: the rotation vector of R_d R') and d = r_d_dot + K e (into d_out).
@@ -303,6 +303,7 @@ REDRES_HOT void FrameTask::velocity_rows_in_order(const Context& ctx, FrameTaskD
     d_out[r] = r_d_dot[ref] + gain_(r) * e;
     (static_cast<int>(kinds_[i]) < 3 ? pos2 : rot2) += e * e;
   }
+  if (!norms) return;
   own.position_error = std::sqrt(pos2);
   own.orientation_error = std::sqrt(rot2);
 }
@@ -313,7 +314,7 @@ REDRES_HOT bool FrameTask::write_rows_in_order(const Context& ctx, PluginData* d
   auto J = builder.equality_matrix();
   REDRES_REQUIRE(J.rows() == rows() && J.cols() == own.rows.J.cols(), "frame task",
                  "the builder holds one equality row per task row");
-  velocity_rows_in_order(ctx, own, J.data(), J.outerStride(), builder.equality_rhs().data());
+  velocity_rows_in_order(ctx, own, J.data(), J.outerStride(), builder.equality_rhs().data(), false);
   return true;
 }
 
@@ -321,7 +322,7 @@ REDRES_HOT void FrameTask::compute(const Context& ctx, TaskData& data) const {
   auto& own = static_cast<FrameTaskData&>(data);
   if (in_order_ && ctx.order == ControlOrder::kVelocity && mode() != TaskMode::kInequality &&
       !(config_.damping > 0.0)) {
-    velocity_rows_in_order(ctx, own, own.rows.J.data(), own.rows.J.rows(), own.rows.d.data());
+    velocity_rows_in_order(ctx, own, own.rows.J.data(), own.rows.J.rows(), own.rows.d.data(), true);
     return;
   }
   TaskTerms& t = own.rows;

@@ -85,8 +85,9 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
 
   /// The end-effector task's rows written straight into the builder's equality rows, when they are the robot's task
   /// rows in their order at the velocity level in mode "equality" (the paper's task): J from the kinematics,
-  /// d = r_d_dot + K e, the errors kept in `data` (which make_data() made). Returns false, writing nothing, for any
-  /// other task; its rows then come from evaluate() and write_task_terms(). The same figures either way.
+  /// d = r_d_dot + K e, each row's error kept in `data` (which make_data() made), but not the errors' norms, which
+  /// only a recorded task's columns read (a constraint's rows are not recorded). Returns false, writing nothing, for
+  /// any other task; its rows then come from evaluate() and write_task_terms(). The same rows either way.
   bool write_rows_in_order(const Context& ctx, PluginData* data, QpBuilder& builder) const;
 
   [[nodiscard]] std::vector<std::string> recorded_columns() const override;
@@ -101,9 +102,9 @@ class FrameTask final : public Configured<Task, FrameTaskConfig>, public PluginO
   // task's rows); returns its error.
   double write_task_row(const Context& ctx, int r, int task_row, const Eigen::Vector3d& e_path, TaskTerms& t) const;
   // compute() for the rows of in_order_ at the velocity level, equality or soft, undamped (the paper's task): J into
-  // J_out (column-major, leading dimension ld), d into d_out, the errors into own.
-  void velocity_rows_in_order(const Context& ctx, FrameTaskData& own, double* J_out, Eigen::Index ld,
-                              double* d_out) const;
+  // J_out (column-major, leading dimension ld), d into d_out, the errors into own (with norms: their norms too).
+  void velocity_rows_in_order(const Context& ctx, FrameTaskData& own, double* J_out, Eigen::Index ld, double* d_out,
+                              bool norms) const;
   [[nodiscard]] bool has_position_rows() const;
   [[nodiscard]] bool has_orientation_rows() const;
 

@@ -233,8 +233,13 @@ void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_
   const Level& L = *levels_[static_cast<std::size_t>(l)];
   const int n = n_;
   qp.clear();
-  // The objective: the level's objectives, its soft tasks (and their damping).
-  qp.W.topLeftCorner(n, n) = obj_.W;
+  // The objective: the level's objectives, its soft tasks (and their damping). clear() left W zero: a diagonal W is
+  // its diagonal.
+  if (obj_.w_diagonal) {
+    for (int i = 0; i < n; ++i) qp.W(i, i) = obj_.W(i, i);
+  } else {
+    qp.W.topLeftCorner(n, n) = obj_.W;
+  }
   qp.zeta.head(n) = obj_.zeta;
   qp.w_diagonal = obj_.w_diagonal;
   // The constraints: rows and bounds.
@@ -265,7 +270,11 @@ void Cascade::assemble(int l, const SchemeData& data, QpProblem& qp, bool least_
   double scale = 0.0;
   for (int i = 0; i < qp.n(); ++i) scale = std::max(scale, qp.W(i, i));  // the slacks' weights too
   if (scale > 0.0) {
-    qp.W.topLeftCorner(n, n) /= scale;
+    if (qp.w_diagonal) {
+      for (int i = 0; i < n; ++i) qp.W(i, i) /= scale;
+    } else {
+      qp.W.topLeftCorner(n, n) /= scale;
+    }
     qp.zeta.head(n) /= scale;
     for (int i = n; i < qp.n(); ++i) qp.W(i, i) /= scale;
   }

@@ -37,6 +37,10 @@ struct Cascade::Level {
   int held_in = 0;   // inequality rows held from the levels above
   std::vector<RowTag> in_tags;  // its QP's inequality rows past the constraints'
   bool has_ls = false;          // below the first, with equality or inequality tasks: a least-squares retry
+  // Equality tasks alone (no soft or inequality task, no objective): its least squares is the best fit of its rows
+  // with the levels above held, so a relaxed level can be solved in least squares first at the next step.
+  bool ls_first = false;
+  bool relaxed_last = false;  // its answer at the last step was the least squares
   // One QP (and its least-squares retry) per number of held rows, 0 to held_eq, each with its engine: the held rows'
   // rank is known only at the step, and a QP with fewer independent rows than rows would be degenerate.
   std::vector<std::unique_ptr<Slot>> slots;
@@ -105,6 +109,10 @@ Cascade::Cascade(const Scheme& scheme, const SchemeData& data, LviEngine& engine
       held_tags.push_back({-1, 0, true, true, spec.priority});
     }
     level->has_ls = !levels_.empty() && level->eq_tasks + level->in_tasks > 0;
+    level->ls_first = level->has_ls && level->in_tasks == 0 && spec.objectives.empty() &&
+                      std::all_of(spec.tasks.begin(), spec.tasks.end(), [&](int k) {
+                        return tasks[static_cast<std::size_t>(k)]->mode() == TaskMode::kEquality;
+                      });
     levels_.push_back(std::move(level));
   }
   held_J_ = Eigen::MatrixXd::Zero(std::min(held_eq, n_), n_);
@@ -205,6 +213,7 @@ void Cascade::size_level(int l, QpProblem& qp, bool least_squares, int held_rows
 
 void Cascade::reset() {
   for (auto& level : levels_) {
+    level->relaxed_last = false;
     for (auto& slot : level->slots) {
       slot->engine->reset();
       if (slot->ls_engine) slot->ls_engine->reset();
@@ -353,11 +362,14 @@ double Cascade::task_error(int l, const SchemeData& data, const Eigen::VectorXd&
   return worst;
 }
 
-double Cascade::hard_miss(int l, const SchemeData& data, const Eigen::VectorXd& x) const {
+double Cascade::hard_miss(int l, const SchemeData& data, const Eigen::VectorXd& x, double& limit) const {
   // The 2-norm of what the level's equality and inequality tasks miss (its soft tasks are never met exactly), as the
-  // engines' `infeasible` measures a fit of the rows (RowFit::miss_norm).
+  // engines' `infeasible` measures a fit of the rows (RowFit::miss_norm). `limit`: 1e-6 (1 + |d|), far above what a
+  // least squares that meets its rows misses by (its solve's tolerance over the rows' conditioning, and eps's bias
+  // after the proximal steps): a level is taken as unmeetable only where it clearly is, and otherwise the exact QP
+  // decides.
   const Level& L = *levels_[static_cast<std::size_t>(l)];
-  double sum = 0.0;
+  double sum = 0.0, d_max = 0.0;
   for (int k : L.tasks) {
     const Task& t = *scheme_->tasks()[static_cast<std::size_t>(k)];
     if (t.mode() == TaskMode::kSoft) continue;
@@ -370,10 +382,12 @@ double Cascade::hard_miss(int l, const SchemeData& data, const Eigen::VectorXd& 
         if (t.has_lower(r)) e = std::max(e, terms.lo(r) - v);
       } else {
         e = v - terms.d(r);
+        d_max = std::max(d_max, std::abs(terms.d(r)));
       }
       sum += e * e;
     }
   }
+  limit = 1e-6 * (1.0 + d_max);
   return std::sqrt(sum);
 }
 
@@ -468,6 +482,7 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
     TextSink text(level.diagnosis);
     text.precision(6);
     if (skip >= 0) {
+      L.relaxed_last = false;
       text << "skipped: ";
       if (skip == 0) {
         text << "nothing left to decide (";
@@ -480,7 +495,8 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
     }
     used_slot_[l] = held_eq_;
     Slot& S = *L.slots[static_cast<std::size_t>(held_eq_)];
-    const bool relaxed_before = S.used_ls && L.has_ls;  // this slot's level was relaxed at the last step
+    const bool relaxed_before = L.ls_first && L.relaxed_last;
+    L.relaxed_last = false;
     S.used_ls = false;
     obj_w_ = scheme_->build_objectives(ctx, static_cast<int>(l), obj_, data);
     SolverResult* answer = nullptr;
@@ -500,6 +516,7 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
     const auto relax = [&] {
       answer = &S.ls_result;
       S.used_ls = true;
+      L.relaxed_last = true;
       level.residual = S.ls_result.info.residual;
       level.status = SolverStatus::kRelaxed;
     };
@@ -509,9 +526,10 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
       // the level's answer (the exact QP would only find its rows infeasible). Once it meets them, the exact QP is
       // solved as at any other step.
       solve_ls();
-      const double miss =
-          S.ls_result.info.status == SolverStatus::kSolved ? hard_miss(static_cast<int>(l), data, S.ls_result.x) : 0.0;
-      if (miss > S.ls_engine->settings().tolerance) {
+      double miss = 0.0, limit = 0.0;
+      if (S.ls_result.info.status == SolverStatus::kSolved)
+        miss = hard_miss(static_cast<int>(l), data, S.ls_result.x, limit);
+      if (miss > limit) {
         relax();
         text << "its tasks cannot all be met below the higher levels (in least squares they still miss by " << miss
              << "): solved in least squares";

@@ -111,10 +111,12 @@ REDRES_HOT void LviEngine::run(const QpProblem& qp, SolverResult& result) {
     return;
   }
 
-  // The step after an infeasible one: rows that still cannot be met inside the bounds are found by their best fit
-  // (the test behind every `infeasible`, diagnose_failure()) at a fraction of what an engine spends before it gives
-  // up (newton's dual runs off to varpi in about 60 iterations on a cascade's unmeetable level).
-  if (const RowFit* fit = last_infeasible_ ? &fitter_.fit(qp) : nullptr;
+  // The step after an infeasible one: equality rows that still cannot be met inside the bounds are found by their
+  // best fit (the test behind every `infeasible`, diagnose_failure(); exact for equality rows alone, where it is an
+  // active-set bounded least squares) at a fraction of what an engine spends before it gives up (newton's dual runs
+  // off to varpi in about 60 iterations on a cascade's unmeetable level). With inequality rows the fit is iterative
+  // and may stop short of a point that meets them, so the engine decides.
+  if (const RowFit* fit = last_infeasible_ && m_i_ == 0 ? &fitter_.fit(qp) : nullptr;
       fit != nullptr && fit->miss_norm() > settings_.tolerance) {
     info.status = SolverStatus::kInfeasible;
     info.residual = fit->miss_norm();

@@ -87,7 +87,7 @@ class Cascade {
   void assemble(int l, const SchemeData& data, QpProblem& qp, bool least_squares);
   void hold(int l, const SchemeData& data, const Eigen::VectorXd& x);
   [[nodiscard]] double task_error(int l, const SchemeData& data, const Eigen::VectorXd& x) const;
-  [[nodiscard]] double hard_miss(int l, const SchemeData& data, const Eigen::VectorXd& x) const;
+  [[nodiscard]] double hard_miss(int l, const SchemeData& data, const Eigen::VectorXd& x, double& limit) const;
   void describe_level(int l, TextSink& out) const;
   const Eigen::VectorXd* solve_one(const Context& ctx, SchemeData& data, SolverInfo& info);
   const Eigen::VectorXd* solve_levels(const Context& ctx, SchemeData& data, SolverInfo& info);

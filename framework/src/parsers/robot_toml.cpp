@@ -54,6 +54,28 @@ void only_with_urdf(const TableReader& r, const RobotReading& c, const char* key
   if (!c.from_urdf && r.raw().contains(key)) r.fail(key, std::string("is used only with `urdf`") + instead);
 }
 
+// A robot's acceleration (jerk) limits are enforced on every joint or on none (joint_acceleration_limits and the
+// braking law need every joint's): limits on some joints only are refused, naming the joints without one, where they
+// would otherwise go unenforced without a word.
+void motion_limits_on_every_joint(const TableReader& r, const RobotSpec& spec) {
+  for (const bool acceleration : {true, false}) {
+    std::string without;
+    std::size_t with = 0;
+    for (const JointSpec& jt : spec.joints) {
+      if (acceleration ? jt.acceleration_limit != nullptr : jt.jerk_limit != nullptr) {
+        ++with;
+      } else {
+        without += (without.empty() ? "'" : ", '") + jt.name + "'";
+      }
+    }
+    if (with == 0 || with == spec.joints.size()) continue;
+    const char* key = acceleration ? "acceleration_limit" : "jerk_limit";
+    r.fail("joints", std::string(acceleration ? "expected an " : "expected a ") + key + " on every joint or on none: " +
+                         std::to_string(with) + " of " + std::to_string(spec.joints.size()) + " joints have one, and " +
+                         without + " not (limits on some joints only would not be enforced on any)");
+  }
+}
+
 }  // namespace
 
 const Schema<RobotReading>& RobotReading::schema() {
@@ -197,11 +219,13 @@ const Schema<RobotReading>& RobotReading::schema() {
                  if (c.from_urdf) {
                    UrdfOverlay overlay(r, c.base_link, c.tip_link, c.problems);
                    build_chain(c.chain, c.options, overlay, c.spec, c.problems);
+                   motion_limits_on_every_joint(r, c.spec);
                    return;
                  }
                  c.chain = read_toml_chain(r, c.spec.kind, c.spec.convention);
                  AsGiven as_given(r);
                  build_chain(c.chain, c.options, as_given, c.spec, c.problems);
+                 motion_limits_on_every_joint(r, c.spec);
                }),
       entry<C>("links", "array of tables [[links]] (below)", "", "none",
                "collision shapes of the URDF's links (with `urdf` only)",

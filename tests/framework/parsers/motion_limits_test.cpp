@@ -78,17 +78,45 @@ name = "j2"
 length = 0.2
 limits = [-1.0, 1.0]
 velocity_limit = { type = "constant", lower = -1.0, upper = 1.0 }
+acceleration_limit = { type = "constant", lower = -3.0, upper = 3.0 }
+jerk_limit = { type = "constant", lower = -200.0, upper = 200.0 }
 )toml";
   const RobotModel robot = load_robot(dir / "robot.toml");
-  EXPECT_FALSE(robot.has_acceleration_limits()) << "joint 2 has none";
+  EXPECT_TRUE(robot.has_acceleration_limits());
   Eigen::VectorXd lo(2), hi(2);
   robot.acceleration_limits(Eigen::Vector2d(0.5, 0.0), lo, hi);
   EXPECT_DOUBLE_EQ(hi(0), 2.5);
   EXPECT_DOUBLE_EQ(lo(0), -2.5);
-  EXPECT_TRUE(std::isinf(hi(1)));
+  EXPECT_EQ(hi(1), 3.0);
   robot.jerk_limits(Eigen::Vector2d(0.0, 0.0), lo, hi);
   EXPECT_EQ(lo(0), -100.0);
   EXPECT_EQ(hi(0), 50.0);
+}
+
+TEST(MotionLimits, LimitsOnSomeJointsOnlyAreRefusedNamingTheJointsWithout) {
+  // Issue 43: a robot whose joints give acceleration limits to 6 of 7 joints ran with none enforced, silently.
+  const auto dir = scratch_dir("motion_limits_partial");
+  for (const char* key : {"acceleration_limit", "jerk_limit"}) {
+    SCOPED_TRACE(key);
+    const std::string joint_keys =
+        "limits = [-1.0, 1.0]\nvelocity_limit = { type = \"constant\", lower = -1.0, upper = 1.0 }\n";
+    std::ofstream(dir / "robot.toml") << "name = \"three\"\nkind = \"planar\"\n"
+                                      << "[[joints]]\nname = \"j1\"\nlength = 0.3\n"
+                                      << joint_keys << key << " = { type = \"constant\", lower = -3.0, upper = 3.0 }\n"
+                                      << "[[joints]]\nname = \"j2\"\nlength = 0.2\n"
+                                      << joint_keys << "[[joints]]\nname = \"j3\"\nlength = 0.1\n"
+                                      << joint_keys;
+    try {
+      (void)load_robot(dir / "robot.toml");
+      ADD_FAILURE() << "a robot with limits on one joint of three was loaded";
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("robot.toml:3:1"), std::string::npos) << what;  // the first [[joints]] entry
+      EXPECT_NE(what.find("key 'joints'"), std::string::npos) << what;
+      EXPECT_NE(what.find(std::string(key) + " on every joint or on none"), std::string::npos) << what;
+      EXPECT_NE(what.find("1 of 3 joints have one, and 'j2', 'j3' not"), std::string::npos) << what;
+    }
+  }
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 #include "redres/control/plugin.hpp"
+#include "common/text.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -177,6 +178,7 @@ template <class Common>
 void apply_common(const TableReader& config, const Common& common, Plugin& p) {
   if (common.name) {
     if (common.name->empty()) config.fail("name", "expected a non-empty name");
+    if (const std::string why = column_name_problem(*common.name); !why.empty()) config.fail("name", why);
     p.set_name(*common.name);
   }
   p.set_active(common.active);

@@ -1,4 +1,5 @@
 #include "redres/control/task.hpp"
+#include "common/text.hpp"
 #include "redres/common/hot.hpp"
 
 #include <algorithm>
@@ -209,6 +210,7 @@ std::unique_ptr<Task> make_task(const TableReader& config, const RobotModel& rob
   config.finish();
   if (common.name) {
     if (common.name->empty()) config.fail("name", "expected a non-empty name");
+    if (const std::string why = column_name_problem(*common.name); !why.empty()) config.fail("name", why);
     p->set_name(*common.name);
   }
   p->set_active(common.active);

@@ -2,7 +2,8 @@
 priorities held at the default tolerance.
 
 The set: every priority level's QP (`Controller.level_qp`) at every 8th of the first 160 steps of shipped scenarios
-(6- and 7-joint arms, the planar 4R and a 28-joint chain at three levels; soft tasks and damping give a dense W with eigenvalues down to 1e-9;
+(6- and 7-joint arms, the planar 4R, a 28-joint chain at three levels and a humanoid's waist and arm with a level that
+cannot be met; soft tasks and damping give a dense W with eigenvalues down to 1e-9;
 obstacle rows; levels that hold the levels above them). The reference: Debian's CVXOPT (an interior-point solver
 nobody in this project wrote), polished by solving the KKT system of the active set it finds. Each engine solves each
 QP from a cold start (`redres.solve_qp`). Checked: an answer called `solved` passes an independent KKT check written

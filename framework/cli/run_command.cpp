@@ -244,10 +244,20 @@ int run_scenario(const RunOptions& options) {
                                "' runs on the kinematic plant; add --set plant.kind=mujoco");
     }
     const std::filesystem::path model = std::filesystem::path(opts->out) / "mujoco_model.xml";
+    // An earlier model redres wrote here (in the manifest, unchanged since) is replaced; any other file of that name
+    // is the user's and stays, as --film's do.
+    remove_earlier_output(opts->out, "mujoco_model.xml");
+    if (std::filesystem::exists(std::filesystem::symlink_status(model))) {
+      throw std::runtime_error("--write-mjcf: " + model.string() +
+                               " exists, and redres did not write it there (or it changed since): redres replaces "
+                               "nothing it did not write; remove it or use another --out");
+    }
     write_text_file(model, scenario_mjcf(scenario));  // before the run: MuJoCo's own viewer can open it at once
     if (!opts->quiet) std::cout << "MuJoCo model: " << model.string() << "\n";
   }
   const Outcome o = run_one(std::move(scenario), opts->out, opts->quiet, record);
+  // Listed after the run, whose own list of outputs would otherwise take it for an earlier run's and remove it.
+  if (opts->write_mjcf) add_to_output_manifest(opts->out, {"mujoco_model.xml"});
   if (o.run.interrupted || g_stop_requested.load()) return kExitInterrupted;  // no figures: asked to stop
   const std::string written =
       std::string(record.format == TrajectoryFormat::kHdf5 ? "trajectory.h5" : "trajectory.csv, frames.csv") +

@@ -76,6 +76,29 @@ TEST(PlantCommand, ValidateNamesThePlant) {
       << r.out;
 }
 
+TEST(PlantCommand, WriteMjcfReplacesOnlyAModelItWrote) {
+  // Issue 43: --write-mjcf replaced a user's own mujoco_model.xml in --out, silently.
+  if (!mujoco_available()) GTEST_SKIP() << "no MuJoCo in this build: AMujocoScenarioRunsOrNamesThePackageToInstall";
+  const std::filesystem::path out = scratch("plant_mjcf_mine");
+  std::filesystem::create_directories(out);
+  std::ofstream(out / "mujoco_model.xml") << "<mine/>\n";
+  const std::string run = "run configs/paper_r_mujoco.toml --quiet --write-mjcf --out '";
+  Cli r = redres(run + out.string() + "'");
+  EXPECT_NE(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("mujoco_model.xml exists, and redres did not write it there"), std::string::npos) << r.out;
+  EXPECT_EQ(read_text(out / "mujoco_model.xml"), "<mine/>\n");
+  EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
+  std::filesystem::remove_all(out);
+  // Its own model, from an earlier run into the same directory, is replaced.
+  const std::filesystem::path again = scratch("plant_mjcf_again");
+  for (int k = 0; k < 2; ++k) {
+    r = redres(run + again.string() + "'");
+    ASSERT_EQ(r.code, 0) << "run " << k << ": " << r.out;
+    EXPECT_NE(read_text(again / "mujoco_model.xml").find("<actuator>"), std::string::npos);
+  }
+  std::filesystem::remove_all(again);
+}
+
 TEST(PlantCommand, FilmAndWriteMjcfRefuseAKinematicScenario) {
   const std::filesystem::path out = scratch("plant_refuse");
   for (const char* flag : {"--film", "--write-mjcf"}) {

@@ -363,27 +363,18 @@ double Cascade::task_error(int l, const SchemeData& data, const Eigen::VectorXd&
 }
 
 double Cascade::hard_miss(int l, const SchemeData& data, const Eigen::VectorXd& x, double& limit) const {
-  // The 2-norm of what the level's equality and inequality tasks miss (its soft tasks are never met exactly), as the
-  // engines' `infeasible` measures a fit of the rows (RowFit::miss_norm). `limit`: 1e-6 (1 + |d|), far above what a
-  // least squares that meets its rows misses by (its solve's tolerance over the rows' conditioning, and eps's bias
+  // The 2-norm of what the level's equality rows miss (a level solved in least squares first has no other rows), as
+  // the engines' `infeasible` measures a fit of the rows (RowFit::miss_norm). `limit`: 1e-6 (1 + |d|), far above what
+  // a least squares that meets its rows misses by (its solve's tolerance over the rows' conditioning, and eps's bias
   // after the proximal steps): a level is taken as unmeetable only where it clearly is, and otherwise the exact QP
   // decides.
   const Level& L = *levels_[static_cast<std::size_t>(l)];
   double sum = 0.0, d_max = 0.0;
   for (int k : L.tasks) {
-    const Task& t = *scheme_->tasks()[static_cast<std::size_t>(k)];
-    if (t.mode() == TaskMode::kSoft) continue;
     const TaskTerms& terms = static_cast<const TaskData&>(*data.tasks[static_cast<std::size_t>(k)]).rows;
-    for (int r = 0; r < t.rows(); ++r) {
-      const double v = terms.J.row(r).dot(x.head(n_));
-      double e = 0.0;
-      if (t.mode() == TaskMode::kInequality) {
-        if (t.has_upper(r)) e = std::max(e, v - terms.hi(r));
-        if (t.has_lower(r)) e = std::max(e, terms.lo(r) - v);
-      } else {
-        e = v - terms.d(r);
-        d_max = std::max(d_max, std::abs(terms.d(r)));
-      }
+    for (Eigen::Index r = 0; r < terms.d.size(); ++r) {
+      const double e = terms.J.row(r).dot(x.head(n_)) - terms.d(r);
+      d_max = std::max(d_max, std::abs(terms.d(r)));
       sum += e * e;
     }
   }
@@ -583,7 +574,6 @@ const Eigen::VectorXd* Cascade::solve_levels(const Context& ctx, SchemeData& dat
       }
       return nullptr;
     }
-    if (answer != nullptr && S.used_ls) level.residual = answer->info.residual;
     if (answer == nullptr) {
       describe_level(static_cast<int>(l), text);
       text << " not solved: " << to_string(S.result.info.status) << ": " << S.result.info.diagnosis;
